@@ -1,0 +1,6 @@
+//! The host side: simulator, trainer, and the tools around policy blobs.
+#![warn(missing_docs)]
+
+pub mod atomic;
+pub mod inspect;
+pub mod policy_file;

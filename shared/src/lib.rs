@@ -1,0 +1,33 @@
+//! The contract between the host trainer and the Zumo firmware.
+//!
+//! Everything both sides must compute identically lives here, in plain
+//! integer arithmetic that the ATmega32U4 runs exactly and cheaply:
+//!
+//! - [`FieldValue`] and [`SensorReading`]: what one robot perceives in one
+//!   control step, in fixed point;
+//! - [`StateHasher`]: reading -> [`State`], with the canonical bit layout of
+//!   `docs/state-hash.md`;
+//! - [`ActionTable`]: the angular speeds a policy chooses among;
+//! - [`PolicyTable`]: the greedy policy, 2 bits per state;
+//! - [`PolicyBlob`]: the versioned, checksummed file that carries a policy
+//!   from the trainer to the firmware.
+//!
+//! The crate is `no_std` and allocation-free so that the firmware links
+//! the very same code the simulator runs.
+#![no_std]
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod action;
+pub mod blob;
+pub mod field;
+pub mod hasher;
+pub mod policy;
+pub mod reading;
+
+pub use action::{ActionId, ActionTable, ActionTableError};
+pub use blob::{BlobError, PolicyBlob, Provenance};
+pub use field::FieldValue;
+pub use hasher::{State, StateHasher, StateInputs};
+pub use policy::PolicyTable;
+pub use reading::SensorReading;
