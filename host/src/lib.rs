@@ -3,4 +3,6 @@
 
 pub mod atomic;
 pub mod inspect;
+pub mod learn;
 pub mod policy_file;
+pub mod report;

@@ -1,0 +1,185 @@
+//! The tabular action-value function shared by every robot.
+
+use rand::RngExt;
+use serde::{Deserialize, Serialize};
+use shared::{ActionId, PolicyTable, State, StateHasher};
+
+/// Q(s, a) for every state of one hasher and every action, with visit counts.
+///
+/// One table is shared by the whole swarm (the thesis' single policy); every
+/// robot's experience updates it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct QTable {
+    hasher: StateHasher,
+    actions: usize,
+    values: Vec<f64>,
+    visits: Vec<u64>,
+}
+
+/// Learning-rate and discount of the Q-update.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct QParams {
+    /// Learning rate alpha.
+    pub alpha: f64,
+    /// Discount gamma.
+    pub gamma: f64,
+}
+
+impl Default for QParams {
+    /// The thesis' alpha 0.2, gamma 0.9.
+    fn default() -> QParams {
+        QParams { alpha: 0.2, gamma: 0.9 }
+    }
+}
+
+impl QTable {
+    /// A table with every value at `initial` (the thesis uses 1.0) and no visits.
+    pub fn new(hasher: StateHasher, actions: usize, initial: f64) -> QTable {
+        let n = hasher.num_states() * actions;
+        QTable { hasher, actions, values: vec![initial; n], visits: vec![0; n] }
+    }
+
+    /// The hasher whose states index the table.
+    pub fn hasher(&self) -> StateHasher {
+        self.hasher
+    }
+
+    /// Number of actions per state.
+    pub fn num_actions(&self) -> usize {
+        self.actions
+    }
+
+    /// The values of one state's actions.
+    pub fn row(&self, state: State) -> &[f64] {
+        let start = state.index() * self.actions;
+        &self.values[start..start + self.actions]
+    }
+
+    /// Q(s, a).
+    pub fn value(&self, state: State, action: ActionId) -> f64 {
+        self.row(state)[action.index()]
+    }
+
+    /// How often (s, a) was updated.
+    pub fn visits(&self, state: State, action: ActionId) -> u64 {
+        self.visits[state.index() * self.actions + action.index()]
+    }
+
+    /// Number of states with at least one update.
+    pub fn states_visited(&self) -> usize {
+        self.visits.chunks(self.actions).filter(|row| row.iter().any(|&v| v > 0)).count()
+    }
+
+    /// An action with the greatest value; among equal maxima, one chosen
+    /// uniformly at random (the generator is drawn only when there is a tie).
+    pub fn greedy(&self, state: State, rng: &mut impl RngExt) -> ActionId {
+        let row = self.row(state);
+        let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let ties = row.iter().filter(|&&v| v == best).count();
+        let pick = if ties > 1 { rng.random_range(0..ties) } else { 0 };
+        let index = row.iter().enumerate().filter(|(_, &v)| v == best).nth(pick).map_or(0, |(i, _)| i);
+        ActionId(index as u8)
+    }
+
+    /// Epsilon-greedy choice: with probability `epsilon` a uniformly random
+    /// action, otherwise [`QTable::greedy`]. With `epsilon == 0` the
+    /// exploration draw is skipped.
+    pub fn select(&self, state: State, epsilon: f64, rng: &mut impl RngExt) -> ActionId {
+        if epsilon > 0.0 && rng.random::<f64>() < epsilon {
+            ActionId(rng.random_range(0..self.actions) as u8)
+        } else {
+            self.greedy(state, rng)
+        }
+    }
+
+    /// The Q-learning update Q(s,a) += alpha (r + gamma max_a' Q(s',a') - Q(s,a)).
+    pub fn update(&mut self, s: State, a: ActionId, reward: f64, next: State, params: QParams) {
+        let next_best = self.row(next).iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let i = s.index() * self.actions + a.index();
+        self.values[i] += params.alpha * (reward + params.gamma * next_best - self.values[i]);
+        self.visits[i] += 1;
+    }
+
+    /// The greedy policy, ties broken towards the lowest action id so that
+    /// export is deterministic (unvisited states get action 0).
+    pub fn greedy_policy(&self) -> PolicyTable {
+        let mut table = PolicyTable::new(self.hasher);
+        for s in 0..self.hasher.num_states() as u16 {
+            let row = self.row(State(s));
+            let mut best = 0;
+            for (a, &v) in row.iter().enumerate() {
+                if v > row[best] {
+                    best = a;
+                }
+            }
+            table.set(State(s), ActionId(best as u8));
+        }
+        table
+    }
+
+    /// Whether another table has the same shape (hasher and action count),
+    /// so that its values can seed this run.
+    pub fn same_shape(&self, other: &QTable) -> bool {
+        self.hasher == other.hasher && self.actions == other.actions
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_pcg::Pcg64Mcg;
+
+    #[test]
+    fn update_matches_a_hand_computed_example() {
+        let mut q = QTable::new(StateHasher::Original, 4, 1.0);
+        let p = QParams { alpha: 0.2, gamma: 0.9 };
+        // Q(5,1) = 1 + 0.2 (0.5 + 0.9 x 1 - 1) = 1.08
+        q.update(State(5), ActionId(1), 0.5, State(7), p);
+        assert!((q.value(State(5), ActionId(1)) - 1.08).abs() < 1e-12);
+        // next state 5 now has max 1.08: Q(9,0) = 1 + 0.2 (-1 + 0.9 x 1.08 - 1) = 0.7944
+        q.update(State(9), ActionId(0), -1.0, State(5), p);
+        assert!((q.value(State(9), ActionId(0)) - 0.7944).abs() < 1e-12);
+        assert_eq!(q.visits(State(5), ActionId(1)), 1);
+        assert_eq!(q.states_visited(), 2);
+    }
+
+    #[test]
+    fn greedy_picks_the_maximum() {
+        let mut q = QTable::new(StateHasher::Bits7, 4, 0.0);
+        q.update(State(3), ActionId(2), 1.0, State(0), QParams::default());
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        for _ in 0..100 {
+            assert_eq!(q.greedy(State(3), &mut rng), ActionId(2));
+        }
+        assert_eq!(q.greedy_policy().action(State(3)), ActionId(2));
+        assert_eq!(q.greedy_policy().action(State(4)), ActionId(0));
+    }
+
+    #[test]
+    fn ties_are_broken_uniformly() {
+        let q = QTable::new(StateHasher::Original, 4, 1.0);
+        let mut rng = Pcg64Mcg::seed_from_u64(7);
+        let mut counts = [0u32; 4];
+        let n = 40_000;
+        for _ in 0..n {
+            counts[q.greedy(State(0), &mut rng).index()] += 1;
+        }
+        // Each count ~ Binomial(40000, 1/4): sd ~ 87; allow 5 sd.
+        for c in counts {
+            assert!((c as i64 - 10_000).abs() < 435, "{counts:?}");
+        }
+    }
+
+    #[test]
+    fn epsilon_one_explores_every_action() {
+        let mut q = QTable::new(StateHasher::Original, 3, 0.0);
+        q.update(State(0), ActionId(0), 10.0, State(1), QParams::default());
+        let mut rng = Pcg64Mcg::seed_from_u64(3);
+        let mut seen = [false; 3];
+        for _ in 0..200 {
+            seen[q.select(State(0), 1.0, &mut rng).index()] = true;
+        }
+        assert_eq!(seen, [true; 3]);
+    }
+}

@@ -1,0 +1,224 @@
+//! PNG charts for experiment reports, drawn with `plotters` into memory and
+//! written atomically.
+
+use super::stats::{Line, MeanCi};
+use anyhow::{anyhow, Context, Result};
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+const WIDTH: u32 = 960;
+const HEIGHT: u32 = 600;
+const FONT: &str = "sans-serif";
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
+
+/// Registers the embedded DejaVu Sans once per process.
+fn ensure_font() -> Result<()> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        let bytes: &'static [u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+        plotters::style::register_font(FONT, FontStyle::Normal, bytes).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(anyhow!("the embedded chart font does not load"))
+    }
+}
+
+/// One arm of an experiment over time: `trials[t][i]` is trial t's value at `x[i]`.
+#[derive(Clone, Debug)]
+pub struct Band {
+    /// Legend label.
+    pub name: String,
+    /// Sample points (steps).
+    pub x: Vec<f64>,
+    /// One series per trial, each as long as `x`.
+    pub trials: Vec<Vec<f64>>,
+}
+
+/// Points of one arm, summarised by a least-squares line.
+#[derive(Clone, Debug)]
+pub struct Scatter {
+    /// Legend label.
+    pub name: String,
+    /// (x, y) points.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Axis labels and title of a chart.
+#[derive(Clone, Copy, Debug)]
+pub struct Labels<'a> {
+    /// Title above the chart.
+    pub title: &'a str,
+    /// X axis label.
+    pub x: &'a str,
+    /// Y axis label.
+    pub y: &'a str,
+}
+
+/// Mean over trials with its 95 % confidence band, one line per arm (like
+/// the thesis' Figure 15).
+pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band]) -> Result<()> {
+    let summaries: Vec<Vec<(f64, MeanCi)>> = bands
+        .iter()
+        .map(|b| {
+            b.x.iter()
+                .enumerate()
+                .map(|(i, &x)| {
+                    let column: Vec<f64> = b.trials.iter().filter_map(|t| t.get(i).copied()).collect();
+                    (x, MeanCi::of(&column))
+                })
+                .collect()
+        })
+        .collect();
+    let x_max = bands.iter().flat_map(|b| b.x.iter().copied()).fold(1.0, f64::max);
+    let y_max = summaries.iter().flatten().map(|(_, ci)| ci.high()).fold(1.0, f64::max) * 1.05;
+    render(path, |root| {
+        let mut chart = frame(root, labels, x_max, y_max)?;
+        for (k, (band, summary)) in bands.iter().zip(&summaries).enumerate() {
+            let color = PALETTE[k % PALETTE.len()];
+            let mut outline: Vec<(f64, f64)> = summary.iter().map(|(x, ci)| (*x, ci.high())).collect();
+            outline.extend(summary.iter().rev().map(|(x, ci)| (*x, ci.low().max(0.0))));
+            chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.2).filled())))?;
+            chart
+                .draw_series(LineSeries::new(summary.iter().map(|(x, ci)| (*x, ci.mean)), color.stroke_width(2)))?
+                .label(band.name.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        }
+        legend(&mut chart)
+    })
+}
+
+/// Points per arm with each arm's least-squares line (like the thesis'
+/// Figure 24).
+pub fn points_with_trend(path: &Path, labels: Labels<'_>, series: &[Scatter]) -> Result<()> {
+    let x_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(1.0, f64::max);
+    let y_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(1.0, f64::max) * 1.05;
+    render(path, |root| {
+        let mut chart = frame(root, labels, x_max, y_max)?;
+        for (k, s) in series.iter().enumerate() {
+            let color = PALETTE[k % PALETTE.len()];
+            chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 2, color.mix(0.35).filled())))?;
+            let label = match Line::fit(&s.points) {
+                Some(line) => {
+                    chart.draw_series(LineSeries::new(
+                        [(0.0, line.at(0.0)), (x_max, line.at(x_max))],
+                        color.stroke_width(3),
+                    ))?;
+                    format!("{} (fit {:+.3e} x + {:.1})", s.name, line.slope, line.intercept)
+                }
+                None => s.name.clone(),
+            };
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+        }
+        legend(&mut chart)
+    })
+}
+
+type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+
+fn frame<'a, 'b>(
+    root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    labels: Labels<'_>,
+    x_max: f64,
+    y_max: f64,
+) -> Result<Chart<'a, 'b>> {
+    let mut chart = ChartBuilder::on(root)
+        .caption(labels.title, (FONT, 24))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(0.0..x_max, 0.0..y_max)?;
+    chart
+        .configure_mesh()
+        .x_desc(labels.x)
+        .y_desc(labels.y)
+        .label_style((FONT, 14))
+        .x_label_formatter(&|x| format_count(*x))
+        .draw()?;
+    Ok(chart)
+}
+
+fn legend<'a, 'b>(chart: &mut Chart<'a, 'b>) -> Result<()>
+where
+    'b: 'a,
+{
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()?;
+    Ok(())
+}
+
+fn format_count(x: f64) -> String {
+    if x >= 1e6 {
+        format!("{:.1}M", x / 1e6)
+    } else if x >= 1e3 {
+        format!("{:.0}k", x / 1e3)
+    } else {
+        format!("{x:.0}")
+    }
+}
+
+/// Draws into an RGB buffer, then encodes a PNG and writes it atomically.
+fn render(
+    path: &Path,
+    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<()>,
+) -> Result<()> {
+    ensure_font()?;
+    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        root.fill(&WHITE)?;
+        draw(&root).with_context(|| format!("cannot draw chart {}", path.display()))?;
+        root.present()?;
+    }
+    let image = image::RgbImage::from_raw(WIDTH, HEIGHT, buffer).context("chart buffer has the wrong size")?;
+    let mut png = Vec::new();
+    image
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .with_context(|| format!("cannot encode chart {}", path.display()))?;
+    crate::atomic::write(path, &png)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn charts_render_to_png_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let x: Vec<f64> = (0..50).map(|i| i as f64 * 1000.0).collect();
+        let bands = vec![
+            Band { name: "OC".into(), x: x.clone(), trials: vec![x.iter().map(|v| v / 1000.0).collect(); 3] },
+            Band {
+                name: "RL".into(),
+                x: x.clone(),
+                trials: (0..3).map(|t| x.iter().map(|v| v / 2000.0 + t as f64).collect()).collect(),
+            },
+        ];
+        let labels = Labels { title: "Formations", x: "step", y: "formations" };
+        let path = dir.path().join("f.png");
+        mean_with_band(&path, labels, &bands).unwrap();
+        let png = image::open(&path).unwrap();
+        assert_eq!((png.width(), png.height()), (WIDTH, HEIGHT));
+        let scatter = vec![Scatter { name: "A".into(), points: x.iter().map(|&v| (v, 100.0 + v / 100.0)).collect() }];
+        let path = dir.path().join("c.png");
+        points_with_trend(&path, labels, &scatter).unwrap();
+        assert!(image::open(&path).is_ok());
+    }
+}

@@ -1,0 +1,4 @@
+//! Experiment reports: statistics and charts.
+
+pub mod chart;
+pub mod stats;
