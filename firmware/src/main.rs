@@ -1,7 +1,112 @@
-//! Firmware entry point. On the host this binary is empty so that the
-//! workspace builds; the AVR build is `scripts/build-firmware`.
+//! Firmware entry point: the control loop. On the host this binary is empty
+//! so that the workspace builds; the AVR build is `scripts/build-firmware`.
+//!
+//! Each 20 ms period: buttons -> field sensors (RC timing) -> Pixy blocks
+//! -> supervisor (mode, faults) -> decision -> motors -> EEPROM (after a
+//! calibration sweep) -> LEDs -> log frame on USART1.
 #![cfg_attr(target_arch = "avr", no_std)]
 #![cfg_attr(target_arch = "avr", no_main)]
+#![cfg_attr(target_arch = "avr", feature(asm_experimental_arch))]
+
+#[cfg(target_arch = "avr")]
+mod board;
+
+#[cfg(target_arch = "avr")]
+#[avr_device::entry]
+fn main() -> ! {
+    use firmware::calibration_record::{self, RECORD_LEN};
+    use firmware::camera::Camera;
+    use firmware::config::{CALIBRATION_EEPROM_ADDR, CALIBRATION_SPIN, CAMERA, UNCALIBRATED};
+    use firmware::decision::Decider;
+    use firmware::embedded;
+    use firmware::supervisor::Supervisor;
+    use shared::{LogFrame, RobotProfile};
+
+    let mut board = board::Board::take();
+    board.init();
+
+    let mut record = [0u8; RECORD_LEN];
+    board.eeprom_read(CALIBRATION_EEPROM_ADDR, &mut record);
+    let stored = calibration_record::decode(&record).ok();
+    let calibration = stored.unwrap_or(UNCALIBRATED);
+    let policy = board::FlashPolicy;
+    let mut decider = Decider::new(&calibration, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
+    let mut supervisor = Supervisor::new(stored.is_some());
+    let mut camera = Camera::new();
+    let spin = RobotProfile::ZUMO.outputs(CALIBRATION_SPIN);
+    let mut frame = [0u8; LogFrame::MAX_ENCODED_LEN];
+
+    board.watchdog_on();
+    loop {
+        board.wait_period();
+        let buttons = board.buttons();
+        let times = board.field_sensors();
+        let camera_ok = camera.acquire(&mut board).is_ok();
+        let plan = supervisor.period(buttons, &times, camera_ok);
+
+        let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors, &spin);
+
+        if let Some(new) = plan.save {
+            board.eeprom_write(CALIBRATION_EEPROM_ADDR, &calibration_record::encode(&new));
+            decider.set_calibration(&new);
+        }
+        board.leds(plan.leds);
+        let log = LogFrame {
+            tick: supervisor.tick(),
+            mode: plan.mode,
+            faults: plan.faults,
+            raw_times: times,
+            values: decision.values,
+            blobs: decision.blobs,
+            blocks: camera.blocks().len() as u8,
+            state: decision.state,
+            action: decision.action,
+            motors: command,
+        };
+        let n = log.encode(&mut frame);
+        board.send(frame.get(..n).unwrap_or(&[]));
+    }
+}
+
+/// One decision and the motor writes, bracketed by the simulator's cycle
+/// markers (GPIOR0 = 1, then 2). Out of line on purpose: in the control
+/// loop's large stack frame, LLVM's AVR backend reaches locals with
+/// `in r0, SREG; adiw r28, ..` sequences that can clobber a multiply's
+/// result in r0 (a miscompilation seen here: the block loop's length);
+/// a small frame needs no such sequences. `scripts/build-firmware` checks
+/// the whole image for the pattern.
+#[cfg(target_arch = "avr")]
+#[inline(never)]
+fn decide_and_drive(
+    board: &board::Board,
+    decider: &firmware::decision::Decider<'_, board::FlashPolicy>,
+    times: &[u16; 3],
+    blocks: &[shared::PixyBlock],
+    source: firmware::supervisor::MotorSource,
+    spin: &shared::DriveOutputs,
+) -> (firmware::decision::Decision, shared::MotorCommand) {
+    use firmware::supervisor::MotorSource;
+    use shared::{DriveOutputs, MotorCommand};
+    board.mark(1);
+    let decision = decider.decide(times, blocks);
+    let (outputs, command) = match source {
+        MotorSource::Policy => (decision.outputs, decision.command),
+        MotorSource::Spin => (*spin, firmware::config::CALIBRATION_SPIN),
+        MotorSource::Stop => (DriveOutputs::STOP, MotorCommand::default()),
+    };
+    board.set_motors(&outputs);
+    board.mark(2);
+    (decision, command)
+}
+
+/// Never reached from the control loop (the build reports whether the
+/// linker kept it); stops the motors and halts.
+#[cfg(target_arch = "avr")]
+#[panic_handler]
+fn panic(_: &core::panic::PanicInfo) -> ! {
+    board::emergency_stop();
+    loop {}
+}
 
 #[cfg(not(target_arch = "avr"))]
 fn main() {}

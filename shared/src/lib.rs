@@ -10,7 +10,12 @@
 //! - [`ActionTable`]: the angular speeds a policy chooses among;
 //! - [`PolicyTable`]: the greedy policy, 2 bits per state;
 //! - [`PolicyBlob`]: the versioned, checksummed file that carries a policy
-//!   from the trainer to the firmware.
+//!   from the trainer to the firmware;
+//! - [`FieldCalibration`]: RC discharge times -> calibrated field values,
+//!   as the robot's photo-transistors are read;
+//! - [`CameraConfig`]: Pixy camera blocks -> puck and obstacle bits;
+//! - [`RobotProfile`]: an action's unicycle speeds -> motor commands;
+//! - [`LogFrame`]: what the robot reports each control period.
 //!
 //! The crate is `no_std` and allocation-free so that the firmware links
 //! the very same code the simulator runs.
@@ -20,14 +25,22 @@
 
 pub mod action;
 pub mod blob;
+pub mod calibration;
+pub mod camera;
+pub mod drive;
 pub mod field;
 pub mod hasher;
+pub mod log;
 pub mod policy;
 pub mod reading;
 
 pub use action::{ActionId, ActionTable, ActionTableError};
 pub use blob::{BlobError, PolicyBlob, Provenance};
+pub use calibration::{FieldCalibration, FieldScales, SensorRange, SensorScale};
+pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
+pub use drive::{DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;
 pub use hasher::{State, StateHasher, StateInputs};
+pub use log::{Faults, LogError, LogFrame, RunMode};
 pub use policy::PolicyTable;
 pub use reading::SensorReading;

@@ -1,0 +1,82 @@
+//! Embeds the policy: decodes the blob with `shared`'s decoder, checks its
+//! hasher, and generates `policy.rs` (the packed table and each action's
+//! motor outputs, computed here on the host so the AVR needs no floats).
+//!
+//! - `FIRMWARE_POLICY`: the blob (default `policies/oc-heuristic.policy`;
+//!   a relative path is taken from the workspace root).
+//! - `FIRMWARE_HASHER`: the hasher the firmware is built for (a name or bit
+//!   count as in `docs/state-hash.md`; default `original`). A blob of
+//!   another hasher fails the build.
+
+use shared::{MotorCommand, PolicyBlob, RobotProfile, StateHasher};
+use std::fmt::Write as _;
+use std::path::PathBuf;
+use std::{env, fs};
+
+const DEFAULT_POLICY: &str = "policies/oc-heuristic.policy";
+const DEFAULT_HASHER: &str = "original";
+
+fn fail(message: &str) -> ! {
+    eprintln!("error: {message}");
+    std::process::exit(1);
+}
+
+fn main() {
+    println!("cargo:rerun-if-env-changed=FIRMWARE_POLICY");
+    println!("cargo:rerun-if-env-changed=FIRMWARE_HASHER");
+    println!("cargo:rerun-if-changed=build.rs");
+    let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR")).join("..");
+    let policy = root.join(env::var("FIRMWARE_POLICY").unwrap_or_else(|_| DEFAULT_POLICY.into()));
+    println!("cargo:rerun-if-changed={}", policy.display());
+
+    let bytes = fs::read(&policy).unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
+    let blob = PolicyBlob::decode(&bytes).unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
+    let hasher_name = env::var("FIRMWARE_HASHER").unwrap_or_else(|_| DEFAULT_HASHER.into());
+    let expected = StateHasher::from_name(&hasher_name)
+        .unwrap_or_else(|| fail(&format!("FIRMWARE_HASHER={hasher_name} is not a hasher (original, original-obstacle, bits7, bits9)")));
+    if blob.hasher() != expected {
+        fail(&format!(
+            "policy file {}: its hasher is {} but the firmware is built for {expected}; \
+             build with FIRMWARE_HASHER={} to use it",
+            policy.display(),
+            blob.hasher(),
+            blob.hasher().name()
+        ));
+    }
+
+    let profile = RobotProfile::ZUMO;
+    let mut commands = [MotorCommand::default(); 4];
+    for (command, w) in commands.iter_mut().zip(blob.actions().angular_speeds()) {
+        *command = profile.mix(blob.actions().forward_speed(), *w);
+    }
+    let mut out = String::new();
+    let hasher = format!("{:?}", blob.hasher());
+    let packed = blob.table().packed();
+    writeln!(out, "/// Path of the embedded policy blob.").unwrap();
+    writeln!(out, "pub const POLICY_PATH: &str = {:?};", policy.display().to_string()).unwrap();
+    writeln!(out, "/// The embedded policy blob itself (for host tests; not linked into the AVR image).").unwrap();
+    writeln!(out, "pub const POLICY_BLOB: &[u8] = include_bytes!({:?});", policy.display().to_string()).unwrap();
+    writeln!(out, "/// The policy's state hasher.").unwrap();
+    writeln!(out, "pub const HASHER: shared::StateHasher = shared::StateHasher::{hasher};").unwrap();
+    writeln!(out, "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout).").unwrap();
+    writeln!(out, "pub const POLICY: [u8; {}] = {:?};", packed.len(), packed).unwrap();
+    writeln!(out, "/// Each action's motor commands and outputs, mixed with `shared::RobotProfile::ZUMO`.").unwrap();
+    writeln!(out, "pub const MOTORS: crate::decision::ActionMotors = crate::decision::ActionMotors {{").unwrap();
+    write!(out, "    commands: [").unwrap();
+    for c in commands {
+        write!(out, "shared::MotorCommand {{ left: {}, right: {} }}, ", c.left, c.right).unwrap();
+    }
+    writeln!(out, "],\n    outputs: [").unwrap();
+    for c in commands {
+        let o = profile.outputs(c);
+        writeln!(
+            out,
+            "        shared::DriveOutputs {{ left: shared::MotorOutput {{ duty: {}, dir_high: {} }}, right: shared::MotorOutput {{ duty: {}, dir_high: {} }} }},",
+            o.left.duty, o.left.dir_high, o.right.duty, o.right.dir_high
+        )
+        .unwrap();
+    }
+    writeln!(out, "    ],\n}};").unwrap();
+    let dest = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("policy.rs");
+    fs::write(&dest, out).unwrap_or_else(|e| fail(&format!("{}: {e}", dest.display())));
+}

@@ -1,0 +1,348 @@
+//! Register access for the Zumo 32U4 (ATmega32U4, 16 MHz): the only
+//! module with `unsafe` and `avr-device`. Pins and timers follow
+//! `../shared/docs/hardware.md`; everything else is in the library.
+//!
+//! | what                | where                                      |
+//! |---------------------|--------------------------------------------|
+//! | motors              | Timer1 mode 8, TOP (ICR1) 400 = 20 kHz; OCR1A/PB5 right, OCR1B/PB6 left; DIR PB1 right, PB2 left |
+//! | field sensors       | PF7 left (DN1), PF4 mid (DN3), PD6 right (DN5); emitters (LEDON, PB7) off |
+//! | clock               | Timer3 free-running at clk/64 (4 us ticks): control period and RC timing |
+//! | Pixy                | TWI master 100 kHz, address 0x54, one 2-byte read per word |
+//! | log                 | USART1 TX (PD3), 115200 8N1, U2X1            |
+//! | buttons             | A PB3, B PD5 (shared with the green LED), both active low |
+//! | LEDs                | yellow PC7 (high = on), green PD5 and red PB0 (low = on) |
+//! | decision marker     | GPIOR0: 1 before a decision, 2 after the motor writes (simulator cycle counting) |
+
+use avr_device::atmega32u4::Peripherals;
+use core::arch::asm;
+use firmware::camera::{BusError, WordSource};
+use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS};
+use firmware::embedded;
+use firmware::rc::Discharge;
+use firmware::supervisor::{Buttons, Leds};
+use shared::DriveOutputs;
+
+/// The policy table, in flash (read with `lpm`, never copied to SRAM).
+#[link_section = ".progmem.data"]
+static POLICY: [u8; embedded::POLICY.len()] = embedded::POLICY;
+
+/// The flash-resident policy table, readable by the decision.
+pub struct FlashPolicy;
+
+impl firmware::decision::PolicyBytes for FlashPolicy {
+    fn byte(&self, index: usize) -> u8 {
+        // Masked into the table (its length is a power of two).
+        let addr = POLICY.as_ptr().wrapping_add(index & (POLICY.len() - 1));
+        let byte: u8;
+        // SAFETY: `lpm` reads program memory at Z; the address lies in POLICY.
+        unsafe { asm!("lpm {0}, Z", out(reg) byte, in("Z") addr, options(pure, readonly, nostack)) };
+        byte
+    }
+}
+
+// Bits of the registers used below (ATmega32U4 datasheet).
+const PB0: u8 = 1 << 0; // red LED (low = on)
+const PB1: u8 = 1 << 1; // right DIR
+const PB2: u8 = 1 << 2; // left DIR
+const PB3: u8 = 1 << 3; // button A
+const PB5: u8 = 1 << 5; // OC1A right PWM
+const PB6: u8 = 1 << 6; // OC1B left PWM
+const PB7: u8 = 1 << 7; // LEDON (emitters)
+const PC7: u8 = 1 << 7; // yellow LED
+const PD5: u8 = 1 << 5; // button B / green LED (low = on)
+const PD6: u8 = 1 << 6; // right field sensor
+const PF4: u8 = 1 << 4; // mid field sensor
+const PF7: u8 = 1 << 7; // left field sensor
+const TWINT: u8 = 1 << 7;
+const TWEA: u8 = 1 << 6;
+const TWSTA: u8 = 1 << 5;
+const TWSTO: u8 = 1 << 4;
+const TWEN: u8 = 1 << 2;
+const PIXY_READ: u8 = (0x54 << 1) | 1;
+const WDE: u8 = 1 << 3;
+const WDCE: u8 = 1 << 4;
+const WDP2: u8 = 1 << 2; // with WDP1..0 = 0: 250 ms
+
+/// The bootloader enters itself after a watchdog reset when this word holds
+/// 0x7777; the firmware clears it at start-up and never writes it.
+const BOOT_KEY: *mut u16 = 0x0800 as *mut u16;
+
+/// The peripherals and the control period's clock.
+pub struct Board {
+    dp: Peripherals,
+    period_start: u16,
+}
+
+impl Board {
+    /// First thing at start-up: stop the watchdog a reset may have left
+    /// running (with the shortest timeout) and clear the bootloader key.
+    pub fn take() -> Board {
+        // SAFETY: called once, before anything else touches the peripherals.
+        let dp = unsafe { Peripherals::steal() };
+        avr_device::asm::wdr();
+        dp.CPU.mcusr().write(|w| unsafe { w.bits(0) }); // WDRF forces WDE on until cleared
+        // SAFETY: timed sequence (<= 4 cycles): set WDCE|WDE, then write 0.
+        unsafe {
+            asm!(
+                "sts 0x60, {ce}",
+                "sts 0x60, {zero}",
+                ce = in(reg) WDCE | WDE,
+                zero = in(reg) 0u8,
+                options(nostack),
+            );
+            core::ptr::write_volatile(BOOT_KEY, 0);
+        }
+        Board { dp, period_start: 0 }
+    }
+
+    /// Sets up pins, timers, TWI and the USART.
+    pub fn init(&mut self) {
+        let dp = &self.dp;
+        // Timer3: free running, clk/64.
+        dp.TC3.tccr3a().write(|w| unsafe { w.bits(0) });
+        dp.TC3.tccr3b().write(|w| unsafe { w.bits(0b011) });
+        // Motors: outputs low; Timer1 mode 8 (phase and frequency correct,
+        // TOP = ICR1 = 400), non-inverting OC1A/OC1B, clk/1: 20 kHz.
+        dp.PORTB.portb().write(|w| unsafe { w.bits(PB3 | PB0) }); // A pull-up, red LED off, LEDON low
+        dp.PORTB.ddrb().write(|w| unsafe { w.bits(PB0 | PB1 | PB2 | PB5 | PB6 | PB7) });
+        dp.TC1.tccr1a().write(|w| unsafe { w.bits(0b1010_0000) });
+        dp.TC1.tccr1b().write(|w| unsafe { w.bits(0b0001_0001) });
+        dp.TC1.icr1().write(|w| w.set(400));
+        dp.TC1.ocr1a().write(|w| w.set(0));
+        dp.TC1.ocr1b().write(|w| w.set(0));
+        // LEDs: yellow off, green off (PD5 high).
+        dp.PORTC.ddrc().write(|w| unsafe { w.bits(PC7) });
+        dp.PORTD.portd().write(|w| unsafe { w.bits(PD5) });
+        dp.PORTD.ddrd().write(|w| unsafe { w.bits(PD5) });
+        // TWI: 100 kHz = 16 MHz / (16 + 2 x 72), prescaler 1.
+        dp.TWI.twsr().write(|w| unsafe { w.bits(0) });
+        dp.TWI.twbr().write(|w| unsafe { w.bits(72) });
+        dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
+        // USART1: 115200 8N1, U2X1 first, then UBRR1 = 16 (117.6 kbaud, +2.1 %).
+        dp.USART1.ucsr1a().write(|w| unsafe { w.bits(1 << 1) });
+        dp.USART1.ubrr1().write(|w| w.set(16));
+        dp.USART1.ucsr1c().write(|w| unsafe { w.bits(0b0000_0110) });
+        dp.USART1.ucsr1b().write(|w| unsafe { w.bits(1 << 3) }); // TXEN1
+        self.period_start = self.now();
+    }
+
+    /// Enables the watchdog (250 ms) for the control loop.
+    pub fn watchdog_on(&mut self) {
+        avr_device::asm::wdr();
+        // SAFETY: timed sequence (<= 4 cycles): WDCE|WDE, then WDE + prescaler.
+        unsafe {
+            asm!(
+                "sts 0x60, {ce}",
+                "sts 0x60, {on}",
+                ce = in(reg) WDCE | WDE,
+                on = in(reg) WDE | WDP2,
+                options(nostack),
+            );
+        }
+    }
+
+    /// Timer3 now, in 4 us ticks.
+    fn now(&self) -> u16 {
+        self.dp.TC3.tcnt3().read().bits()
+    }
+
+    /// Busy-waits (simavr cannot wake from SLEEP) until `ticks` have passed since `from`.
+    fn wait_until(&self, from: u16, ticks: u16) {
+        while self.now().wrapping_sub(from) < ticks {}
+    }
+
+    /// Waits for the next control period and feeds the watchdog. After an
+    /// overrun the schedule restarts from now rather than catching up.
+    pub fn wait_period(&mut self) {
+        let next = self.period_start.wrapping_add(PERIOD_TICKS);
+        if self.now().wrapping_sub(self.period_start) >= PERIOD_TICKS {
+            self.period_start = self.now();
+        } else {
+            self.wait_until(self.period_start, PERIOD_TICKS);
+            self.period_start = next;
+        }
+        avr_device::asm::wdr();
+    }
+
+    /// Feeds the watchdog (long operations: EEPROM writes).
+    pub fn feed_watchdog(&self) {
+        avr_device::asm::wdr();
+    }
+
+    /// Reads both buttons. B shares PD5 with the green LED: the pin becomes
+    /// a pulled-up input for a few microseconds, then is restored.
+    pub fn buttons(&self) -> Buttons {
+        let d = &self.dp.PORTD;
+        let a = self.dp.PORTB.pinb().read().bits() & PB3 == 0;
+        let (ddr, port) = (d.ddrd().read().bits(), d.portd().read().bits());
+        d.ddrd().write(|w| unsafe { w.bits(ddr & !PD5) });
+        d.portd().write(|w| unsafe { w.bits(port | PD5) });
+        let t = self.now();
+        self.wait_until(t, 2);
+        let b = d.pind().read().bits() & PD5 == 0;
+        d.portd().write(|w| unsafe { w.bits(port) });
+        d.ddrd().write(|w| unsafe { w.bits(ddr) });
+        Buttons { a, b }
+    }
+
+    /// Times the three field sensors' RC discharge: charge them for 10 us,
+    /// make them inputs (no pull-up), then poll them together against
+    /// Timer3 until all read low or 2000 us passed.
+    pub fn field_sensors(&self) -> [u16; 3] {
+        let (f, d) = (&self.dp.PORTF, &self.dp.PORTD);
+        f.portf().modify(|r, w| unsafe { w.bits(r.bits() | PF7 | PF4) });
+        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() | PF7 | PF4) });
+        d.portd().modify(|r, w| unsafe { w.bits(r.bits() | PD6) });
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | PD6) });
+        let t = self.now();
+        self.wait_until(t, RC_CHARGE_US.div_ceil(TICK_US) + 1);
+        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() & !(PF7 | PF4)) });
+        f.portf().modify(|r, w| unsafe { w.bits(r.bits() & !(PF7 | PF4)) });
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !PD6) });
+        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !PD6) });
+        let mut discharge = Discharge::start(self.now());
+        loop {
+            let (pf, pd) = (f.pinf().read().bits(), d.pind().read().bits());
+            let low = u8::from(pf & PF7 == 0) | u8::from(pf & PF4 == 0) << 1 | u8::from(pd & PD6 == 0) << 2;
+            if discharge.sample(self.now(), low) {
+                return discharge.times();
+            }
+        }
+    }
+
+    /// Applies motor outputs: OCR1A/PB1 right, OCR1B/PB2 left.
+    pub fn set_motors(&self, out: &DriveOutputs) {
+        let b = &self.dp.PORTB;
+        let mut dir = 0;
+        if out.right.dir_high {
+            dir |= PB1;
+        }
+        if out.left.dir_high {
+            dir |= PB2;
+        }
+        b.portb().modify(|r, w| unsafe { w.bits((r.bits() & !(PB1 | PB2)) | dir) });
+        self.dp.TC1.ocr1a().write(|w| w.set(out.right.duty));
+        self.dp.TC1.ocr1b().write(|w| w.set(out.left.duty));
+    }
+
+    /// Writes the decision marker (GPIOR0) the simulator test watches.
+    #[inline(always)]
+    pub fn mark(&self, value: u8) {
+        self.dp.CPU.gpior0().write(|w| unsafe { w.bits(value) });
+    }
+
+    /// Lights the LEDs.
+    pub fn leds(&self, leds: Leds) {
+        let (b, c, d) = (&self.dp.PORTB, &self.dp.PORTC, &self.dp.PORTD);
+        c.portc().modify(|r, w| unsafe { w.bits(if leds.yellow { r.bits() | PC7 } else { r.bits() & !PC7 }) });
+        b.portb().modify(|r, w| unsafe { w.bits(if leds.red { r.bits() & !PB0 } else { r.bits() | PB0 }) });
+        d.portd().modify(|r, w| unsafe { w.bits(if leds.green { r.bits() & !PD5 } else { r.bits() | PD5 }) });
+    }
+
+    /// Sends bytes on USART1 (blocking).
+    pub fn send(&self, bytes: &[u8]) {
+        let u = &self.dp.USART1;
+        for byte in bytes {
+            while u.ucsr1a().read().bits() & (1 << 5) == 0 {} // UDRE1
+            u.udr1().write(|w| unsafe { w.bits(*byte) });
+        }
+    }
+
+    /// Reads `out.len()` bytes of EEPROM from `addr`.
+    pub fn eeprom_read(&self, addr: u16, out: &mut [u8]) {
+        let e = &self.dp.EEPROM;
+        for (i, byte) in out.iter_mut().enumerate() {
+            while e.eecr().read().bits() & (1 << 1) != 0 {} // EEPE
+            e.eear().write(|w| w.set(addr + i as u16));
+            e.eecr().write(|w| unsafe { w.bits(1 << 0) }); // EERE
+            *byte = e.eedr().read().bits();
+        }
+    }
+
+    /// Writes bytes to EEPROM at `addr` (3.4 ms per byte; feeds the watchdog).
+    pub fn eeprom_write(&self, addr: u16, bytes: &[u8]) {
+        let e = &self.dp.EEPROM;
+        for (i, byte) in bytes.iter().enumerate() {
+            while e.eecr().read().bits() & (1 << 1) != 0 {
+                self.feed_watchdog();
+            }
+            e.eear().write(|w| w.set(addr + i as u16));
+            e.eedr().write(|w| unsafe { w.bits(*byte) });
+            // SAFETY: timed sequence (<= 4 cycles, no interrupts are enabled):
+            // EEMPE, then EEPE, in EECR (I/O 0x1F).
+            unsafe { asm!("sbi 0x1f, 2", "sbi 0x1f, 1", options(nostack)) };
+        }
+    }
+
+    /// Waits for TWINT, or gives up after [`TWI_TIMEOUT_TICKS`]; returns TWSR's status.
+    fn twi_step(&self, control: u8) -> Result<u8, BusError> {
+        let t = &self.dp.TWI;
+        t.twcr().write(|w| unsafe { w.bits(control) });
+        let start = self.now();
+        while t.twcr().read().bits() & TWINT == 0 {
+            if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
+                // Release the bus: disable and re-enable the TWI.
+                t.twcr().write(|w| unsafe { w.bits(0) });
+                t.twcr().write(|w| unsafe { w.bits(TWEN) });
+                return Err(BusError::Stalled);
+            }
+        }
+        Ok(t.twsr().read().bits() & 0xF8)
+    }
+
+    fn twi_stop(&self) {
+        self.dp.TWI.twcr().write(|w| unsafe { w.bits(TWINT | TWEN | TWSTO) });
+        let start = self.now();
+        while self.dp.TWI.twcr().read().bits() & TWSTO != 0 {
+            if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
+                self.dp.TWI.twcr().write(|w| unsafe { w.bits(0) });
+                self.dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
+                return;
+            }
+        }
+    }
+
+    /// One read transaction of `N` bytes from the Pixy: START, SLA+R, the
+    /// bytes (the last one NACKed), STOP.
+    fn twi_read<const N: usize>(&self) -> Result<[u8; N], BusError> {
+        let result = self.twi_read_inner::<N>();
+        self.twi_stop();
+        result
+    }
+
+    fn twi_read_inner<const N: usize>(&self) -> Result<[u8; N], BusError> {
+        let status = self.twi_step(TWINT | TWSTA | TWEN)?;
+        if status != 0x08 && status != 0x10 {
+            return Err(BusError::Stalled);
+        }
+        self.dp.TWI.twdr().write(|w| unsafe { w.bits(PIXY_READ) });
+        if self.twi_step(TWINT | TWEN)? != 0x40 {
+            return Err(BusError::Nack);
+        }
+        let mut out = [0u8; N];
+        for (i, byte) in out.iter_mut().enumerate() {
+            let ack = if i + 1 < N { TWEA } else { 0 };
+            self.twi_step(TWINT | TWEN | ack)?;
+            *byte = self.dp.TWI.twdr().read().bits();
+        }
+        Ok(out)
+    }
+}
+
+impl WordSource for Board {
+    fn read_word(&mut self) -> Result<u16, BusError> {
+        self.twi_read::<2>().map(u16::from_le_bytes)
+    }
+
+    fn skip_byte(&mut self) -> Result<(), BusError> {
+        self.twi_read::<1>().map(|_| ())
+    }
+}
+
+/// Stops the motors from any state (panic handler).
+pub fn emergency_stop() {
+    // SAFETY: the program is ending; only the motor registers are touched.
+    let dp = unsafe { Peripherals::steal() };
+    dp.TC1.ocr1a().write(|w| w.set(0));
+    dp.TC1.ocr1b().write(|w| w.set(0));
+}

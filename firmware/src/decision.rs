@@ -1,0 +1,163 @@
+//! One decision: raw RC times and Pixy blocks -> motor outputs.
+//!
+//! Calibrate the three times, classify the blocks, hash the reading with
+//! the policy's hasher (`shared`, the trainer's code), look the state's
+//! action up in the packed greedy table, and take that action's motor
+//! outputs, computed at build time. Integer-only: this is the code path the
+//! 2,000-cycle budget covers. It cannot panic: every index is masked into
+//! its table.
+
+use shared::{
+    ActionId, BlobSummary, CameraConfig, DriveOutputs, FieldCalibration, FieldScales, FieldValue, MotorCommand,
+    PixyBlock, PolicyTable, SensorReading, State, StateHasher,
+};
+
+/// Read access to the packed policy table (in flash on the robot).
+pub trait PolicyBytes {
+    /// The byte at `index`; `index` is below the table's length.
+    fn byte(&self, index: usize) -> u8;
+}
+
+impl PolicyBytes for [u8] {
+    fn byte(&self, index: usize) -> u8 {
+        self.get(index).copied().unwrap_or(0)
+    }
+}
+
+/// The motor outputs of each action (up to four).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ActionMotors {
+    /// Signed commands, for the log.
+    pub commands: [MotorCommand; 4],
+    /// Pin-level outputs (duty, direction), for the board.
+    pub outputs: [DriveOutputs; 4],
+}
+
+/// Everything a decision computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decision {
+    /// Calibrated left, mid, right field values.
+    pub values: [FieldValue; 3],
+    /// The camera's sensor bits.
+    pub blobs: BlobSummary,
+    /// The hashed state.
+    pub state: State,
+    /// The policy's action.
+    pub action: ActionId,
+    /// The action's motor commands.
+    pub command: MotorCommand,
+    /// The action's pin-level outputs.
+    pub outputs: DriveOutputs,
+}
+
+/// The decision's fixed inputs: calibration, camera classification, hasher,
+/// policy table and per-action motor outputs.
+#[derive(Clone, Copy, Debug)]
+pub struct Decider<'a, P: PolicyBytes + ?Sized> {
+    scales: FieldScales,
+    camera: CameraConfig,
+    hasher: StateHasher,
+    policy: &'a P,
+    motors: ActionMotors,
+}
+
+impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
+    /// A decider. `policy` holds `hasher.num_states() / 4` packed bytes.
+    pub fn new(
+        calibration: &FieldCalibration,
+        camera: CameraConfig,
+        hasher: StateHasher,
+        policy: &'a P,
+        motors: ActionMotors,
+    ) -> Self {
+        Decider { scales: calibration.scales(), camera, hasher, policy, motors }
+    }
+
+    /// Replaces the calibration (after a sweep).
+    pub fn set_calibration(&mut self, calibration: &FieldCalibration) {
+        self.scales = calibration.scales();
+    }
+
+    /// Decides for one period's raw times and blocks.
+    pub fn decide(&self, times: &[u16; 3], blocks: &[PixyBlock]) -> Decision {
+        let values = self.scales.values(times);
+        let blobs = self.camera.classify(blocks);
+        let reading = SensorReading {
+            left: values[0],
+            mid: values[1],
+            right: values[2],
+            puck_left: blobs.puck_left,
+            puck_right: blobs.puck_right,
+            obstacle_left: blobs.obstacle_left,
+            obstacle_right: blobs.obstacle_right,
+        };
+        let state = self.hasher.hash(&reading);
+        let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
+        let byte = self.policy.byte(PolicyTable::byte_index(masked));
+        let action = PolicyTable::action_in_byte(byte, masked);
+        let i = action.index() & 3;
+        Decision { values, blobs, state, action, command: self.motors.commands[i], outputs: self.motors.outputs[i] }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use crate::config::{CAMERA, UNCALIBRATED};
+    use crate::embedded;
+    use shared::{PolicyBlob, RobotProfile, SensorRange};
+
+    fn motors_of(blob: &PolicyBlob) -> ActionMotors {
+        let mut m = ActionMotors { commands: [MotorCommand::default(); 4], outputs: [DriveOutputs::STOP; 4] };
+        for (i, w) in blob.actions().angular_speeds().iter().enumerate() {
+            m.commands[i] = RobotProfile::ZUMO.mix(blob.actions().forward_speed(), *w);
+            m.outputs[i] = RobotProfile::ZUMO.outputs(m.commands[i]);
+        }
+        m
+    }
+
+    #[test]
+    fn the_embedded_policy_matches_its_blob_for_every_state() {
+        let blob = PolicyBlob::decode(embedded::POLICY_BLOB).unwrap();
+        assert_eq!(blob.hasher(), embedded::HASHER);
+        assert_eq!(blob.table().packed(), &embedded::POLICY[..]);
+        assert_eq!(motors_of(&blob), embedded::MOTORS);
+        let cal = FieldCalibration { ranges: [SensorRange { bright: 0, dark: 32768 }; 3] };
+        let d = Decider::new(&cal, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        // Walk states through readings: every (left < mid, right < mid, mid bin, pucks) combination.
+        let k = embedded::HASHER.mid_bits();
+        for bin in 0..(1u16 << k) {
+            for bits in 0..16u8 {
+                // mid value = (bin + 1/2) / 2^k: the middle of the bin
+                let mid_time = 32768 - (bin << (15 - k)) - (1 << (14 - k));
+                let left_time = if bits & 4 != 0 { mid_time + 100 } else { mid_time };
+                let right_time = if bits & 8 != 0 { mid_time + 100 } else { mid_time };
+                let mut blocks = std::vec::Vec::new();
+                if bits & 1 != 0 {
+                    blocks.push(PixyBlock { signature: 1, x: 10, y: 150, width: 5, height: 5, angle: 0 });
+                }
+                if bits & 2 != 0 {
+                    blocks.push(PixyBlock { signature: 1, x: 300, y: 150, width: 5, height: 5, angle: 0 });
+                }
+                let dec = d.decide(&[left_time, mid_time, right_time], &blocks);
+                let expected_state = State(u16::from(bits) | bin << 4);
+                assert_eq!(dec.state, expected_state);
+                let action = blob.table().action(expected_state);
+                assert_eq!(dec.action, action);
+                assert_eq!(dec.command, embedded::MOTORS.commands[action.index()]);
+            }
+        }
+    }
+
+    #[test]
+    fn uncalibrated_timeouts_are_dark_and_never_panic() {
+        let d = Decider::new(&UNCALIBRATED, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        let dec = d.decide(&[u16::MAX; 3], &[]);
+        assert_eq!(dec.values, [FieldValue::ZERO; 3]);
+        assert_eq!(dec.state, State(0));
+        // A short policy slice reads zeros instead of panicking.
+        let d = Decider::new(&UNCALIBRATED, CAMERA, StateHasher::OriginalObstacle, &[0u8; 3][..], embedded::MOTORS);
+        assert_eq!(d.decide(&[0; 3], &[]).action, ActionId(0));
+    }
+}

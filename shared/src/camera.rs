@@ -1,0 +1,157 @@
+//! The Pixy (CMUcam5) camera as a sensor: its blocks and how they become
+//! the puck and obstacle bits of a [`SensorReading`](crate::SensorReading).
+//!
+//! The firmware parses [`PixyBlock`]s from the camera; the simulator will
+//! model the camera by producing the same blocks. Both then classify them
+//! with [`CameraConfig::classify`], so robot and simulator agree exactly on
+//! what counts as a puck or an obstacle on the left or the right.
+//!
+//! Classification (integer-only): a block counts if its signature is the
+//! puck (or robot) signature and its centre lies in the "near" image
+//! region; it is on the left if its centre's x is below the split column,
+//! otherwise on the right. The camera looks forward and down, so the lower
+//! part of the image (large y) is the ground close to the robot.
+
+use serde::{Deserialize, Serialize};
+
+/// Width of the Pixy's image in its block coordinates (x is 0..=319).
+pub const IMAGE_WIDTH: u16 = 320;
+/// Height of the Pixy's image in its block coordinates (y is 0..=199).
+pub const IMAGE_HEIGHT: u16 = 200;
+
+/// One detected object as the Pixy reports it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct PixyBlock {
+    /// Colour signature 1..=7, or a colour code (octal digits) above 7.
+    pub signature: u16,
+    /// Centre column, 0..=319, left to right.
+    pub x: u16,
+    /// Centre row, 0..=199, top to bottom.
+    pub y: u16,
+    /// Width in pixels.
+    pub width: u16,
+    /// Height in pixels.
+    pub height: u16,
+    /// Angle in degrees of a colour-code block; 0 for normal blocks.
+    pub angle: i16,
+}
+
+/// A rectangle of the image, bounds inclusive.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct ImageRegion {
+    /// Leftmost column inside.
+    pub x_min: u16,
+    /// Rightmost column inside.
+    pub x_max: u16,
+    /// Top row inside.
+    pub y_min: u16,
+    /// Bottom row inside.
+    pub y_max: u16,
+}
+
+impl ImageRegion {
+    /// Whether a point lies inside.
+    pub const fn contains(&self, x: u16, y: u16) -> bool {
+        x >= self.x_min && x <= self.x_max && y >= self.y_min && y <= self.y_max
+    }
+}
+
+/// What the camera reports as sensor bits: the puck and obstacle sensors
+/// of the thesis, on each side.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct BlobSummary {
+    /// A puck in the near region, left half.
+    pub puck_left: bool,
+    /// A puck in the near region, right half.
+    pub puck_right: bool,
+    /// A robot in the near region, left half.
+    pub obstacle_left: bool,
+    /// A robot in the near region, right half.
+    pub obstacle_right: bool,
+}
+
+/// How the camera's blocks are classified.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct CameraConfig {
+    /// Signature taught to the Pixy for pucks.
+    pub puck_signature: u16,
+    /// Signature taught to the Pixy for robots (obstacles); may be a
+    /// colour code.
+    pub robot_signature: u16,
+    /// Where a block's centre must be to be sensed.
+    pub near: ImageRegion,
+    /// Blocks with `x < split_x` are on the left, the others on the right.
+    pub split_x: u16,
+}
+
+impl CameraConfig {
+    /// The defaults: pucks are signature 1, robots signature 2; "near" is
+    /// the lower half of the image (rows 100..=199) across its full width,
+    /// split in the middle (column 160).
+    pub const DEFAULT: CameraConfig = CameraConfig {
+        puck_signature: 1,
+        robot_signature: 2,
+        near: ImageRegion { x_min: 0, x_max: IMAGE_WIDTH - 1, y_min: IMAGE_HEIGHT / 2, y_max: IMAGE_HEIGHT - 1 },
+        split_x: IMAGE_WIDTH / 2,
+    };
+
+    /// The sensor bits of a set of blocks (any number, any order).
+    pub fn classify(&self, blocks: &[PixyBlock]) -> BlobSummary {
+        let mut summary = BlobSummary::default();
+        for b in blocks {
+            if !self.near.contains(b.x, b.y) {
+                continue;
+            }
+            let left = b.x < self.split_x;
+            if b.signature == self.puck_signature {
+                summary.puck_left |= left;
+                summary.puck_right |= !left;
+            }
+            if b.signature == self.robot_signature {
+                summary.obstacle_left |= left;
+                summary.obstacle_right |= !left;
+            }
+        }
+        summary
+    }
+}
+
+impl Default for CameraConfig {
+    /// [`CameraConfig::DEFAULT`].
+    fn default() -> CameraConfig {
+        CameraConfig::DEFAULT
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn block(signature: u16, x: u16, y: u16) -> PixyBlock {
+        PixyBlock { signature, x, y, width: 10, height: 10, angle: 0 }
+    }
+
+    #[test]
+    fn nothing_seen_is_all_false() {
+        assert_eq!(CameraConfig::DEFAULT.classify(&[]), BlobSummary::default());
+    }
+
+    #[test]
+    fn sides_signatures_and_the_near_region() {
+        let c = CameraConfig::DEFAULT;
+        let s = c.classify(&[block(1, 159, 150), block(2, 160, 199)]);
+        assert_eq!(s, BlobSummary { puck_left: true, puck_right: false, obstacle_left: false, obstacle_right: true });
+        // Far (upper half) and unknown signatures are ignored.
+        assert_eq!(c.classify(&[block(1, 10, 99), block(3, 10, 150), block(2, 300, 0)]), BlobSummary::default());
+        // Region edges are inclusive.
+        assert!(c.classify(&[block(1, 0, 100)]).puck_left);
+        assert!(c.classify(&[block(1, 319, 199)]).puck_right);
+    }
+
+    #[test]
+    fn a_colour_code_can_be_the_robot_signature() {
+        let c = CameraConfig { robot_signature: 0o12, ..CameraConfig::DEFAULT };
+        let s = c.classify(&[PixyBlock { angle: -45, ..block(0o12, 20, 180) }]);
+        assert!(s.obstacle_left && !s.obstacle_right && !s.puck_left);
+    }
+}

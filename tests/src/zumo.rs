@@ -1,0 +1,371 @@
+//! The firmware ELF running in simavr, wired like a Zumo 32U4 on a field:
+//! RC-timed field sensors, a Pixy on TWI, buttons, motor registers, the
+//! USART1 log and the decision marker.
+//!
+//! `avr-tester` runs the simulation; what it does not offer (USART1 on the
+//! 32U4, data memory, the cycle counter, EEPROM, I/O register hooks) goes
+//! through simavr's own handle (`simavr-ffi`), which simavr passes to the
+//! global logger when it creates a core (`../shared/docs/firmware-toolchain.md`).
+
+use avr_tester::{AvrTester, TwiPacket};
+use firmware::pixy::encode_frame;
+use shared::{LogError, LogFrame, PixyBlock};
+use simavr_ffi as ffi;
+use std::cell::{Cell, RefCell};
+use std::collections::VecDeque;
+use std::ffi::c_void;
+use std::os::raw::{c_char, c_int};
+use std::path::PathBuf;
+use std::ptr::null_mut;
+use std::rc::Rc;
+use std::sync::Once;
+
+/// Simulated clock, Hz.
+pub const CLOCK_HZ: u64 = 16_000_000;
+/// Cycles per Timer3 tick (clk/64): the firmware's RC time unit.
+pub const CYCLES_PER_TICK: u64 = 64;
+/// OCR1A (right motor duty) in data memory.
+const OCR1A: usize = 0x88;
+/// OCR1B (left motor duty) in data memory.
+const OCR1B: usize = 0x8A;
+/// GPIOR0, the firmware's decision marker, in data memory.
+const GPIOR0: u16 = 0x3E;
+/// The stack pointer (SPL, SPH) in data memory.
+const SP: usize = 0x5D;
+/// Above the firmware's statics (0x0100 + .data + .bss, 91 bytes today).
+const STATICS_END: usize = 0x0200;
+/// One past the last SRAM byte.
+const RAM_END: usize = 0x0B00;
+/// The stack paint pattern.
+const PAINT: u8 = 0xA5;
+/// Pixy's 7-bit I2C address.
+const PIXY_ADDRESS: u8 = 0x54;
+
+/// The release ELF `scripts/build-firmware` writes; panics with what to run
+/// if it is missing (the tests never skip silently).
+pub fn firmware_elf() -> PathBuf {
+    let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/avr-none/firmware/firmware.elf");
+    assert!(
+        elf.exists(),
+        "the firmware ELF {} is missing: run `scripts/build-firmware` (needs gcc-avr, avr-libc and the rust-src \
+         component; `scripts/setup` installs them), or run everything with `./scripts/test`",
+        elf.display()
+    );
+    elf
+}
+
+const fn ioctl(a: u8, b: u8, c: u8, d: u8) -> u32 {
+    u32::from_be_bytes([a, b, c, d])
+}
+
+thread_local! {
+    static LAST_AVR: Cell<*mut ffi::avr_t> = const { Cell::new(null_mut()) };
+}
+
+unsafe extern "C" fn capture_handle(avr: *mut ffi::avr_t, _: c_int, _: *const c_char, _: *mut ffi::__va_list_tag) {
+    if !avr.is_null() {
+        LAST_AVR.with(|c| c.set(avr));
+    }
+}
+
+/// Loads the ELF and returns simavr's handle of the new core.
+fn load(elf: &PathBuf) -> (AvrTester, *mut ffi::avr_t) {
+    static INSTALL: Once = Once::new();
+    INSTALL.call_once(|| {
+        // avr-tester installs its (silent) logger once, at its first load;
+        // ours replaces it afterwards and is never replaced again.
+        drop(AvrTester::atmega32u4().with_clock_of_16_mhz().load(elf));
+        unsafe { ffi::avr_global_logger_set(Some(capture_handle)) };
+    });
+    LAST_AVR.with(|c| c.set(null_mut()));
+    let tester = AvrTester::atmega32u4().with_clock_of_16_mhz().load(elf);
+    let avr = LAST_AVR.with(|c| c.get());
+    assert!(!avr.is_null(), "simavr did not pass its handle to the logger");
+    (tester, avr)
+}
+
+/// One emulated field sensor: its pin's IRQ (the cycle timer's parameter).
+struct RcSensor {
+    irq: *mut ffi::avr_irq_t,
+}
+
+/// The emulated Pixy: a byte queue refilled with the current scene once per
+/// camera frame (20 ms); zeros when it has nothing; NACK when absent.
+struct Pixy {
+    avr: *mut ffi::avr_t,
+    present: bool,
+    scene: Vec<PixyBlock>,
+    bytes: VecDeque<u8>,
+    last_frame: u64,
+}
+
+impl Pixy {
+    fn next_byte(&mut self) -> u8 {
+        let now = unsafe { (*self.avr).cycle };
+        if self.bytes.is_empty() && now.saturating_sub(self.last_frame) >= CLOCK_HZ / 50 {
+            self.last_frame = now;
+            let mut words = [0u16; 128];
+            let n = encode_frame(&self.scene, &mut words);
+            self.bytes.extend(words[..n].iter().flat_map(|w| w.to_le_bytes()));
+        }
+        self.bytes.pop_front().unwrap_or(0)
+    }
+
+    fn on_packet(&mut self, p: TwiPacket) -> Option<TwiPacket> {
+        if !self.present || p.addr >> 1 != PIXY_ADDRESS {
+            return None;
+        }
+        if p.is_start() {
+            return Some(p.respond_ack());
+        }
+        if p.is_read() {
+            return Some(p.respond_data(self.next_byte()));
+        }
+        None
+    }
+}
+
+/// What the simavr callbacks record and read.
+struct State {
+    avr: *mut ffi::avr_t,
+    uart: Vec<u8>,
+    marks: Vec<(u8, u64)>,
+    ddr: [u8; 2],
+    /// Discharge delay of each sensor in cycles; `None` = never (timeout).
+    delays: [Option<u64>; 3],
+    sensors: [RcSensor; 3],
+}
+
+/// Left, mid, right: (port, bit).
+const SENSOR_PINS: [(u8, u8); 3] = [(b'F', 7), (b'F', 4), (b'D', 6)];
+
+unsafe extern "C" fn on_uart(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    let state = unsafe { &mut *(param as *mut State) };
+    state.uart.push(value as u8);
+}
+
+unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v: u8, param: *mut c_void) {
+    unsafe {
+        *(*avr).data.add(usize::from(addr)) = v;
+        let state = &mut *(param as *mut State);
+        state.marks.push((v, (*avr).cycle));
+    }
+}
+
+unsafe extern "C" fn on_discharged(_: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+    let sensor = unsafe { &*(param as *const RcSensor) };
+    unsafe { ffi::avr_raise_irq(sensor.irq, 0) };
+    0
+}
+
+unsafe fn on_ddr(port: u8, value: u32, param: *mut c_void) {
+    let state = unsafe { &mut *(param as *mut State) };
+    let slot = usize::from(port == b'D');
+    let (old, new) = (state.ddr[slot], value as u8);
+    state.ddr[slot] = new;
+    for (i, &(p, bit)) in SENSOR_PINS.iter().enumerate() {
+        let sensor = &mut state.sensors[i] as *mut RcSensor;
+        if p != port {
+            continue;
+        }
+        let mask = 1 << bit;
+        if old & mask != 0 && new & mask == 0 {
+            // Charged, now an input: discharge after the sensor's delay.
+            if let Some(delay) = state.delays[i] {
+                unsafe { ffi::avr_cycle_timer_register(state.avr, delay, Some(on_discharged), sensor as *mut c_void) };
+            }
+        } else if old & mask == 0 && new & mask != 0 {
+            unsafe { ffi::avr_cycle_timer_cancel(state.avr, Some(on_discharged), sensor as *mut c_void) };
+        }
+    }
+}
+
+unsafe extern "C" fn on_ddr_f(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    unsafe { on_ddr(b'F', value, param) }
+}
+
+unsafe extern "C" fn on_ddr_d(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    unsafe { on_ddr(b'D', value, param) }
+}
+
+#[repr(C)]
+struct EepromDesc {
+    ee: *mut u8,
+    offset: u16,
+    size: u32,
+}
+
+/// The firmware running in simavr on an emulated Zumo.
+pub struct Zumo {
+    // Field order is drop order: the simulator goes before the state its
+    // callbacks point to.
+    tester: AvrTester,
+    state: Box<State>,
+    pixy: Rc<RefCell<Pixy>>,
+    buttons: [u8; 2],
+    decoded: usize,
+}
+
+impl Zumo {
+    /// Loads the release ELF (erased EEPROM, Pixy present seeing nothing,
+    /// sensors discharging after 1 ms) and runs its start-up.
+    pub fn boot() -> Zumo {
+        let (tester, avr) = load(&firmware_elf());
+        let mut state = Box::new(State {
+            avr,
+            uart: Vec::new(),
+            marks: Vec::new(),
+            ddr: [0; 2],
+            delays: [Some(CLOCK_HZ / 1000); 3],
+            sensors: SENSOR_PINS.map(|(port, bit)| RcSensor {
+                irq: unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', port), c_int::from(bit)) },
+            }),
+        });
+        let state_ptr = &mut *state as *mut State;
+        unsafe {
+            assert!(state.sensors.iter().all(|s| !s.irq.is_null()), "no field sensor pins");
+            // USART1: bytes out, not to stdout.
+            let mut flags: u32 = 0;
+            ffi::avr_ioctl(avr, ioctl(b'u', b'a', b'g', b'1'), &mut flags as *mut u32 as *mut c_void);
+            flags &= !ffi::AVR_UART_FLAG_STDIO;
+            ffi::avr_ioctl(avr, ioctl(b'u', b'a', b's', b'1'), &mut flags as *mut u32 as *mut c_void);
+            let uart = ffi::avr_io_getirq(avr, ioctl(b'u', b'a', b'r', b'1'), ffi::UART_IRQ_OUTPUT as c_int);
+            ffi::avr_irq_register_notify(uart, Some(on_uart), state_ptr as *mut c_void);
+            for (port, f) in [(b'F', on_ddr_f as unsafe extern "C" fn(_, _, _)), (b'D', on_ddr_d)] {
+                let irq = ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', port), ffi::IOPORT_IRQ_DIRECTION_ALL as c_int);
+                ffi::avr_irq_register_notify(irq, Some(f), state_ptr as *mut c_void);
+            }
+            ffi::avr_register_io_write(avr, GPIOR0, Some(on_gpior0), state_ptr as *mut c_void);
+        }
+        let pixy = Rc::new(RefCell::new(Pixy { avr, present: true, scene: Vec::new(), bytes: VecDeque::new(), last_frame: 0 }));
+        let mut zumo = Zumo { tester, state, pixy: pixy.clone(), buttons: [0; 2], decoded: 0 };
+        zumo.tester.twi0().attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
+        zumo.set_button(b'B', 3, false);
+        zumo.set_button(b'D', 5, false);
+        zumo
+    }
+
+    /// Stores bytes in the simulated EEPROM.
+    pub fn write_eeprom(&mut self, offset: u16, bytes: &[u8]) {
+        let mut copy = bytes.to_vec();
+        let mut desc = EepromDesc { ee: copy.as_mut_ptr(), offset, size: copy.len() as u32 };
+        let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b's', b'p'), &mut desc as *mut _ as *mut c_void) };
+        assert_eq!(r, 0, "EEPROM write refused");
+    }
+
+    /// Reads bytes of the simulated EEPROM.
+    pub fn read_eeprom(&mut self, offset: u16, len: usize) -> Vec<u8> {
+        let mut desc = EepromDesc { ee: null_mut(), offset, size: len as u32 };
+        let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b'g', b'p'), &mut desc as *mut _ as *mut c_void) };
+        assert_eq!(r, 0, "EEPROM read refused");
+        unsafe { std::slice::from_raw_parts(desc.ee, len).to_vec() }
+    }
+
+    /// Sets the field sensors' discharge times in Timer3 ticks (`None`: the
+    /// sensor never discharges and times out).
+    pub fn set_sensor_ticks(&mut self, ticks: [Option<u16>; 3]) {
+        self.state.delays = ticks.map(|t| t.map(|t| u64::from(t) * CYCLES_PER_TICK));
+    }
+
+    /// What the Pixy sees from now on.
+    pub fn show(&mut self, blocks: &[PixyBlock]) {
+        self.pixy.borrow_mut().scene = blocks.to_vec();
+    }
+
+    /// Connects or disconnects the Pixy (disconnected: it NACKs its address).
+    pub fn connect_pixy(&mut self, present: bool) {
+        let mut p = self.pixy.borrow_mut();
+        p.present = present;
+        p.bytes.clear();
+    }
+
+    fn set_button(&mut self, port: u8, bit: u8, pressed: bool) {
+        let slot = usize::from(port == b'D');
+        self.buttons[slot] |= 1 << bit;
+        let mut ext = ffi::avr_ioport_external_t {
+            _bitfield_align_1: [],
+            _bitfield_1: Default::default(),
+            __bindgen_padding_0: Default::default(),
+        };
+        ext.set_name(u64::from(port));
+        ext.set_mask(u64::from(self.buttons[slot]));
+        // Pull-ups make released buttons read high.
+        ext.set_value(if pressed { u64::from(self.buttons[slot] & !(1 << bit)) } else { u64::from(self.buttons[slot]) });
+        unsafe {
+            ffi::avr_ioctl(self.state.avr, ioctl(b'i', b'o', b'p', port), &mut ext as *mut _ as *mut c_void);
+            let irq = ffi::avr_io_getirq(self.state.avr, ioctl(b'i', b'o', b'g', port), c_int::from(bit));
+            ffi::avr_raise_irq(irq, u32::from(!pressed));
+        }
+    }
+
+    /// Presses button A for 60 ms (three control periods), then releases it.
+    pub fn press_a(&mut self) {
+        self.set_button(b'B', 3, true);
+        self.run_ms(60);
+        self.set_button(b'B', 3, false);
+    }
+
+    /// Presses button B for 60 ms, then releases it.
+    pub fn press_b(&mut self) {
+        self.set_button(b'D', 5, true);
+        self.run_ms(60);
+        self.set_button(b'D', 5, false);
+    }
+
+    /// Runs the firmware for `ms` simulated milliseconds.
+    pub fn run_ms(&mut self, ms: u64) {
+        self.tester.run_for_ms(ms);
+    }
+
+    fn data(&self, addr: usize) -> u8 {
+        unsafe { *(*self.state.avr).data.add(addr) }
+    }
+
+    fn word(&self, addr: usize) -> u16 {
+        u16::from_le_bytes([self.data(addr), self.data(addr + 1)])
+    }
+
+    /// Motor duties as the firmware wrote them: (left = OCR1B, right = OCR1A).
+    pub fn duties(&self) -> (u16, u16) {
+        (self.word(OCR1B), self.word(OCR1A))
+    }
+
+    /// Fills the free SRAM between the statics and the stack pointer with a
+    /// pattern, for [`Zumo::stack_low_water`].
+    pub fn paint_stack(&mut self) {
+        let sp = usize::from(self.word(SP));
+        for addr in STATICS_END..sp {
+            unsafe { *(*self.state.avr).data.add(addr) = PAINT };
+        }
+    }
+
+    /// Lowest SRAM address the stack has written since [`Zumo::paint_stack`].
+    pub fn stack_low_water(&self) -> usize {
+        (STATICS_END..RAM_END).find(|a| self.data(*a) != PAINT).unwrap_or(RAM_END)
+    }
+
+    /// The word at SRAM 0x0800 (the bootloader's key).
+    pub fn boot_key(&self) -> u16 {
+        self.word(0x0800)
+    }
+
+    /// Log frames received since the last call, decoded with `shared`.
+    pub fn frames(&mut self) -> Vec<Result<LogFrame, LogError>> {
+        let uart = &self.state.uart;
+        let mut out = Vec::new();
+        let mut start = self.decoded;
+        for (i, b) in uart.iter().enumerate().skip(self.decoded) {
+            if *b == LogFrame::DELIMITER {
+                out.push(LogFrame::decode(&uart[start..i]));
+                start = i + 1;
+            }
+        }
+        self.decoded = start;
+        out
+    }
+
+    /// Cycles from each decision-start marker to its decision-end marker.
+    pub fn decision_cycles(&self) -> Vec<u64> {
+        self.state.marks.windows(2).filter(|w| w[0].0 == 1 && w[1].0 == 2).map(|w| w[1].1 - w[0].1).collect()
+    }
+}
