@@ -2,7 +2,12 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod bench;
+pub mod controller;
 pub mod inspect;
 pub mod learn;
 pub mod policy_file;
+pub mod render;
 pub mod report;
+pub mod scenario;
+pub mod sim;

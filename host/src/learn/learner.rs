@@ -1,0 +1,192 @@
+//! The Q-learning controller: one table, every robot's experience.
+
+use super::qtable::{QParams, QTable};
+use super::reward::Reward;
+use crate::controller::{Controller, Perception};
+use crate::sim::{ScalarField, SimConfig, SimRng, StepOutcome, World};
+use anyhow::{bail, Result};
+use serde::{Deserialize, Serialize};
+use shared::{ActionId, ActionTable, State, StateHasher};
+
+/// What the learner is and how it learns.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LearnConfig {
+    /// State representation (`original`, `original-obstacle`, `bits7`, `bits9`).
+    pub hasher: StateHasherName,
+    /// Angular speeds of the actions, radians per step (2 to 4).
+    pub actions: Vec<f32>,
+    /// Learning rate.
+    pub alpha: f64,
+    /// Discount.
+    pub gamma: f64,
+    /// Exploration probability.
+    pub epsilon: f64,
+    /// Initial Q-value of every (state, action).
+    pub initial_q: f64,
+    /// The reward signal.
+    pub reward: Reward,
+}
+
+/// A [`StateHasher`] as configs and the CLI name it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub struct StateHasherName(pub StateHasher);
+
+impl TryFrom<String> for StateHasherName {
+    type Error = String;
+
+    fn try_from(s: String) -> Result<StateHasherName, String> {
+        s.parse()
+    }
+}
+
+impl From<StateHasherName> for String {
+    fn from(h: StateHasherName) -> String {
+        h.0.name().to_string()
+    }
+}
+
+impl std::str::FromStr for StateHasherName {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<StateHasherName, String> {
+        StateHasher::from_name(s).map(StateHasherName).ok_or_else(|| {
+            format!("unknown hasher {s:?}: expected original, original-obstacle, bits7, bits9 (or 8, 10, 7, 9)")
+        })
+    }
+}
+
+impl Default for LearnConfig {
+    /// The thesis' Table 1: Original hasher, alpha 0.2, gamma 0.9, epsilon
+    /// 0, initial Q 1.0, the four default actions, the reference reward.
+    fn default() -> LearnConfig {
+        let params = QParams::default();
+        LearnConfig {
+            hasher: StateHasherName(StateHasher::Original),
+            actions: ActionTable::DEFAULT_ANGULAR.to_vec(),
+            alpha: params.alpha,
+            gamma: params.gamma,
+            epsilon: 0.0,
+            initial_q: 1.0,
+            reward: Reward::Reference,
+        }
+    }
+}
+
+impl LearnConfig {
+    /// Checks ranges before a run; errors name the setting.
+    pub fn validate(&self) -> Result<()> {
+        if let Err(e) = ActionTable::new(&self.actions, 1.0) {
+            bail!("learn.actions = {:?}: {e}", self.actions);
+        }
+        for (name, value) in [("learn.alpha", self.alpha), ("learn.gamma", self.gamma), ("learn.epsilon", self.epsilon)] {
+            if !(0.0..=1.0).contains(&value) {
+                bail!("{name} = {value}: must be in [0, 1]");
+            }
+        }
+        if !self.initial_q.is_finite() {
+            bail!("learn.initial_q = {}: must be a finite number", self.initial_q);
+        }
+        Ok(())
+    }
+
+    /// The Q-update's parameters.
+    pub fn params(&self) -> QParams {
+        QParams { alpha: self.alpha, gamma: self.gamma }
+    }
+}
+
+/// Tabular Q-learning as a [`Controller`]: each step every robot hashes its
+/// reading, picks an epsilon-greedy action from the one shared table; after
+/// the physics step every robot's (s, a, r, s') is applied in robot order
+/// with the same global reward.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct QLearner {
+    config: LearnConfig,
+    q: QTable,
+    /// Each robot's (state, action) of the step in flight.
+    chosen: Vec<(State, ActionId)>,
+    /// The reward signal of the world before the step in flight (set at
+    /// every episode start).
+    last_signal: Option<f64>,
+    /// Whether learning is on (off: act greedily, change nothing).
+    learning: bool,
+}
+
+impl QLearner {
+    /// A learner with every Q-value at `config.initial_q`.
+    pub fn new(config: LearnConfig) -> Result<QLearner> {
+        config.validate()?;
+        let q = QTable::new(config.hasher.0, config.actions.len(), config.initial_q);
+        Ok(QLearner { config, q, chosen: Vec::new(), last_signal: None, learning: true })
+    }
+
+    /// A learner that starts from another run's table (the thesis' RL2 and
+    /// the transfer experiment). The table must have this config's hasher
+    /// and action count.
+    pub fn with_table(config: LearnConfig, q: QTable) -> Result<QLearner> {
+        let mut learner = QLearner::new(config)?;
+        if !learner.q.same_shape(&q) {
+            bail!(
+                "the seed Q-table is for hasher {} with {} actions, but this run uses hasher {} with {} actions",
+                q.hasher(),
+                q.num_actions(),
+                learner.q.hasher(),
+                learner.q.num_actions()
+            );
+        }
+        learner.q = q;
+        Ok(learner)
+    }
+
+    /// Turns learning on or off.
+    pub fn set_learning(&mut self, on: bool) {
+        self.learning = on;
+    }
+
+    /// The Q-table.
+    pub fn table(&self) -> &QTable {
+        &self.q
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &LearnConfig {
+        &self.config
+    }
+}
+
+impl Controller for QLearner {
+    fn decide(&mut self, perception: &Perception<'_>, turns: &mut [f32], rng: &mut SimRng) {
+        let hasher = self.q.hasher();
+        self.chosen.clear();
+        for (reading, turn) in perception.readings.iter().zip(turns.iter_mut()) {
+            let state = hasher.hash(reading);
+            let action = self.q.select(state, self.config.epsilon, rng);
+            *turn = self.config.actions[action.index()];
+            self.chosen.push((state, action));
+        }
+    }
+
+    fn wants_eval_every_step(&self) -> bool {
+        self.learning
+    }
+
+    fn episode_start(&mut self, world: &World, field: &ScalarField, config: &SimConfig) {
+        self.last_signal = Some(self.config.reward.signal(world, field, config, None));
+    }
+
+    fn observe(&mut self, outcome: &StepOutcome<'_>) {
+        if !self.learning {
+            return;
+        }
+        let signal = self.config.reward.signal(outcome.world, outcome.field, outcome.config, outcome.eval);
+        let reward = self.config.reward.reward(self.last_signal.unwrap_or(signal), signal);
+        let hasher = self.q.hasher();
+        let params = self.config.params();
+        for (&(s, a), reading) in self.chosen.iter().zip(outcome.readings) {
+            self.q.update(s, a, reward, hasher.hash(reading), params);
+        }
+        self.last_signal = Some(signal);
+    }
+}

@@ -1,0 +1,177 @@
+//! A simulation and its controller from the CLI's choices (`--field`,
+//! `--controller`, counts, seed), with the per-field defaults of the
+//! thesis' experiments, and a timed run that summarises it.
+
+use crate::controller::{Controller, GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
+use crate::sim::{BroadPhase, FieldSource, SimConfig, Simulation, Thresholds, Totals};
+use anyhow::{Context, Result};
+use serde::Serialize;
+use shared::ActionTable;
+use std::fmt;
+use std::path::PathBuf;
+use std::str::FromStr;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Which controller drives the robots.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ControllerChoice {
+    /// Orbital construction (`oc`).
+    Orbital,
+    /// Uniformly random actions (`random`).
+    Random,
+    /// A greedy policy blob (`policy:FILE`).
+    Policy(PathBuf),
+}
+
+impl FromStr for ControllerChoice {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<ControllerChoice, String> {
+        match s {
+            "oc" => Ok(ControllerChoice::Orbital),
+            "random" => Ok(ControllerChoice::Random),
+            _ => match s.strip_prefix("policy:") {
+                Some(path) if !path.is_empty() => Ok(ControllerChoice::Policy(PathBuf::from(path))),
+                _ => Err(format!("unknown controller {s:?}: expected oc, random or policy:FILE")),
+            },
+        }
+    }
+}
+
+impl fmt::Display for ControllerChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ControllerChoice::Orbital => f.write_str("oc"),
+            ControllerChoice::Random => f.write_str("random"),
+            ControllerChoice::Policy(p) => write!(f, "policy:{}", p.display()),
+        }
+    }
+}
+
+/// What to simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// The field.
+    pub field: FieldSource,
+    /// The controller.
+    pub controller: ControllerChoice,
+    /// Number of robots.
+    pub robots: usize,
+    /// Number of pucks.
+    pub pucks: usize,
+    /// Seed of every generator.
+    pub seed: u64,
+    /// Contact search.
+    pub broad_phase: BroadPhase,
+    /// Arena side; `None` for the default 800.
+    pub arena_size: Option<f64>,
+}
+
+impl Default for Scenario {
+    /// The thesis' standard run: annulus, orbital construction, 8 robots,
+    /// 250 pucks, seed 1.
+    fn default() -> Scenario {
+        Scenario {
+            field: FieldSource::Annulus,
+            controller: ControllerChoice::Orbital,
+            robots: 8,
+            pucks: 250,
+            seed: 1,
+            broad_phase: BroadPhase::Grid,
+            arena_size: None,
+        }
+    }
+}
+
+impl Scenario {
+    /// The settings: the reference defaults, the annulus thresholds and
+    /// 150,000-step stuck limit on the annulus, thresholds 1.0 and a
+    /// 50,000-step limit on letters and images; half the robots innies for
+    /// orbital construction on the annulus, none otherwise.
+    pub fn config(&self) -> SimConfig {
+        let mut c = SimConfig::default();
+        c.world.robots = self.robots;
+        c.world.pucks = self.pucks;
+        c.world.broad_phase = self.broad_phase;
+        if let Some(size) = self.arena_size {
+            c.world.arena_size = size;
+        }
+        let cavity = self.field.has_cavity();
+        if !cavity {
+            c.thresholds = Thresholds::LETTERS;
+            c.episode.stuck_limit = 50_000;
+        }
+        if self.controller == ControllerChoice::Orbital && cavity {
+            c.world.innies = self.robots / 2;
+        }
+        c
+    }
+
+    /// Loads the field and policy, validates the settings and builds the
+    /// simulation and controller. Errors name the offending input.
+    pub fn build(&self) -> Result<(Simulation, Box<dyn Controller>)> {
+        let mut config = self.config();
+        let controller: Box<dyn Controller> = match &self.controller {
+            ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds)),
+            ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
+            ControllerChoice::Policy(path) => {
+                let blob = crate::policy_file::read(path)?;
+                config.world.forward_speed = f64::from(blob.actions().forward_speed());
+                Box::new(GreedyPolicy::new(blob))
+            }
+        };
+        config.validate().context("invalid simulation settings")?;
+        let field = Arc::new(self.field.load()?);
+        let sim = Simulation::new(config, field, self.seed).context("invalid simulation settings")?;
+        Ok((sim, controller))
+    }
+}
+
+/// The figures `host run` prints.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Steps run.
+    pub steps: u64,
+    /// Episodes that formed the shape.
+    pub formations: u64,
+    /// Episodes reset at the stuck limit.
+    pub stuck: u64,
+    /// Robot-robot collisions per 1000 steps.
+    pub collisions_per_1000: f64,
+    /// Mean Eval at the formation checks.
+    pub mean_eval: f64,
+    /// Wall-clock speed of the run.
+    pub steps_per_second: f64,
+}
+
+impl RunSummary {
+    fn new(totals: &Totals, seconds: f64) -> RunSummary {
+        RunSummary {
+            steps: totals.steps,
+            formations: totals.formations,
+            stuck: totals.stuck,
+            collisions_per_1000: totals.collisions_per_1000(),
+            mean_eval: totals.mean_eval(),
+            steps_per_second: if seconds > 0.0 { totals.steps as f64 / seconds } else { f64::INFINITY },
+        }
+    }
+}
+
+impl fmt::Display for RunSummary {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "steps                {}", self.steps)?;
+        writeln!(f, "formations           {}", self.formations)?;
+        writeln!(f, "stuck episodes       {}", self.stuck)?;
+        writeln!(f, "collisions per 1000  {:.1}", self.collisions_per_1000)?;
+        writeln!(f, "mean Eval            {:.4}", self.mean_eval)?;
+        write!(f, "steps per second     {:.0}", self.steps_per_second)
+    }
+}
+
+/// Runs `steps` steps and summarises them with the measured speed.
+pub fn run_timed<C: Controller + ?Sized>(sim: &mut Simulation, controller: &mut C, steps: u64) -> RunSummary {
+    let start = Instant::now();
+    sim.run(controller, steps);
+    RunSummary::new(sim.totals(), start.elapsed().as_secs_f64())
+}

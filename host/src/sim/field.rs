@@ -1,0 +1,283 @@
+//! Scalar fields: a grid of values in [0, 1] stretched over the arena.
+//!
+//! Sensors read the nearest cell, `index = round(cells x position /
+//! arena_size)`; the evaluation of pucks truncates instead. Positions whose
+//! index falls outside the grid read 0 (so sensor points in the last half
+//! cell along the right and bottom edges read 0, as in the original).
+
+use super::letters::Letter;
+use super::vec2::Vec2;
+use serde::{Deserialize, Serialize};
+use shared::FieldValue;
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// A grid of field values, row-major, row 0 at the top (y = 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScalarField {
+    width: usize,
+    height: usize,
+    values: Vec<f32>,
+    fixed: Vec<FieldValue>,
+}
+
+impl ScalarField {
+    /// A field from `width x height` values (row-major), clamped to [0, 1].
+    /// Returns `None` if the sizes do not match or are zero.
+    pub fn new(width: usize, height: usize, values: Vec<f32>) -> Option<ScalarField> {
+        if width == 0 || height == 0 || values.len() != width * height {
+            return None;
+        }
+        let values: Vec<f32> = values.into_iter().map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 }).collect();
+        let fixed = values.iter().map(|&v| FieldValue::from_f32(v)).collect();
+        Some(ScalarField { width, height, values, fixed })
+    }
+
+    /// The annulus field of the reference model: 64 x 64 cells, value
+    /// `1 - distance((i, j), (32, 32)) / (32 sqrt 2)`, so cell (32, 32) is
+    /// exactly 1 and the farthest cell (0, 0) is 0.
+    pub fn annulus() -> ScalarField {
+        const N: usize = 64;
+        let centre = (N / 2) as f64;
+        let farthest = centre.hypot(centre);
+        let values = (0..N * N)
+            .map(|k| {
+                let (x, y) = ((k % N) as f64, (k / N) as f64);
+                (1.0 - (x - centre).hypot(y - centre) / farthest) as f32
+            })
+            .collect();
+        ScalarField::new(N, N, values).expect("64 x 64 values")
+    }
+
+    /// Grid width (columns).
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Grid height (rows).
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The value of cell (`x`, `y`), or 0 outside the grid.
+    pub fn cell(&self, x: i64, y: i64) -> f32 {
+        self.cell_index(x, y).map_or(0.0, |k| self.values[k])
+    }
+
+    fn cell_index(&self, x: i64, y: i64) -> Option<usize> {
+        let inside = (0..self.width as i64).contains(&x) && (0..self.height as i64).contains(&y);
+        inside.then(|| y as usize * self.width + x as usize)
+    }
+
+    /// The cell a sensor at `p` reads: nearest cell by rounding.
+    pub fn nearest_cell(&self, p: Vec2, arena_size: f64) -> (i64, i64) {
+        let x = round_half_away(self.width as f64 * p.x / arena_size);
+        let y = round_half_away(self.height as f64 * p.y / arena_size);
+        (x, y)
+    }
+
+    /// The sensor reading at `p`, in fixed point (nearest cell; 0 outside).
+    pub fn sense(&self, p: Vec2, arena_size: f64) -> FieldValue {
+        let (x, y) = self.nearest_cell(p, arena_size);
+        self.cell_index(x, y).map_or(FieldValue::ZERO, |k| self.fixed[k])
+    }
+
+    /// The value used to evaluate a puck at `p`: the cell found by
+    /// truncation (0 outside).
+    pub fn evaluate(&self, p: Vec2, arena_size: f64) -> f32 {
+        let x = (self.width as f64 * p.x / arena_size) as i64;
+        let y = (self.height as f64 * p.y / arena_size) as i64;
+        self.cell(x, y)
+    }
+}
+
+/// `t.round() as i64` without the libm call `round` compiles to on
+/// baseline x86-64: the fractional part `t - trunc(t)` is exact, so the
+/// result is identical. (Indices beyond `i64` saturate, as `as` does.)
+fn round_half_away(t: f64) -> i64 {
+    let whole = t as i64;
+    let frac = t - whole as f64;
+    if frac >= 0.5 {
+        whole.saturating_add(1)
+    } else if frac <= -0.5 {
+        whole.saturating_sub(1)
+    } else {
+        whole
+    }
+}
+
+/// Where a field comes from: the `--field` argument.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum FieldSource {
+    /// The 64 x 64 annulus (`annulus`).
+    Annulus,
+    /// A generated letter (`letter:T`).
+    Letter(Letter),
+    /// A PNG or JPEG image (any other argument: its path).
+    Image(PathBuf),
+}
+
+/// A field that cannot be loaded, naming the input and the reason.
+#[derive(Debug)]
+pub enum FieldError {
+    /// `letter:` followed by something other than T, I, L, V, X or Z.
+    UnknownLetter(String),
+    /// The image file cannot be read or decoded.
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: image::ImageError,
+    },
+    /// The image decodes to no pixels.
+    EmptyImage(PathBuf),
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FieldError::UnknownLetter(l) => {
+                write!(f, "unknown letter {l:?} in the field name: expected one of {}", Letter::NAMES)
+            }
+            FieldError::Image { path, reason } => write!(f, "cannot load field image {}: {reason}", path.display()),
+            FieldError::EmptyImage(path) => write!(f, "field image {} has no pixels", path.display()),
+        }
+    }
+}
+
+impl std::error::Error for FieldError {}
+
+impl FromStr for FieldSource {
+    type Err = FieldError;
+
+    /// `annulus`, `letter:X`, or a path.
+    fn from_str(s: &str) -> Result<FieldSource, FieldError> {
+        if s == "annulus" {
+            Ok(FieldSource::Annulus)
+        } else if let Some(letter) = s.strip_prefix("letter:") {
+            letter.parse().map(FieldSource::Letter).map_err(|_| FieldError::UnknownLetter(letter.to_string()))
+        } else {
+            Ok(FieldSource::Image(PathBuf::from(s)))
+        }
+    }
+}
+
+impl TryFrom<String> for FieldSource {
+    type Error = FieldError;
+    fn try_from(s: String) -> Result<FieldSource, FieldError> {
+        s.parse()
+    }
+}
+
+impl From<FieldSource> for String {
+    fn from(f: FieldSource) -> String {
+        f.to_string()
+    }
+}
+
+impl fmt::Display for FieldSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FieldSource::Annulus => f.write_str("annulus"),
+            FieldSource::Letter(l) => write!(f, "letter:{l}"),
+            FieldSource::Image(p) => write!(f, "{}", p.display()),
+        }
+    }
+}
+
+impl FieldSource {
+    /// Builds or loads the field.
+    pub fn load(&self) -> Result<ScalarField, FieldError> {
+        match self {
+            FieldSource::Annulus => Ok(ScalarField::annulus()),
+            FieldSource::Letter(l) => Ok(l.field()),
+            FieldSource::Image(path) => load_image(path),
+        }
+    }
+
+    /// Whether the target shape has a hole in the middle that innies keep
+    /// free (only the annulus: the thesis removes innies for letters).
+    pub fn has_cavity(&self) -> bool {
+        matches!(self, FieldSource::Annulus)
+    }
+}
+
+/// An image field: mean of R, G, B over 255, one cell per pixel.
+fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
+    let err = |reason| FieldError::Image { path: path.to_path_buf(), reason };
+    let img = image::ImageReader::open(path)
+        .map_err(|e| err(image::ImageError::IoError(e)))?
+        .with_guessed_format()
+        .map_err(|e| err(image::ImageError::IoError(e)))?
+        .decode()
+        .map_err(err)?
+        .to_rgb8();
+    let values = img.pixels().map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / (3.0 * 255.0)).collect();
+    ScalarField::new(img.width() as usize, img.height() as usize, values)
+        .ok_or_else(|| FieldError::EmptyImage(path.to_path_buf()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn annulus_centre_is_exactly_one_and_far_corner_zero() {
+        let f = ScalarField::annulus();
+        assert_eq!(f.cell(32, 32), 1.0);
+        assert_eq!(f.cell(0, 0), 0.0);
+        assert!(f.cell(63, 63) > 0.0);
+        assert_eq!(f.sense(Vec2::new(400.0, 400.0), 800.0), FieldValue::ONE);
+    }
+
+    #[test]
+    fn sensors_round_and_read_zero_past_the_last_half_cell() {
+        let f = ScalarField::annulus();
+        // 64 cells over 800 units: 12.5 units per cell.
+        assert_eq!(f.nearest_cell(Vec2::new(6.0, 6.0), 800.0), (0, 0));
+        assert_eq!(f.nearest_cell(Vec2::new(6.25, 18.7), 800.0), (1, 1));
+        assert_eq!(f.nearest_cell(Vec2::new(793.0, 400.0), 800.0), (63, 32));
+        assert_eq!(f.nearest_cell(Vec2::new(793.75, 400.0), 800.0), (64, 32));
+        assert_eq!(f.sense(Vec2::new(793.75, 400.0), 800.0), FieldValue::ZERO);
+        assert_eq!(f.sense(Vec2::new(400.0, 795.0), 800.0), FieldValue::ZERO);
+        assert_eq!(f.sense(Vec2::new(793.0, 400.0), 800.0), FieldValue::from_f32(f.cell(63, 32)));
+        assert_eq!(f.sense(Vec2::new(-7.0, 400.0), 800.0), FieldValue::ZERO);
+        // evaluation truncates: 799 -> cell 63
+        assert_eq!(f.evaluate(Vec2::new(799.0, 400.0), 800.0), f.cell(63, 32));
+        assert_eq!(f.evaluate(Vec2::new(12.4, 12.4), 800.0), f.cell(0, 0));
+    }
+
+    #[test]
+    fn rounding_matches_the_standard_round() {
+        for t in [0.0, 0.49999999999999994, 0.5, 1.5, 2.4999, 63.5, -0.2, -0.5, -0.50001, -1.5, 1e300, f64::NAN] {
+            assert_eq!(round_half_away(t), t.round() as i64, "{t}");
+        }
+    }
+
+    #[test]
+    fn sources_parse_and_errors_name_the_input() {
+        assert_eq!("annulus".parse::<FieldSource>().unwrap(), FieldSource::Annulus);
+        assert_eq!("letter:T".parse::<FieldSource>().unwrap(), FieldSource::Letter(Letter::T));
+        let e = "letter:Q".parse::<FieldSource>().unwrap_err().to_string();
+        assert!(e.contains("\"Q\""), "{e}");
+        let missing = FieldSource::Image(PathBuf::from("/no/such/field.png"));
+        let e = missing.load().unwrap_err().to_string();
+        assert!(e.contains("/no/such/field.png"), "{e}");
+    }
+
+    #[test]
+    fn images_read_as_mean_rgb() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.png");
+        let mut img = image::RgbImage::new(2, 1);
+        img.put_pixel(0, 0, image::Rgb([255, 255, 255]));
+        img.put_pixel(1, 0, image::Rgb([255, 0, 0]));
+        img.save(&path).unwrap();
+        let f = FieldSource::Image(path).load().unwrap();
+        assert_eq!((f.width(), f.height()), (2, 1));
+        assert_eq!(f.cell(0, 0), 1.0);
+        assert!((f.cell(1, 0) - 1.0 / 3.0).abs() < 1e-6);
+    }
+}

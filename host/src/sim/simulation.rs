@@ -1,0 +1,236 @@
+//! The step loop: sense, decide, act, step physics, evaluate, and end and
+//! reset episodes.
+//!
+//! [`Simulation`] owns the world, the field (shared, read-only), the sensor
+//! model and the counters; the controller is passed to each call so the
+//! trainer keeps ownership of its learner. [`SimulationState`] is everything
+//! that determines the future: saving it and resuming gives the same
+//! trajectory bit for bit.
+
+use super::config::{ConfigError, SimConfig};
+use super::eval::eval;
+use super::field::ScalarField;
+use super::sensors::{DiscSensors, SensorModel};
+use super::world::World;
+use super::SimRng;
+use crate::controller::{Controller, Perception};
+use rand::SeedableRng;
+use serde::{Deserialize, Serialize};
+use shared::SensorReading;
+use std::sync::Arc;
+
+/// Why an episode ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EpisodeEnd {
+    /// Eval exceeded the success threshold at a check.
+    Formed,
+    /// The stuck limit was reached without success.
+    Stuck,
+}
+
+/// What a step produced, as the controller sees it.
+#[derive(Clone, Copy, Debug)]
+pub struct StepOutcome<'a> {
+    /// Steps of the episode so far, this one included.
+    pub episode_step: u64,
+    /// Eval after the step: every step if the controller asked for it,
+    /// otherwise only at formation checks.
+    pub eval: Option<f64>,
+    /// Set when this step ended the episode; the world is reset after the
+    /// controller has seen it.
+    pub end: Option<EpisodeEnd>,
+    /// Robot-robot pairs in contact during the step.
+    pub robot_contacts: usize,
+    /// The world after the step (before any reset), for other measures
+    /// such as Eval'.
+    pub world: &'a World,
+    /// The field.
+    pub field: &'a ScalarField,
+}
+
+/// Counters over the simulation's life.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Totals {
+    /// Steps run.
+    pub steps: u64,
+    /// Episodes that formed the shape.
+    pub formations: u64,
+    /// Episodes reset at the stuck limit.
+    pub stuck: u64,
+    /// Robot-robot contacts, summed over steps.
+    pub robot_contacts: u64,
+    /// Sum of Eval at formation checks.
+    pub eval_sum: f64,
+    /// Number of formation checks.
+    pub eval_checks: u64,
+}
+
+impl Totals {
+    /// Robot-robot collisions per 1000 steps.
+    pub fn collisions_per_1000(&self) -> f64 {
+        if self.steps == 0 {
+            0.0
+        } else {
+            self.robot_contacts as f64 * 1000.0 / self.steps as f64
+        }
+    }
+
+    /// Mean Eval over the formation checks (0 before the first).
+    pub fn mean_eval(&self) -> f64 {
+        if self.eval_checks == 0 {
+            0.0
+        } else {
+            self.eval_sum / self.eval_checks as f64
+        }
+    }
+}
+
+/// Everything that determines a simulation's future.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SimulationState {
+    /// The settings.
+    pub config: SimConfig,
+    /// Bodies, robots, the world's generator.
+    pub world: World,
+    /// The generator handed to the controller.
+    pub controller_rng: SimRng,
+    /// Steps of the current episode.
+    pub episode_step: u64,
+    /// Counters.
+    pub totals: Totals,
+}
+
+/// A running simulation with sensor model `S`.
+pub struct Simulation<S: SensorModel = DiscSensors> {
+    state: SimulationState,
+    field: Arc<ScalarField>,
+    sensors: S,
+    readings: Vec<SensorReading>,
+    turns: Vec<f32>,
+}
+
+/// Added to the seed for the controller's generator, so that it draws a
+/// stream independent of the world's.
+const CONTROLLER_STREAM: u64 = 0x9E37_79B9_7F4A_7C15;
+
+impl Simulation<DiscSensors> {
+    /// A simulation with the reference disc sensors of `config.sensors`.
+    pub fn new(config: SimConfig, field: Arc<ScalarField>, seed: u64) -> Result<Simulation, ConfigError> {
+        let sensors = DiscSensors::new(&config.sensors, config.world.robot_radius);
+        Simulation::with_sensors(config, field, sensors, seed)
+    }
+}
+
+impl<S: SensorModel> Simulation<S> {
+    /// A simulation with any sensor model; the world's generator is seeded
+    /// with `seed`, the controller's with a value derived from it.
+    pub fn with_sensors(config: SimConfig, field: Arc<ScalarField>, sensors: S, seed: u64) -> Result<Self, ConfigError> {
+        let world = World::new(&config, seed)?;
+        let controller_rng = SimRng::seed_from_u64(seed.wrapping_add(CONTROLLER_STREAM));
+        let state = SimulationState { config, world, controller_rng, episode_step: 0, totals: Totals::default() };
+        Ok(Simulation::resume(state, field, sensors))
+    }
+
+    /// Continues from a saved state.
+    pub fn resume(state: SimulationState, field: Arc<ScalarField>, sensors: S) -> Self {
+        let robots = state.world.robots().len();
+        Simulation { state, field, sensors, readings: vec![SensorReading::default(); robots], turns: vec![0.0; robots] }
+    }
+
+    /// The state to save for a bit-exact resume.
+    pub fn state(&self) -> &SimulationState {
+        &self.state
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.state.world
+    }
+
+    /// The field.
+    pub fn field(&self) -> &ScalarField {
+        &self.field
+    }
+
+    /// The sensor model.
+    pub fn sensors(&self) -> &S {
+        &self.sensors
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &SimConfig {
+        &self.state.config
+    }
+
+    /// Counters so far.
+    pub fn totals(&self) -> &Totals {
+        &self.state.totals
+    }
+
+    /// The readings of the last step's sensing.
+    pub fn readings(&self) -> &[SensorReading] {
+        &self.readings
+    }
+
+    /// Eval of the current world.
+    pub fn eval(&self) -> f64 {
+        eval(&self.state.world, &self.field, &self.state.config.thresholds)
+    }
+
+    /// One step: sense, decide, turn and move, evaluate, report to the
+    /// controller, and reset the world if the episode ended. Returns how the
+    /// episode ended, if it did.
+    pub fn step<C: Controller + ?Sized>(&mut self, controller: &mut C) -> Option<EpisodeEnd> {
+        let s = &mut self.state;
+        self.sensors.sense(&s.world, &self.field, &mut self.readings);
+        let perception = Perception { readings: &self.readings, robots: s.world.robots(), episode_step: s.episode_step };
+        controller.decide(&perception, &mut self.turns, &mut s.controller_rng);
+        s.world.step(&self.turns);
+        s.episode_step += 1;
+
+        let episode = &s.config.episode;
+        let check = s.episode_step % episode.check_interval == 0;
+        let eval = (check || controller.wants_eval_every_step())
+            .then(|| eval(&s.world, &self.field, &s.config.thresholds));
+        let mut end = None;
+        if let (true, Some(e)) = (check, eval) {
+            s.totals.eval_sum += e;
+            s.totals.eval_checks += 1;
+            if e > episode.success_eval {
+                end = Some(EpisodeEnd::Formed);
+            }
+        }
+        if end.is_none() && s.episode_step >= episode.stuck_limit {
+            end = Some(EpisodeEnd::Stuck);
+        }
+        let robot_contacts = s.world.robot_contacts();
+        s.totals.steps += 1;
+        s.totals.robot_contacts += robot_contacts as u64;
+        controller.observe(&StepOutcome {
+            episode_step: s.episode_step,
+            eval,
+            end,
+            robot_contacts,
+            world: &s.world,
+            field: &self.field,
+        });
+        match end {
+            Some(EpisodeEnd::Formed) => s.totals.formations += 1,
+            Some(EpisodeEnd::Stuck) => s.totals.stuck += 1,
+            None => {}
+        }
+        if end.is_some() {
+            s.world.reset();
+            s.episode_step = 0;
+        }
+        end
+    }
+
+    /// Runs `steps` steps.
+    pub fn run<C: Controller + ?Sized>(&mut self, controller: &mut C, steps: u64) {
+        for _ in 0..steps {
+            self.step(controller);
+        }
+    }
+}
