@@ -5,6 +5,7 @@ use host::render::RenderOptions;
 use host::scenario::{run_timed, ControllerChoice, Scenario};
 use host::sim::{BroadPhase, FieldSource};
 use shared::StateHasher;
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -251,20 +252,19 @@ fn run(cli: Cli) -> Result<()> {
         Command::Monitor(args) => monitor(args),
         Command::Replay(args) => {
             let report = host::robot::replay::replay_files(&args.log, &args.policy, args.visits.as_deref())?;
-            if args.json {
-                println!("{}", serde_json::to_string(&report).context("cannot encode the report")?);
+            let text = if args.json {
+                serde_json::to_string(&report).context("cannot encode the report")? + "\n"
             } else {
-                print!("{report}");
-            }
-            Ok(())
+                report.to_string()
+            };
+            std::io::stdout().write_all(text.as_bytes()).context("cannot write the report")
         }
         Command::Flash(args) => {
             use host::robot::flash;
             let cwd = std::env::current_dir().context("cannot read the current directory")?;
             let plan = flash::FlashPlan::new(&args.policy, args.hasher, args.port, args.repo.as_deref(), &cwd)?;
             if args.dry_run {
-                print!("{}", plan.describe());
-                return Ok(());
+                return std::io::stdout().write_all(plan.describe().as_bytes()).context("cannot write the commands");
             }
             let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
             flash::flash(&plan, avrdude.as_deref(), flash::PORT_WAIT, &mut std::io::stdout())
