@@ -84,6 +84,11 @@ impl Faults {
         self.0 & other.0 == other.0
     }
 
+    /// Whether any flag of `other` is set.
+    pub const fn intersects(self, other: Faults) -> bool {
+        self.0 & other.0 != 0
+    }
+
     /// Whether no flag is set.
     pub const fn is_empty(self) -> bool {
         self.0 == 0
@@ -193,6 +198,12 @@ impl LogFrame {
     pub const DELIMITER: u8 = 0;
     /// Longest encoded frame, delimiter included.
     pub const MAX_ENCODED_LEN: usize = cobs::max_encoding_length(MAX_RAW_LEN) + 1;
+
+    /// Whether the policy's action drove the motors this period: driving
+    /// with no fault that stops the motors (the firmware's supervisor rule).
+    pub const fn policy_drove(&self) -> bool {
+        matches!(self.mode, RunMode::Driving) && !self.faults.intersects(Faults::STOPS_MOTORS)
+    }
 
     /// Encodes the frame into `out`; returns its length, the trailing
     /// delimiter included.
@@ -343,6 +354,10 @@ mod tests {
         assert!(Faults::STOPS_MOTORS.contains(Faults::CAMERA_SILENT));
         assert!(Faults::STOPS_MOTORS.contains(Faults::SENSORS_TIMEOUT));
         assert!(!Faults::STOPS_MOTORS.contains(Faults::NO_CALIBRATION));
+        let driving = LogFrame { mode: RunMode::Driving, faults: Faults::CALIBRATION_FAILED, ..sample() };
+        assert!(driving.policy_drove());
+        assert!(!LogFrame { faults: Faults::SENSORS_TIMEOUT, ..driving }.policy_drove());
+        assert!(!LogFrame { mode: RunMode::Idle, ..driving }.policy_drove());
         let all = Faults::NAMED.iter().fold(Faults::NONE, |acc, (f, _)| acc.with(*f));
         assert_eq!(all, Faults(15));
     }

@@ -23,8 +23,6 @@ const READ_TIMEOUT: Duration = Duration::from_millis(100);
 
 /// Opens the byte stream to monitor (again, after it was lost).
 pub trait PortOpener {
-    /// What is being opened, for messages.
-    fn name(&self) -> String;
     /// Opens the stream; an error means "not there (yet)".
     fn open(&mut self) -> Result<Box<dyn Read + Send>>;
 }
@@ -38,10 +36,6 @@ pub struct SerialOpener {
 }
 
 impl PortOpener for SerialOpener {
-    fn name(&self) -> String {
-        self.port.clone()
-    }
-
     fn open(&mut self) -> Result<Box<dyn Read + Send>> {
         let port = serialport::new(&self.port, self.baud)
             .data_bits(serialport::DataBits::Eight)
@@ -147,14 +141,19 @@ impl fmt::Display for LiveStatus {
             }
         }
         let driven: u64 = self.actions.iter().sum();
-        if driven > 0 {
+        // None until the policy has driven at least once.
+        let shares: Option<Vec<u64>> = self.actions.iter().map(|n| (n * 100).checked_div(driven)).collect();
+        if let Some(shares) = shares {
             f.write_str(" | actions")?;
-            for (a, n) in self.actions.iter().enumerate() {
-                write!(f, " {a}:{}%", n * 100 / driven)?;
+            for (a, pct) in shares.iter().enumerate() {
+                write!(f, " {a}:{pct}%")?;
             }
         }
         if self.disconnects > 0 {
             write!(f, " | disconnects {}", self.disconnects)?;
+        }
+        if self.skipped_bytes > 0 {
+            write!(f, " | skipped {} bytes of partial frames", self.skipped_bytes)?;
         }
         Ok(())
     }
@@ -349,10 +348,6 @@ mod tests {
     }
 
     impl PortOpener for Unplugging {
-        fn name(&self) -> String {
-            "fake".into()
-        }
-
         fn open(&mut self) -> Result<Box<dyn Read + Send>> {
             if std::mem::take(&mut self.fail_next) {
                 anyhow::bail!("no such port");
