@@ -28,13 +28,17 @@ fn main() -> ! {
     let mut record = [0u8; RECORD_LEN];
     board.eeprom_read(CALIBRATION_EEPROM_ADDR, &mut record);
     let stored = calibration_record::decode(&record).ok();
-    let calibration = stored.unwrap_or(UNCALIBRATED);
+    let mut calibration = stored.unwrap_or(UNCALIBRATED);
     let policy = board::FlashPolicy;
     let mut decider = Decider::new(&calibration, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
     let mut supervisor = Supervisor::new(stored.is_some());
     let mut camera = Camera::new();
     let spin = RobotProfile::ZUMO.outputs(CALIBRATION_SPIN);
     let mut frame = [0u8; LogFrame::MAX_ENCODED_LEN];
+    // Frames since the log last carried the calibration in use: it goes out
+    // in the first frame, after a new one takes effect, and every
+    // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
+    let mut since_calibration = LogFrame::CALIBRATION_EVERY - 1;
 
     board.watchdog_on();
     loop {
@@ -45,10 +49,19 @@ fn main() -> ! {
         let plan = supervisor.period(buttons, &times, camera_ok);
 
         let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors, &spin);
+        since_calibration = since_calibration.saturating_add(1);
+        let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
+            since_calibration = 0;
+            Some(calibration)
+        } else {
+            None
+        };
 
         if let Some(new) = plan.save {
             board.eeprom_write(CALIBRATION_EEPROM_ADDR, &calibration_record::encode(&new));
             decider.set_calibration(&new);
+            calibration = new;
+            since_calibration = LogFrame::CALIBRATION_EVERY - 1;
         }
         board.leds(plan.leds);
         let log = LogFrame {
@@ -62,6 +75,7 @@ fn main() -> ! {
             state: decision.state,
             action: decision.action,
             motors: command,
+            calibration: logged_calibration,
         };
         let n = log.encode(&mut frame);
         board.send(frame.get(..n).unwrap_or(&[]));

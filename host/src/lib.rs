@@ -9,5 +9,6 @@ pub mod learn;
 pub mod policy_file;
 pub mod render;
 pub mod report;
+pub mod robot;
 pub mod scenario;
 pub mod sim;

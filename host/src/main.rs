@@ -4,10 +4,15 @@ use host::bench::BenchVariant;
 use host::render::RenderOptions;
 use host::scenario::{run_timed, ControllerChoice, Scenario};
 use host::sim::{BroadPhase, FieldSource};
+use shared::StateHasher;
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
-/// Simulate, train and inspect policies for Zumo puck-construction swarms.
+/// Simulate, train and inspect policies for Zumo puck-construction swarms;
+/// flash robots, record and replay their logs.
 #[derive(Parser)]
 #[command(version, about)]
 struct Cli {
@@ -68,6 +73,80 @@ enum Command {
     /// Work with policy blob files.
     #[command(subcommand)]
     Policy(PolicyCommand),
+    /// Record a robot's serial log into a file (each frame with a host
+    /// timestamp) with a live status line; survives unplugging, Ctrl-C ends.
+    Monitor(MonitorArgs),
+    /// Check a recorded log (or a raw serial capture) against a policy:
+    /// divergences, state coverage, actions, faults, damaged records.
+    Replay(ReplayArgs),
+    /// Build the firmware with a policy and flash it with avrdude (double
+    /// press of reset); --dry-run prints the commands.
+    Flash(FlashArgs),
+}
+
+/// `host monitor`'s options (docs/robot-logs.md).
+#[derive(Args)]
+struct MonitorArgs {
+    /// Serial port of the robot's TTL adapter or radio, e.g. /dev/ttyUSB0.
+    #[arg(long, required_unless_present = "list")]
+    port: Option<String>,
+    /// Baud rate (the firmware sends 115200 8N1).
+    #[arg(long, default_value_t = host::robot::monitor::DEFAULT_BAUD)]
+    baud: u32,
+    /// Recorded-log file to write (refused if it exists, unless --append).
+    #[arg(long, required_unless_present = "list")]
+    out: Option<PathBuf>,
+    /// Add to an existing recorded log instead of refusing it.
+    #[arg(long)]
+    append: bool,
+    /// Stop after recording this many frames (for scripts and tests).
+    #[arg(long)]
+    frames: Option<u64>,
+    /// List the serial ports and exit.
+    #[arg(long)]
+    list: bool,
+}
+
+/// `host replay`'s options (docs/robot-logs.md).
+#[derive(Args)]
+struct ReplayArgs {
+    /// Recorded log from `host monitor`, or a raw capture of the serial line.
+    #[arg(long)]
+    log: PathBuf,
+    /// The policy blob the robot was flashed with.
+    #[arg(long)]
+    policy: PathBuf,
+    /// Training visit counts per state (JSON, docs/robot-logs.md): reports
+    /// the states the robot met that training never visited.
+    #[arg(long)]
+    visits: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+/// `host flash`'s options (docs/robot-logs.md).
+#[derive(Args)]
+struct FlashArgs {
+    /// The policy blob to embed.
+    #[arg(long)]
+    policy: PathBuf,
+    /// The bootloader's serial port (appears after a double press of reset), e.g. /dev/ttyACM0.
+    #[arg(long)]
+    port: Option<String>,
+    /// Build for this hasher; the policy must use it (default: the policy's own).
+    #[arg(long, value_parser = parse_hasher)]
+    hasher: Option<StateHasher>,
+    /// The zumo-swarm checkout to build in (default: the one around the current directory).
+    #[arg(long)]
+    repo: Option<PathBuf>,
+    /// Validate and print the exact commands; build and write nothing.
+    #[arg(long)]
+    dry_run: bool,
+}
+
+fn parse_hasher(s: &str) -> Result<StateHasher, String> {
+    StateHasher::from_name(s).ok_or_else(|| format!("{s:?} is not a hasher (original, original-obstacle, bits7, bits9)"))
 }
 
 /// What to simulate.
@@ -170,5 +249,48 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", host::inspect::render(&blob));
             Ok(())
         }
+        Command::Monitor(args) => monitor(args),
+        Command::Replay(args) => {
+            let report = host::robot::replay::replay_files(&args.log, &args.policy, args.visits.as_deref())?;
+            let text = if args.json {
+                serde_json::to_string(&report).context("cannot encode the report")? + "\n"
+            } else {
+                report.to_string()
+            };
+            std::io::stdout().write_all(text.as_bytes()).context("cannot write the report")
+        }
+        Command::Flash(args) => {
+            use host::robot::flash;
+            let cwd = std::env::current_dir().context("cannot read the current directory")?;
+            let plan = flash::FlashPlan::new(&args.policy, args.hasher, args.port, args.repo.as_deref(), &cwd)?;
+            if args.dry_run {
+                return std::io::stdout().write_all(plan.describe().as_bytes()).context("cannot write the commands");
+            }
+            let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
+            flash::flash(&plan, avrdude.as_deref(), flash::PORT_WAIT, &mut std::io::stdout())
+        }
     }
+}
+
+fn monitor(args: MonitorArgs) -> Result<()> {
+    use host::robot::monitor::{self, MonitorOptions, SerialOpener, StatusPrinter};
+    if args.list {
+        for port in monitor::list_ports()? {
+            println!("{port}");
+        }
+        return Ok(());
+    }
+    let (Some(port), Some(out)) = (args.port, args.out) else {
+        anyhow::bail!("--port and --out are required");
+    };
+    let mut log = host::robot::log_file::LogWriter::create(&out, args.append)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst)).context("cannot install the Ctrl-C handler")?;
+    let mut printer = StatusPrinter::new(std::io::stderr(), &port);
+    let options = MonitorOptions { max_frames: args.frames, ..MonitorOptions::default() };
+    let mut opener = SerialOpener { port, baud: args.baud };
+    let status = monitor::run(&mut opener, &mut log, &options, &stop, &mut |e| printer.show(&e))?;
+    printer.finish(&status);
+    Ok(())
 }

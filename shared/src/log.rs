@@ -1,11 +1,14 @@
 //! The robot's log frame: one per control period, sent on the serial line
 //! and decoded on the host with this same code.
 //!
-//! Wire format, format version 1:
+//! Wire format, format version 2:
 //!
 //! ```text
 //! COBS( version (1 byte) | postcard(LogFrame) | CRC-16 (LE) ) | 0x00
 //! ```
+//!
+//! Version 2 added [`LogFrame::calibration`], so that a host can recompute
+//! the calibrated values from the raw times (`host replay`).
 //!
 //! - The first byte of every format's payload is its version, so a host
 //!   refuses frames of another format with [`LogError::UnsupportedVersion`]
@@ -18,6 +21,7 @@
 //! A frame is at most [`LogFrame::MAX_ENCODED_LEN`] bytes with its delimiter.
 
 use crate::action::ActionId;
+use crate::calibration::FieldCalibration;
 use crate::camera::BlobSummary;
 use crate::drive::MotorCommand;
 use crate::field::FieldValue;
@@ -29,8 +33,9 @@ use serde::{Deserialize, Serialize};
 const CRC16: Crc<u16, NoTable> = Crc::<u16, NoTable>::new(&CRC_16_IBM_3740);
 
 /// Largest body postcard can produce for a [`LogFrame`] (every varint at
-/// its longest).
-const MAX_BODY_LEN: usize = 5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2;
+/// its longest): tick, mode, faults, raw times, values, blobs, blocks,
+/// state, action, motors, and the calibration (tag + six times).
+const MAX_BODY_LEN: usize = 5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3;
 /// Version byte + body + CRC.
 const MAX_RAW_LEN: usize = 1 + MAX_BODY_LEN + 2;
 
@@ -63,10 +68,25 @@ impl Faults {
 
     /// No fault.
     pub const NONE: Faults = Faults(0);
+    /// The faults that stop the motors while driving (they clear by
+    /// themselves when readings return); the others are about calibration.
+    pub const STOPS_MOTORS: Faults = Faults(Faults::CAMERA_SILENT.0 | Faults::SENSORS_TIMEOUT.0);
+    /// Every flag with its name, lowest bit first (for reports).
+    pub const NAMED: [(Faults, &'static str); 4] = [
+        (Faults::NO_CALIBRATION, "no calibration"),
+        (Faults::CALIBRATION_FAILED, "calibration failed"),
+        (Faults::CAMERA_SILENT, "camera silent"),
+        (Faults::SENSORS_TIMEOUT, "sensors timed out"),
+    ];
 
     /// Whether every flag of `other` is set.
     pub const fn contains(self, other: Faults) -> bool {
         self.0 & other.0 == other.0
+    }
+
+    /// Whether any flag of `other` is set.
+    pub const fn intersects(self, other: Faults) -> bool {
+        self.0 & other.0 != 0
     }
 
     /// Whether no flag is set.
@@ -118,6 +138,12 @@ pub struct LogFrame {
     pub action: ActionId,
     /// The motor commands applied (0 when stopped).
     pub motors: MotorCommand,
+    /// The calibration `values` were computed with (the whole timing range
+    /// while uncalibrated), sent in the first frame after start-up, in the
+    /// first frame after a new calibration takes effect, and at least every
+    /// [`LogFrame::CALIBRATION_EVERY`] frames; it holds until the next
+    /// one. `None` in the other frames.
+    pub calibration: Option<FieldCalibration>,
 }
 
 /// Why a frame was refused.
@@ -164,11 +190,20 @@ pub type EncodedFrame = [u8; LogFrame::MAX_ENCODED_LEN];
 
 impl LogFrame {
     /// The format version this build writes and reads.
-    pub const VERSION: u8 = 1;
+    pub const VERSION: u8 = 2;
+    /// The robot repeats its calibration at least every this many frames
+    /// (one second), so a host that starts listening mid-run learns it.
+    pub const CALIBRATION_EVERY: u8 = 50;
     /// The byte that ends every frame.
     pub const DELIMITER: u8 = 0;
     /// Longest encoded frame, delimiter included.
     pub const MAX_ENCODED_LEN: usize = cobs::max_encoding_length(MAX_RAW_LEN) + 1;
+
+    /// Whether the policy's action drove the motors this period: driving
+    /// with no fault that stops the motors (the firmware's supervisor rule).
+    pub const fn policy_drove(&self) -> bool {
+        matches!(self.mode, RunMode::Driving) && !self.faults.intersects(Faults::STOPS_MOTORS)
+    }
 
     /// Encodes the frame into `out`; returns its length, the trailing
     /// delimiter included.
@@ -219,6 +254,7 @@ impl LogFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::calibration::SensorRange;
     use proptest::prelude::*;
 
     fn sample() -> LogFrame {
@@ -233,6 +269,7 @@ mod tests {
             state: State(101),
             action: ActionId(3),
             motors: MotorCommand { left: 341, right: -41 },
+            calibration: None,
         }
     }
 
@@ -264,27 +301,42 @@ mod tests {
             faults: Faults(u8::MAX),
             mode: RunMode::Calibrating,
             blobs: BlobSummary { puck_left: true, puck_right: true, obstacle_left: true, obstacle_right: true },
+            calibration: Some(FieldCalibration { ranges: [SensorRange { bright: u16::MAX, dark: u16::MAX }; 3] }),
         };
         let (buf, n) = encoded(&big);
         assert!(n <= LogFrame::MAX_ENCODED_LEN);
-        assert_eq!(LogFrame::MAX_ENCODED_LEN, 45, "docs/firmware.md states this bound");
+        assert_eq!(LogFrame::MAX_ENCODED_LEN, 64, "docs/firmware.md states this bound");
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(big));
     }
 
     #[test]
     fn another_version_is_refused_by_its_first_byte() {
         let mut raw = [0u8; 8];
-        raw[0] = 2;
+        raw[0] = 1;
         let crc = CRC16.checksum(&raw[..6]);
         raw[6..].copy_from_slice(&crc.to_le_bytes());
         let mut enc = [0u8; 16];
         let n = cobs::try_encode(&raw, &mut enc).unwrap();
-        assert_eq!(LogFrame::decode(&enc[..n]), Err(LogError::UnsupportedVersion(2)));
+        assert_eq!(LogFrame::decode(&enc[..n]), Err(LogError::UnsupportedVersion(1)));
     }
 
     #[test]
     fn every_single_bit_flip_is_rejected() {
-        let (buf, n) = encoded(&sample());
+        let with_calibration = LogFrame { calibration: Some(calibration()), ..sample() };
+        for frame in [sample(), with_calibration] {
+            every_bit_flip_of(&frame);
+        }
+        assert!(LogFrame::decode(&[]).is_err());
+    }
+
+    fn calibration() -> FieldCalibration {
+        FieldCalibration {
+            ranges: [SensorRange { bright: 40, dark: 420 }, SensorRange { bright: 35, dark: 500 }, SensorRange { bright: 50, dark: 380 }],
+        }
+    }
+
+    fn every_bit_flip_of(frame: &LogFrame) {
+        let (buf, n) = encoded(frame);
         for i in 0..n - 1 {
             for bit in 0..8 {
                 let mut bad = buf;
@@ -292,7 +344,22 @@ mod tests {
                 assert!(LogFrame::decode(&bad[..n]).is_err(), "byte {i} bit {bit}");
             }
         }
-        assert!(LogFrame::decode(&[]).is_err());
+    }
+
+    #[test]
+    fn the_calibration_round_trips_and_motor_stopping_faults_are_the_runtime_ones() {
+        let f = LogFrame { calibration: Some(calibration()), ..sample() };
+        let (buf, n) = encoded(&f);
+        assert_eq!(LogFrame::decode(&buf[..n]), Ok(f));
+        assert!(Faults::STOPS_MOTORS.contains(Faults::CAMERA_SILENT));
+        assert!(Faults::STOPS_MOTORS.contains(Faults::SENSORS_TIMEOUT));
+        assert!(!Faults::STOPS_MOTORS.contains(Faults::NO_CALIBRATION));
+        let driving = LogFrame { mode: RunMode::Driving, faults: Faults::CALIBRATION_FAILED, ..sample() };
+        assert!(driving.policy_drove());
+        assert!(!LogFrame { faults: Faults::SENSORS_TIMEOUT, ..driving }.policy_drove());
+        assert!(!LogFrame { mode: RunMode::Idle, ..driving }.policy_drove());
+        let all = Faults::NAMED.iter().fold(Faults::NONE, |acc, (f, _)| acc.with(*f));
+        assert_eq!(all, Faults(15));
     }
 
     proptest! {
@@ -302,8 +369,11 @@ mod tests {
         }
 
         #[test]
-        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400) {
-            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, ..sample() };
+        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>()) {
+            let calibration = cal.map(|t| FieldCalibration {
+                ranges: [SensorRange { bright: t[0], dark: t[1] }, SensorRange { bright: t[2], dark: t[3] }, SensorRange { bright: t[4], dark: t[5] }],
+            });
+            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, calibration, ..sample() };
             let (buf, n) = encoded(&f);
             prop_assert_eq!(LogFrame::decode(&buf[..n]), Ok(f));
         }

@@ -349,6 +349,12 @@ impl Zumo {
         self.word(0x0800)
     }
 
+    /// Every byte the firmware has sent on USART1 since boot: the raw
+    /// serial stream a host would receive (for the monitor and replay tests).
+    pub fn uart_bytes(&self) -> &[u8] {
+        &self.state.uart
+    }
+
     /// Log frames received since the last call, decoded with `shared`.
     pub fn frames(&mut self) -> Vec<Result<LogFrame, LogError>> {
         let uart = &self.state.uart;

@@ -1,0 +1,386 @@
+//! The recorded-log file `host monitor` writes and `host replay` reads
+//! (format described in `docs/robot-logs.md`):
+//!
+//! ```text
+//! header:  "ZUMOLOG" 0x00 | format version (1 byte, 1)
+//! record:  COBS( host time (u64 LE, microseconds since the Unix epoch)
+//!              | frame bytes as received (the robot's COBS frame, without its 0x00)
+//!              | CRC-16/IBM-3740 (LE) of the time and frame bytes ) | 0x00
+//! ```
+//!
+//! Records are appended one `write` each, so a crash loses at most the
+//! record being written; a record cut short or damaged is found by its CRC
+//! and skipped, and the next `0x00` resynchronises. The frame bytes are kept
+//! as received, undecoded, so a replay sees exactly what came off the wire.
+//!
+//! A file without the header is read as a raw capture of the serial line
+//! (`cat /dev/ttyUSB0 > x.bin`): the robot's frames split at `0x00`, with no
+//! host times.
+
+use super::frame_splitter::{Chunk, FrameSplitter};
+use anyhow::{bail, Context, Result};
+use crc::{Crc, CRC_16_IBM_3740};
+use std::fmt;
+use std::fs::{File, OpenOptions};
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
+
+/// The first bytes of a recorded log. The `0x00` makes it impossible for a
+/// raw capture to start with them (no robot frame is 7 bytes long).
+pub const MAGIC: [u8; 8] = *b"ZUMOLOG\0";
+/// The format version this build writes and reads.
+pub const VERSION: u8 = 1;
+/// Header length: magic and version.
+pub const HEADER_LEN: usize = MAGIC.len() + 1;
+/// Bytes of a record payload around the frame: host time and CRC.
+const RECORD_OVERHEAD: usize = 8 + 2;
+/// Records are forced to the disk at most this often (a process crash
+/// loses nothing already written; a power cut at most this much).
+const SYNC_EVERY: Duration = Duration::from_secs(1);
+
+const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
+
+/// Microseconds since the Unix epoch, the records' host time.
+pub fn host_time_us() -> u64 {
+    SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| u64::try_from(d.as_micros()).unwrap_or(u64::MAX))
+}
+
+/// Encodes one record, its `0x00` terminator included.
+pub fn encode_record(host_time_us: u64, frame: &[u8]) -> Vec<u8> {
+    let mut payload = Vec::with_capacity(frame.len() + RECORD_OVERHEAD);
+    payload.extend_from_slice(&host_time_us.to_le_bytes());
+    payload.extend_from_slice(frame);
+    let crc = CRC16.checksum(&payload);
+    payload.extend_from_slice(&crc.to_le_bytes());
+    let mut out = vec![0u8; cobs::max_encoding_length(payload.len()) + 1];
+    let n = cobs::encode(&payload, &mut out);
+    out.truncate(n + 1);
+    out[n] = 0;
+    out
+}
+
+/// Appends records to a recorded-log file.
+pub struct LogWriter {
+    file: File,
+    path: PathBuf,
+    last_sync: Instant,
+}
+
+impl LogWriter {
+    /// Creates `path` with a header, or with `append` adds to an existing
+    /// recorded log (checking its header; created if missing). Refuses to
+    /// overwrite an existing file without `append`.
+    pub fn create(path: &Path, append: bool) -> Result<LogWriter> {
+        let existing = std::fs::metadata(path).ok().map(|m| m.len());
+        if existing.is_some() && !append {
+            bail!("log file {} already exists: choose another --out, or pass --append to add to it", path.display());
+        }
+        let has_content = existing.is_some_and(|len| len > 0);
+        if has_content {
+            let mut header = [0u8; HEADER_LEN];
+            let mut f = File::open(path).with_context(|| format!("cannot open log file {}", path.display()))?;
+            let n = read_up_to(&mut f, &mut header).with_context(|| format!("cannot read log file {}", path.display()))?;
+            check_header(&header[..n]).with_context(|| format!("cannot append to {}", path.display()))?;
+        }
+        let file = OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+            .with_context(|| format!("cannot open log file {} for writing", path.display()))?;
+        let mut w = LogWriter { file, path: path.to_path_buf(), last_sync: Instant::now() };
+        if has_content {
+            // Ends a record a crash may have cut short, so that it does not
+            // swallow the first new one (an empty record is skipped).
+            w.write(&[0])?;
+        } else {
+            let mut header = MAGIC.to_vec();
+            header.push(VERSION);
+            w.write(&header)?;
+        }
+        w.file.sync_all().with_context(|| format!("cannot flush log file {}", path.display()))?;
+        Ok(w)
+    }
+
+    /// Appends one frame as received, stamped with `host_time_us`: one
+    /// `write` of the whole record, then at most once a second an `fsync`.
+    pub fn append(&mut self, host_time_us: u64, frame: &[u8]) -> Result<()> {
+        self.write(&encode_record(host_time_us, frame))?;
+        if self.last_sync.elapsed() >= SYNC_EVERY {
+            self.sync()?;
+        }
+        Ok(())
+    }
+
+    /// Forces everything written so far to the disk.
+    pub fn sync(&mut self) -> Result<()> {
+        self.last_sync = Instant::now();
+        self.file.sync_data().with_context(|| format!("cannot flush log file {}", self.path.display()))
+    }
+
+    fn write(&mut self, bytes: &[u8]) -> Result<()> {
+        self.file.write_all(bytes).with_context(|| format!("cannot write log file {}", self.path.display()))
+    }
+}
+
+fn read_up_to(f: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match f.read(&mut buf[n..])? {
+            0 => break,
+            k => n += k,
+        }
+    }
+    Ok(n)
+}
+
+/// What kind of file was read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SourceKind {
+    /// A recorded log of this format version.
+    Recorded,
+    /// A raw capture of the serial line.
+    RawCapture,
+}
+
+impl fmt::Display for SourceKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            SourceKind::Recorded => write!(f, "recorded log (format version {VERSION})"),
+            SourceKind::RawCapture => f.write_str("raw serial capture"),
+        }
+    }
+}
+
+/// Why a record of a recorded log was skipped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RecordError {
+    /// The file ends inside the record (no terminator) and what is there
+    /// does not check out: the recording stopped mid-write.
+    Truncated,
+    /// Not valid COBS.
+    BadCobs,
+    /// Too short for a host time, a frame byte and a CRC.
+    TooShort(usize),
+    /// The record's CRC does not match: damaged on disk.
+    CrcMismatch {
+        /// CRC in the record.
+        stored: u16,
+        /// CRC of its content.
+        computed: u16,
+    },
+}
+
+impl fmt::Display for RecordError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            RecordError::Truncated => f.write_str("record truncated: the file ends before its terminator"),
+            RecordError::BadCobs => f.write_str("record is not valid COBS"),
+            RecordError::TooShort(n) => write!(f, "record of {n} bytes is too short"),
+            RecordError::CrcMismatch { stored, computed } => {
+                write!(f, "record is corrupt: CRC-16 is {computed:#06x}, record says {stored:#06x}")
+            }
+        }
+    }
+}
+
+/// One record (or, in a raw capture, one chunk between delimiters).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Entry {
+    /// Byte offset of the record or chunk in the file.
+    pub offset: u64,
+    /// Its length in the file, without the terminator.
+    pub len: usize,
+    /// Host time in microseconds since the Unix epoch (recorded logs only).
+    pub host_time_us: Option<u64>,
+    /// The robot frame's bytes as received, or why the record was skipped.
+    pub frame: Result<Vec<u8>, RecordError>,
+}
+
+/// A whole file, split into entries.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Recording {
+    /// Recorded log or raw capture.
+    pub kind: SourceKind,
+    /// Every record or chunk, in file order.
+    pub entries: Vec<Entry>,
+}
+
+fn check_header(bytes: &[u8]) -> Result<()> {
+    if !MAGIC.starts_with(&bytes[..bytes.len().min(MAGIC.len())]) {
+        bail!("not a recorded log (it does not start with \"ZUMOLOG\\0\")");
+    }
+    if bytes.len() < HEADER_LEN {
+        bail!("the recorded-log header is truncated ({} of {HEADER_LEN} bytes)", bytes.len());
+    }
+    let version = bytes[MAGIC.len()];
+    if version != VERSION {
+        bail!("recorded-log format version {version} is not supported (this build reads version {VERSION})");
+    }
+    Ok(())
+}
+
+/// Splits a file's bytes into entries. Fails only on a header that cannot
+/// be read (truncated, another format version); damaged records become
+/// entries with an error.
+pub fn parse(bytes: &[u8]) -> Result<Recording> {
+    let starts_like_header = !bytes.is_empty() && MAGIC.starts_with(&bytes[..bytes.len().min(MAGIC.len())]);
+    if !starts_like_header {
+        let mut splitter = FrameSplitter::new();
+        let mut chunks = splitter.push(bytes);
+        chunks.extend(splitter.finish());
+        let entries = chunks
+            .into_iter()
+            .map(|c| Entry { offset: c.offset, len: c.bytes.len(), host_time_us: None, frame: Ok(c.bytes) })
+            .collect();
+        return Ok(Recording { kind: SourceKind::RawCapture, entries });
+    }
+    check_header(bytes)?;
+    let mut splitter = FrameSplitter::at_offset(HEADER_LEN as u64);
+    let mut chunks = splitter.push(&bytes[HEADER_LEN..]);
+    chunks.extend(splitter.finish());
+    Ok(Recording { kind: SourceKind::Recorded, entries: chunks.iter().map(decode_record).collect() })
+}
+
+fn decode_record(chunk: &Chunk) -> Entry {
+    let mut payload = vec![0u8; chunk.bytes.len()];
+    let checked = match cobs::decode(&chunk.bytes, &mut payload) {
+        Err(_) => Err(RecordError::BadCobs),
+        Ok(n) if n <= RECORD_OVERHEAD => Err(RecordError::TooShort(n)),
+        Ok(n) => {
+            let stored = u16::from_le_bytes([payload[n - 2], payload[n - 1]]);
+            let computed = CRC16.checksum(&payload[..n - 2]);
+            if stored == computed {
+                Ok(n)
+            } else {
+                Err(RecordError::CrcMismatch { stored, computed })
+            }
+        }
+    };
+    let entry = |host_time_us, frame| Entry { offset: chunk.offset, len: chunk.bytes.len(), host_time_us, frame };
+    match checked {
+        Ok(n) => {
+            let mut time = [0u8; 8];
+            time.copy_from_slice(&payload[..8]);
+            entry(Some(u64::from_le_bytes(time)), Ok(payload[8..n - 2].to_vec()))
+        }
+        Err(_) if !chunk.terminated => entry(None, Err(RecordError::Truncated)),
+        Err(e) => entry(None, Err(e)),
+    }
+}
+
+/// Reads and splits a recorded log or raw capture; errors name the file.
+pub fn read(path: &Path) -> Result<Recording> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read log file {}", path.display()))?;
+    parse(&bytes).with_context(|| format!("log file {}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn file_of(records: &[(u64, &[u8])]) -> Vec<u8> {
+        let mut bytes = MAGIC.to_vec();
+        bytes.push(VERSION);
+        for (t, f) in records {
+            bytes.extend(encode_record(*t, f));
+        }
+        bytes
+    }
+
+    const FRAMES: [(u64, &[u8]); 3] = [(1_000_000, &[3, 1, 2, 9]), (0x0100_0000_0000_0000, &[1]), (7, &[5; 300])];
+
+    #[test]
+    fn records_round_trip_with_offsets() {
+        let bytes = file_of(&FRAMES);
+        let rec = parse(&bytes).unwrap();
+        assert_eq!(rec.kind, SourceKind::Recorded);
+        assert_eq!(rec.entries.len(), 3);
+        for (e, (t, f)) in rec.entries.iter().zip(FRAMES) {
+            assert_eq!((e.host_time_us, e.frame.as_deref()), (Some(t), Ok(f)));
+        }
+        assert_eq!(rec.entries[0].offset, HEADER_LEN as u64);
+        assert_eq!(rec.entries[1].offset, (HEADER_LEN + encode_record(FRAMES[0].0, FRAMES[0].1).len()) as u64);
+    }
+
+    #[test]
+    fn every_truncation_is_an_error_or_loses_only_the_last_record() {
+        let bytes = file_of(&FRAMES);
+        for len in 0..bytes.len() {
+            match parse(&bytes[..len]) {
+                Err(e) => assert!(len > 0 && len < HEADER_LEN && e.to_string().contains("truncated"), "{len}: {e}"),
+                Ok(rec) if len == 0 => assert!(rec.entries.is_empty()),
+                Ok(rec) => {
+                    let good: Vec<_> = rec.entries.iter().filter(|e| e.frame.is_ok()).collect();
+                    let bad: Vec<_> = rec.entries.iter().filter(|e| e.frame.is_err()).collect();
+                    assert!(bad.len() <= 1, "{len}");
+                    for b in bad {
+                        assert_eq!(b.frame, Err(RecordError::Truncated), "{len}");
+                    }
+                    for (e, (t, f)) in good.iter().zip(FRAMES) {
+                        assert_eq!((e.host_time_us, e.frame.as_deref()), (Some(t), Ok(f)), "{len}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn every_bit_flip_after_the_header_damages_at_most_two_records_and_never_passes_unnoticed() {
+        let bytes = file_of(&FRAMES);
+        let clean = parse(&bytes).unwrap();
+        for i in HEADER_LEN..bytes.len() {
+            for bit in 0..8 {
+                let mut bad = bytes.clone();
+                bad[i] ^= 1 << bit;
+                let rec = parse(&bad).unwrap();
+                let good: Vec<&Entry> = rec.entries.iter().filter(|e| e.frame.is_ok()).collect();
+                // A flip can join two records (terminator lost) or split one
+                // (a zero appears): never more than two lost, never a wrong one kept.
+                assert!(good.len() + 2 >= clean.entries.len(), "byte {i} bit {bit}");
+                for e in good {
+                    assert!(clean.entries.iter().any(|c| c.frame == e.frame && c.host_time_us == e.host_time_us));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn another_version_and_raw_captures() {
+        let mut bytes = file_of(&FRAMES);
+        bytes[MAGIC.len()] = 2;
+        let e = parse(&bytes).unwrap_err().to_string();
+        assert!(e.contains("version 2 is not supported"), "{e}");
+        let raw = parse(&[0, 4, 5, 0, 6]).unwrap();
+        assert_eq!(raw.kind, SourceKind::RawCapture);
+        assert_eq!(raw.entries.iter().map(|e| (e.offset, e.frame.clone().unwrap())).collect::<Vec<_>>(), vec![(1, vec![4, 5]), (4, vec![6])]);
+    }
+
+    #[test]
+    fn the_writer_appends_and_refuses_to_overwrite() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.log");
+        let mut w = LogWriter::create(&path, false).unwrap();
+        w.append(FRAMES[0].0, FRAMES[0].1).unwrap();
+        drop(w);
+        let e = LogWriter::create(&path, false).err().unwrap().to_string();
+        assert!(e.contains("already exists") && e.contains("run.log"), "{e}");
+        // A crash cut the last record short: appending loses only that one.
+        let mut cut = std::fs::read(&path).unwrap();
+        cut.extend(&encode_record(9, &[1, 2, 3])[..5]);
+        std::fs::write(&path, &cut).unwrap();
+        let mut w = LogWriter::create(&path, true).unwrap();
+        w.append(FRAMES[1].0, FRAMES[1].1).unwrap();
+        w.sync().unwrap();
+        let rec = read(&path).unwrap();
+        assert_eq!(rec.entries.len(), 3);
+        assert!(rec.entries[1].frame.is_err());
+        for (e, (t, f)) in [&rec.entries[0], &rec.entries[2]].into_iter().zip(FRAMES) {
+            assert_eq!((e.host_time_us, e.frame.as_deref()), (Some(t), Ok(f)));
+        }
+        let other = dir.path().join("other.bin");
+        std::fs::write(&other, b"hello").unwrap();
+        let e = format!("{:#}", LogWriter::create(&other, true).err().unwrap());
+        assert!(e.contains("other.bin") && e.contains("not a recorded log"), "{e}");
+    }
+}

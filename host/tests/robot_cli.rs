@@ -1,0 +1,140 @@
+//! The robot commands of the `host` CLI: replay (text and JSON, damaged
+//! input), flash --dry-run, and their errors naming the bad input.
+
+use assert_cmd::Command;
+use host::robot::log_file::{encode_record, MAGIC, VERSION};
+use shared::{FieldCalibration, LogFrame, PolicyBlob, RunMode, SensorRange};
+use std::path::{Path, PathBuf};
+
+const CAL: FieldCalibration = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+
+fn host() -> Command {
+    Command::cargo_bin("host").unwrap()
+}
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap()
+}
+
+fn policy_path() -> PathBuf {
+    repo().join("policies/oc-heuristic.policy")
+}
+
+/// Idle frames as the firmware logs them (no motors), the first with the
+/// calibration; one record damaged on disk.
+fn write_log(path: &Path) -> u64 {
+    let blob = PolicyBlob::decode(&std::fs::read(policy_path()).unwrap()).unwrap();
+    let mut bytes = MAGIC.to_vec();
+    bytes.push(VERSION);
+    let mut damaged_at = 0;
+    for tick in 1..=5u32 {
+        let raw = [100 + tick as u16 * 50, 240, 300];
+        let values = CAL.scales().values(&raw);
+        let reading = shared::SensorReading { left: values[0], mid: values[1], right: values[2], ..Default::default() };
+        let state = blob.hasher().hash(&reading);
+        let frame = LogFrame {
+            tick,
+            mode: RunMode::Idle,
+            raw_times: raw,
+            values,
+            state,
+            action: blob.table().action(state),
+            calibration: (tick == 1).then_some(CAL),
+            ..LogFrame::default()
+        };
+        let mut buf = [0u8; LogFrame::MAX_ENCODED_LEN];
+        let n = frame.encode(&mut buf);
+        let mut record = encode_record(u64::from(tick) * 20_000, &buf[..n - 1]);
+        if tick == 3 {
+            damaged_at = bytes.len() as u64;
+            record[10] = record[10].wrapping_add(1).max(1); // damaged, never a new delimiter
+        }
+        bytes.extend(record);
+    }
+    std::fs::write(path, bytes).unwrap();
+    damaged_at
+}
+
+#[test]
+fn replay_reports_in_text_and_json_and_names_damaged_records() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.log");
+    let damaged_at = write_log(&log);
+    let out = host().args(["replay", "--log"]).arg(&log).arg("--policy").arg(policy_path()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("5 entries, 4 frames decoded"), "{text}");
+    assert!(text.contains(&format!("at byte {damaged_at}")) && text.contains("divergences: 0 frames"), "{text}");
+
+    let out = host().args(["replay", "--json", "--log"]).arg(&log).arg("--policy").arg(policy_path()).output().unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((v["frames"].as_u64(), v["damaged"].as_u64(), v["diverged"].as_u64()), (Some(4), Some(1), Some(0)));
+    assert_eq!(v["first_damaged"][0]["offset"].as_u64(), Some(damaged_at));
+    assert_eq!(v["modes"][0].as_u64(), Some(4));
+    assert_eq!(v["calibration_checked"].as_u64(), Some(4));
+}
+
+#[test]
+fn replay_and_monitor_errors_name_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.log");
+    write_log(&log);
+    let fails = |cmd: &mut Command| {
+        let out = cmd.output().unwrap();
+        assert!(!out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let e = fails(host().args(["replay", "--log", "/no/such.log", "--policy"]).arg(policy_path()));
+    assert!(e.contains("/no/such.log"), "{e}");
+    let e = fails(host().args(["replay", "--log"]).arg(&log).args(["--policy", "/no/such.policy"]));
+    assert!(e.contains("/no/such.policy"), "{e}");
+    let visits = dir.path().join("visits.json");
+    std::fs::write(&visits, format!(r#"{{"hasher": "bits7", "visits": {:?}}}"#, vec![1; 128])).unwrap();
+    let e = fails(host().args(["replay", "--log"]).arg(&log).arg("--policy").arg(policy_path()).arg("--visits").arg(&visits));
+    assert!(e.contains("visits.json") && e.contains("bits7"), "{e}");
+    let mut other_version = MAGIC.to_vec();
+    other_version.push(VERSION + 1);
+    let future = dir.path().join("future.log");
+    std::fs::write(&future, other_version).unwrap();
+    let e = fails(host().args(["replay", "--log"]).arg(&future).arg("--policy").arg(policy_path()));
+    assert!(e.contains("future.log") && e.contains("format version 2 is not supported"), "{e}");
+
+    let e = fails(host().args(["monitor", "--port", "/dev/null-port", "--out"]).arg(&log));
+    assert!(e.contains("already exists") && e.contains("run.log"), "{e}");
+    let e = fails(host().args(["monitor", "--out", "x.log"]));
+    assert!(e.contains("--port"), "{e}");
+}
+
+#[test]
+fn flash_dry_run_prints_the_exact_commands_and_validates_first() {
+    let out = host().current_dir(repo().join("host")).args(["flash", "--dry-run", "--port", "/dev/ttyACM0", "--policy"]).arg(policy_path()).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let repo = repo();
+    let expected = format!(
+        "FIRMWARE_POLICY={} FIRMWARE_HASHER=original {}/scripts/build-firmware\n\
+         # then double-press the robot's reset button (its bootloader waits 8 s); once /dev/ttyACM0 exists:\n\
+         avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U flash:w:{}/target/avr-none/firmware/firmware.hex:i\n",
+        policy_path().display(),
+        repo.display(),
+        repo.display()
+    );
+    assert_eq!(String::from_utf8(out.stdout).unwrap(), expected);
+
+    let dir = tempfile::tempdir().unwrap();
+    let fails = |cmd: &mut Command| {
+        let out = cmd.output().unwrap();
+        assert!(!out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let e = fails(host().current_dir(dir.path()).args(["flash", "--dry-run", "--policy"]).arg(policy_path()));
+    assert!(e.contains("must run inside a zumo-swarm checkout"), "{e}");
+    let e = fails(host().current_dir(&repo).args(["flash", "--dry-run", "--hasher", "original-obstacle", "--policy"]).arg(policy_path()));
+    assert!(e.contains("uses hasher original") && e.contains("original-obstacle"), "{e}");
+    let bad = dir.path().join("bad.policy");
+    std::fs::write(&bad, b"not a policy").unwrap();
+    let e = fails(host().current_dir(&repo).args(["flash", "--dry-run", "--policy"]).arg(&bad));
+    assert!(e.contains("bad.policy") && e.contains("not a policy blob"), "{e}");
+    let e = fails(host().current_dir(&repo).args(["flash", "--hasher", "eleven", "--policy"]).arg(policy_path()));
+    assert!(e.contains("\"eleven\""), "{e}");
+}
