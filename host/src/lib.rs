@@ -10,4 +10,5 @@ pub mod policy_file;
 pub mod render;
 pub mod report;
 pub mod scenario;
+pub mod sensor_choice;
 pub mod sim;
