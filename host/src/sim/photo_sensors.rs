@@ -12,9 +12,11 @@
 //!    time is inversely proportional to the light plus a dark current:
 //!    `1/t = 1/t_dark + L(v) (1/t_bright - 1/t_dark)`, which is `t_bright`
 //!    at `v = 1` and `t_dark` at `v = 0` (brighter is faster);
-//! 4. whole Timer3 ticks, `floor(t / 4 us)`, capped at the 2000 us timeout:
-//!    the firmware polls the pins against the free-running timer and keeps
-//!    the elapsed whole ticks;
+//! 4. whole Timer3 ticks, `floor((t + latency) / 4 us)`, capped at the
+//!    2000 us timeout: the firmware polls the pins against the free-running
+//!    timer and keeps the elapsed whole ticks; `latency` is its mean delay
+//!    between a pin going low and the timer read that sees it, net of the
+//!    time between the pins becoming inputs and the start read;
 //! 5. the firmware's own calibration arithmetic ([`shared::FieldScales`])
 //!    with the calibration a sweep over the field would store: each
 //!    sensor's ticks at field 1.0 (bright) and 0.0 (dark).
@@ -70,21 +72,26 @@ pub struct PhotoSensorConfig {
     pub response: [PhotoResponse; 3],
     /// Projector gamma: light = value^gamma of full brightness.
     pub gamma: f64,
+    /// The firmware's mean timing latency, us (see the module docs).
+    pub poll_latency_us: f64,
 }
 
 impl Default for PhotoSensorConfig {
     /// Estimates for a Zumo 32U4's front array (to be measured, see
-    /// `docs/robot-sensors.md`): the sensors 0.8 robot radii ahead of the
-    /// centre, DN1 and DN5 half a radius to each side; discharge 150 to
+    /// `docs/robot-sensors.md`): the sensors 0.7 robot radii (35 mm) ahead
+    /// of the centre, DN1 and DN5 0.75 radii (37 mm) to each side; discharge 150 to
     /// 170 us under full brightness and 1700 to 1820 us in the dark (the
-    /// three sensors differ a little, as real ones do); gamma 2.2.
+    /// three sensors differ a little, as real ones do); gamma 2.2; the
+    /// firmware's latency as measured in simavr, 2.8 us
+    /// (`docs/robot-sensors.md`).
     fn default() -> PhotoSensorConfig {
-        let mount = |right| MountPoint { forward: 0.8, right };
+        let mount = |right| MountPoint { forward: 0.7, right };
         let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
         PhotoSensorConfig {
-            mounts: [mount(-0.5), mount(0.0), mount(0.5)],
+            mounts: [mount(-0.75), mount(0.0), mount(0.75)],
             response: [response(150.0, 1700.0), response(160.0, 1760.0), response(170.0, 1820.0)],
             gamma: 2.2,
+            poll_latency_us: 2.8,
         }
     }
 }
@@ -109,6 +116,8 @@ impl PhotoSensorConfig {
     /// dark times must differ by at least one tick, or no calibration exists.
     pub fn validate(&self) -> Result<(), ConfigError> {
         check("field.gamma", self.gamma, self.gamma > 0.0, "must be positive")?;
+        let latency = self.poll_latency_us;
+        check("field.poll_latency_us", latency, latency >= 0.0, "must not be negative")?;
         for (i, name) in NAMES.iter().enumerate() {
             let m = self.mounts[i];
             check(&format!("field.mounts[{i}].forward ({name})"), m.forward, true, "must be a finite number")?;
@@ -118,7 +127,7 @@ impl PhotoSensorConfig {
             check(
                 &format!("field.response[{i}].dark_us ({name})"),
                 r.dark_us,
-                quantise_us(r.dark_us) > quantise_us(r.bright_us),
+                quantise_us(r.dark_us + latency) > quantise_us(r.bright_us + latency),
                 "must be at least one 4 us tick longer than bright_us",
             )?;
         }
@@ -126,23 +135,21 @@ impl PhotoSensorConfig {
     }
 
     /// The calibration a sweep over a field showing both 1.0 and 0.0 stores:
-    /// per sensor, the ticks of its bright and dark times.
+    /// per sensor, the firmware's readings of its bright and dark times.
     pub fn calibration(&self) -> FieldCalibration {
-        FieldCalibration {
-            ranges: self.response.map(|r| SensorRange { bright: quantise_us(r.bright_us), dark: quantise_us(r.dark_us) }),
-        }
+        let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
+        FieldCalibration { ranges: self.response.map(|r| SensorRange { bright: ticks(r.bright_us), dark: ticks(r.dark_us) }) }
     }
 }
 
-/// What the three field sensors report in one control period.
+/// What the three field sensors measure in one control period.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PhotoReading {
-    /// Discharge times, us (before the timer's quantisation).
+    /// Discharge times, us (the pins' behaviour, before the firmware's
+    /// latency and quantisation).
     pub discharge_us: [f64; 3],
     /// The firmware's raw readings: whole Timer3 ticks, capped at the timeout.
     pub ticks: [u16; 3],
-    /// Calibrated field values, with the firmware's arithmetic.
-    pub values: [FieldValue; 3],
 }
 
 /// The three sensors of a robot of a given radius, ready to read.
@@ -152,6 +159,7 @@ pub struct PhotoSensors {
     points: [Vec2; 3],
     response: [PhotoResponse; 3],
     gamma: f64,
+    latency_us: f64,
     calibration: FieldCalibration,
     scales: FieldScales,
 }
@@ -164,6 +172,7 @@ impl PhotoSensors {
             points: config.mounts.map(|m| Vec2::new(m.forward * robot_radius, m.right * robot_radius)),
             response: config.response,
             gamma: config.gamma,
+            latency_us: config.poll_latency_us,
             calibration,
             scales: calibration.scales(),
         }
@@ -172,6 +181,11 @@ impl PhotoSensors {
     /// The calibration the robot stores (and the firmware applies).
     pub fn calibration(&self) -> FieldCalibration {
         self.calibration
+    }
+
+    /// Calibrated values of raw readings, with the firmware's arithmetic.
+    pub fn values(&self, ticks: &[u16; 3]) -> [FieldValue; 3] {
+        self.scales.values(ticks)
     }
 
     /// The sensor points in the robot's frame (x forward, y right), units.
@@ -185,9 +199,8 @@ impl PhotoSensors {
         for i in 0..3 {
             let v = field.sense(pos + self.points[i].rotated(direction), arena_size);
             r.discharge_us[i] = self.response[i].discharge_us(f64::from(v.to_f32()), self.gamma);
-            r.ticks[i] = quantise_us(r.discharge_us[i]);
+            r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
         }
-        r.values = self.scales.values(&r.ticks);
         r
     }
 }
@@ -230,17 +243,18 @@ mod tests {
     fn full_and_no_light_read_one_and_zero_through_the_calibration() {
         let config = PhotoSensorConfig::default();
         let cal = config.calibration();
-        assert_eq!(cal.ranges[0], SensorRange { bright: 37, dark: 425 });
+        // (150 + 2.8) / 4 and (1700 + 2.8) / 4, floored.
+        assert_eq!(cal.ranges[0], SensorRange { bright: 38, dark: 425 });
         let sensors = PhotoSensors::new(&config, 10.0);
         let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
         // One cell over the whole arena: every point inside reads it.
         let at = Vec2::new(20.0, 20.0);
         let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, 100.0);
-        assert_eq!(r.values, [FieldValue::ONE; 3]);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ONE; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.bright));
         let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, 100.0);
-        assert_eq!(r.values, [FieldValue::ZERO; 3]);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
     }
 
@@ -252,8 +266,8 @@ mod tests {
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
         let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, 100.0);
-        assert_eq!(r.values[2], FieldValue::ONE);
-        assert_eq!(r.values[0], FieldValue::ZERO);
+        let values = sensors.values(&r.ticks);
+        assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
     }
 
     #[test]

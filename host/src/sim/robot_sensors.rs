@@ -46,7 +46,8 @@ impl RobotSensorConfig {
 /// stimulus the robot's pins and bus would carry, and the reading.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RobotObservation {
-    /// Discharge times of the left, mid and right sensors, us.
+    /// Discharge times of the left, mid and right sensors, us (what the
+    /// pins do; the firmware adds its latency when it times them).
     pub discharge_us: [f64; 3],
     /// The firmware's raw times: whole Timer3 ticks.
     pub ticks: [u16; 3],
@@ -87,6 +88,14 @@ impl RobotSensors {
         self.photo.calibration()
     }
 
+    /// The reading the firmware computes from raw times (ticks) and a
+    /// camera frame: the calibration of the times, the classification of
+    /// the blocks it reads (the first [`MAX_BLOCKS_PER_PERIOD`]).
+    pub fn reading(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> SensorReading {
+        let read = &frame[..frame.len().min(MAX_BLOCKS_PER_PERIOD)];
+        SensorReading::from_parts(self.photo.values(ticks), self.camera.classify().classify(read))
+    }
+
     /// Robot `robot`'s observation of the world (reuses `out`'s buffer).
     pub fn observe(&mut self, world: &World, field: &ScalarField, robot: usize, out: &mut RobotObservation) {
         let pos = world.bodies()[robot].pos;
@@ -94,7 +103,7 @@ impl RobotSensors {
         self.camera.frame(world, robot, &mut out.frame);
         out.discharge_us = photo.discharge_us;
         out.ticks = photo.ticks;
-        out.reading = SensorReading::from_parts(photo.values, self.camera.classify().classify(out.blocks_read()));
+        out.reading = self.reading(&photo.ticks, &out.frame);
     }
 }
 
