@@ -51,10 +51,10 @@ impl fmt::Display for SensorChoice {
 
 /// Reads and validates a robot sensor config file; errors name the file.
 pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read robot sensor config {}", path.display()))?;
-    let config: RobotSensorConfig = serde_json::from_str(&text)
-        .with_context(|| format!("robot sensor config {} is not valid", path.display()))?;
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read robot sensor config {}", path.display()))?;
+    let config: RobotSensorConfig =
+        serde_json::from_str(&text).with_context(|| format!("robot sensor config {} is not valid", path.display()))?;
     config.validate().with_context(|| format!("robot sensor config {}", path.display()))?;
     Ok(config)
 }

@@ -40,7 +40,14 @@ pub struct Sample {
 /// Samples `count` robot states from episodes on `field` driven by the
 /// greedy policy in `policy` with the default robot sensor model: after
 /// `warmup` steps, every robot's observation every `every` steps.
-pub fn sample_states(policy: &Path, field: FieldSource, count: usize, warmup: u64, every: u64, seed: u64) -> Result<Vec<Sample>> {
+pub fn sample_states(
+    policy: &Path,
+    field: FieldSource,
+    count: usize,
+    warmup: u64,
+    every: u64,
+    seed: u64,
+) -> Result<Vec<Sample>> {
     let name = field.to_string();
     let scenario = Scenario {
         field,
@@ -50,7 +57,9 @@ pub fn sample_states(policy: &Path, field: FieldSource, count: usize, warmup: u6
         ..Scenario::default()
     };
     let (mut sim, mut controller) = scenario.build()?;
-    let SelectedSensors::Robot(model) = sim.sensors() else { bail!("the scenario did not build the robot sensor model") };
+    let SelectedSensors::Robot(model) = sim.sensors() else {
+        bail!("the scenario did not build the robot sensor model")
+    };
     let mut model: RobotSensors = (**model).clone();
     sim.run(&mut controller, warmup);
     let mut samples = Vec::with_capacity(count);
@@ -248,11 +257,9 @@ mod tests {
     #[test]
     fn mirroring_swaps_sides_and_the_hash_notices() {
         let model = RobotSensors::new(&RobotSensorConfig::default(), 10.0);
-        let policy = crate::standin::standin(
-            &read_policy("oc-heuristic.policy").unwrap().1,
-            StateHasher::OriginalObstacle,
-        )
-        .unwrap();
+        let policy =
+            crate::standin::standin(&read_policy("oc-heuristic.policy").unwrap().1, StateHasher::OriginalObstacle)
+                .unwrap();
         let e = Expectation::new(&model, &policy);
         let puck = PixyBlock { signature: 1, x: 40, y: 150, width: 30, height: 20, angle: 0 };
         let ticks = [100, 200, 300];

@@ -138,7 +138,8 @@ fn random_policy(like: &PolicyBlob, seed: u64) -> PolicyBlob {
 }
 
 fn samples_of(policy: &std::path::Path) -> Vec<Sample> {
-    let fields = [(FieldSource::Annulus, 11), (FieldSource::Letter(Letter::T), 12), (FieldSource::Letter(Letter::L), 13)];
+    let fields =
+        [(FieldSource::Annulus, 11), (FieldSource::Letter(Letter::T), 12), (FieldSource::Letter(Letter::L), 13)];
     let mut samples = Vec::new();
     for (field, seed) in fields {
         let name = field.to_string();
@@ -207,7 +208,10 @@ fn equivalence(v: &Variant) {
     let stimuli: Vec<Stimulus<'_>> = samples
         .iter()
         .zip(&nudged)
-        .map(|(s, t)| Stimulus { cycles: t.map(|t| cycles_of_ticks(t, config.field.poll_latency_us)), frame: &s.observation.frame })
+        .map(|(s, t)| Stimulus {
+            cycles: t.map(|t| cycles_of_ticks(t, config.field.poll_latency_us)),
+            frame: &s.observation.frame,
+        })
         .collect();
     let observed = play(&mut z, &stimuli, &mut holding);
     let mismatches: Vec<String> = observed
@@ -215,7 +219,12 @@ fn equivalence(v: &Variant) {
         .zip(&expected)
         .zip(&samples)
         .filter(|((o, e), _)| !matches(o, e))
-        .map(|((o, e), s)| format!("{} step {} robot {}: expected {e:?}, firmware {:?} duties {:?}", s.field, s.step, s.robot, o.frame, o.duties))
+        .map(|((o, e), s)| {
+            format!(
+                "{} step {} robot {}: expected {e:?}, firmware {:?} duties {:?}",
+                s.field, s.step, s.robot, o.frame, o.duties
+            )
+        })
         .collect();
     let exact = samples.len() - mismatches.len();
     let exact_offsets = offsets_of(nudged.iter().zip(&observed).map(|(t, o)| (t, &o.frame)));
@@ -264,8 +273,11 @@ fn equivalence(v: &Variant) {
             }
         }
     }
-    let e2e_action_agree =
-        samples.iter().zip(&observed_e2e).filter(|(s, o)| expectation.expect(&s.observation.ticks, &s.observation.frame).action == o.frame.action).count();
+    let e2e_action_agree = samples
+        .iter()
+        .zip(&observed_e2e)
+        .filter(|(s, o)| expectation.expect(&s.observation.ticks, &s.observation.frame).action == o.frame.action)
+        .count();
 
     let cycles = z.decision_cycles();
     let worst = *cycles.iter().max().expect("decision markers");
@@ -273,7 +285,11 @@ fn equivalence(v: &Variant) {
     let n = samples.len();
     println!("== {} ({} hasher), {}", v.policy, v.hasher.name(), elf.display());
     println!("samples: {n} (annulus, letter:T, letter:L; {PER_FIELD} each); actions over the sample {histogram:?}");
-    println!("exact check: {exact}/{n} match ({:.1} %), {nudged_count} stimuli nudged ({:.1} %)", percent(exact, n), percent(nudged_count, n));
+    println!(
+        "exact check: {exact}/{n} match ({:.1} %), {nudged_count} stimuli nudged ({:.1} %)",
+        percent(exact, n),
+        percent(nudged_count, n)
+    );
     println!("exact check: firmware raw time minus stimulus ticks (per sensor reading): {exact_offsets:?}");
     println!(
         "negative controls: mirrored expectations mismatch {mirror_mismatches}/{n} ({:.1} %), another policy {other_mismatches}/{n} ({:.1} %)",
@@ -289,12 +305,27 @@ fn equivalence(v: &Variant) {
         unexplained.len()
     );
     println!("end to end: firmware raw time minus model ticks (per sensor reading): {offsets:?}");
-    println!("cycles per decision over {} decisions: min {}, mean {mean:.0}, max {worst}", cycles.len(), cycles.iter().min().unwrap_or(&0));
+    println!(
+        "cycles per decision over {} decisions: min {}, mean {mean:.0}, max {worst}",
+        cycles.len(),
+        cycles.iter().min().unwrap_or(&0)
+    );
     println!("wall time {:.1} s", started.elapsed().as_secs_f64());
 
-    assert!(mismatches.is_empty(), "{} of {n} periods differ, first: {:#?}", mismatches.len(), &mismatches[..mismatches.len().min(5)]);
-    assert!(mirror_mismatches * 10 >= n, "mirrored expectations mismatch only {mirror_mismatches} of {n}: the check is too weak");
-    assert!(other_mismatches * 4 >= n, "another policy mismatches only {other_mismatches} of {n}: the check is too weak");
+    assert!(
+        mismatches.is_empty(),
+        "{} of {n} periods differ, first: {:#?}",
+        mismatches.len(),
+        &mismatches[..mismatches.len().min(5)]
+    );
+    assert!(
+        mirror_mismatches * 10 >= n,
+        "mirrored expectations mismatch only {mirror_mismatches} of {n}: the check is too weak"
+    );
+    assert!(
+        other_mismatches * 4 >= n,
+        "another policy mismatches only {other_mismatches} of {n}: the check is too weak"
+    );
     assert!(unexplained.is_empty(), "unexplained end-to-end disagreements: {unexplained:#?}");
     assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles, budget {BUDGET_CYCLES}");
 }

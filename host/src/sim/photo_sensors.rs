@@ -123,7 +123,12 @@ impl PhotoSensorConfig {
             check(&format!("field.mounts[{i}].forward ({name})"), m.forward, true, "must be a finite number")?;
             check(&format!("field.mounts[{i}].right ({name})"), m.right, true, "must be a finite number")?;
             let r = self.response[i];
-            check(&format!("field.response[{i}].bright_us ({name})"), r.bright_us, r.bright_us > 0.0, "must be positive")?;
+            check(
+                &format!("field.response[{i}].bright_us ({name})"),
+                r.bright_us,
+                r.bright_us > 0.0,
+                "must be positive",
+            )?;
             check(
                 &format!("field.response[{i}].dark_us ({name})"),
                 r.dark_us,
@@ -138,7 +143,9 @@ impl PhotoSensorConfig {
     /// per sensor, the firmware's readings of its bright and dark times.
     pub fn calibration(&self) -> FieldCalibration {
         let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
-        FieldCalibration { ranges: self.response.map(|r| SensorRange { bright: ticks(r.bright_us), dark: ticks(r.dark_us) }) }
+        FieldCalibration {
+            ranges: self.response.map(|r| SensorRange { bright: ticks(r.bright_us), dark: ticks(r.dark_us) }),
+        }
     }
 }
 

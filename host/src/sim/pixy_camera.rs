@@ -300,7 +300,8 @@ impl PixyCamera {
             }
             false
         });
-        in_view.sort_by(|a, b| a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index)));
+        in_view
+            .sort_by(|a, b| a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index)));
 
         self.blobs.clear();
         for (k, body) in in_view.iter().enumerate() {
@@ -337,21 +338,27 @@ impl PixyCamera {
         });
         let per_signature = self.per_signature;
         let mut kept = 0;
-        out.extend(self.blobs.iter().enumerate().filter_map(|(i, b)| {
-            // Blobs are grouped by signature: count within the group.
-            kept = if i > 0 && self.blobs[i - 1].signature == b.signature { kept + 1 } else { 1 };
-            (kept <= per_signature).then_some(b)
-        }).map(|b| {
-            let (width, height) = ((b.rect.right - b.rect.left) as u16, (b.rect.bottom - b.rect.top) as u16);
-            PixyBlock {
-                signature: b.signature,
-                x: b.rect.left as u16 + width / 2,
-                y: b.rect.top as u16 + height / 2,
-                width,
-                height,
-                angle: 0,
-            }
-        }));
+        out.extend(
+            self.blobs
+                .iter()
+                .enumerate()
+                .filter_map(|(i, b)| {
+                    // Blobs are grouped by signature: count within the group.
+                    kept = if i > 0 && self.blobs[i - 1].signature == b.signature { kept + 1 } else { 1 };
+                    (kept <= per_signature).then_some(b)
+                })
+                .map(|b| {
+                    let (width, height) = ((b.rect.right - b.rect.left) as u16, (b.rect.bottom - b.rect.top) as u16);
+                    PixyBlock {
+                        signature: b.signature,
+                        x: b.rect.left as u16 + width / 2,
+                        y: b.rect.top as u16 + height / 2,
+                        width,
+                        height,
+                        angle: 0,
+                    }
+                }),
+        );
     }
 
     /// The clipped pixel box of a cylinder of `radius` and `height` whose
@@ -419,9 +426,8 @@ impl PixyCamera {
         }
         let mut k = 0;
         while k < blobs.len() {
-            let enclosed = (0..blobs.len()).any(|o| {
-                o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k)
-            });
+            let enclosed = (0..blobs.len())
+                .any(|o| o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k));
             if enclosed {
                 blobs.remove(k);
             } else {

@@ -120,9 +120,11 @@ impl SensorModel for RobotSensors {
     /// The three field sensor points (the camera's view is not drawn).
     fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
         let (pos, dir) = (world.bodies()[robot].pos, world.robots()[robot].direction);
-        out.extend(
-            self.photo.points().iter().map(|p| Footprint { centre: pos + p.rotated(dir), radius: 0.0, kind: FootprintKind::Field }),
-        );
+        out.extend(self.photo.points().iter().map(|p| Footprint {
+            centre: pos + p.rotated(dir),
+            radius: 0.0,
+            kind: FootprintKind::Field,
+        }));
     }
 }
 
@@ -136,8 +138,10 @@ mod tests {
     fn the_reading_is_the_firmware_arithmetic_on_the_raw_stimulus() {
         let config = SimConfig::default();
         // Robot 0 facing +x with five pucks ahead: only four blocks are read.
-        let robots = [(Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie), (Vec2::new(260.0, 430.0), 0.0, RobotKind::Outie)];
-        let pucks: Vec<Vec2> = (0..5).map(|k| Vec2::new(240.0 + 25.0 * f64::from(k), 385.0 + 10.0 * f64::from(k % 2))).collect();
+        let robots =
+            [(Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie), (Vec2::new(260.0, 430.0), 0.0, RobotKind::Outie)];
+        let pucks: Vec<Vec2> =
+            (0..5).map(|k| Vec2::new(240.0 + 25.0 * f64::from(k), 385.0 + 10.0 * f64::from(k % 2))).collect();
         let world = World::scene(&config, &robots, &pucks, 1);
         let field = ScalarField::annulus();
         let mut model = RobotSensors::new(&RobotSensorConfig::default(), 10.0);
