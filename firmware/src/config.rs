@@ -5,18 +5,20 @@
 
 use shared::{CameraConfig, FieldCalibration, MotorCommand, SensorRange};
 
-/// Length of one Timer3 tick, in microseconds.
-pub const TICK_US: u16 = 4;
+/// Length of one Timer3 tick, in microseconds (`shared`: the simulator
+/// quantises to the same ticks).
+pub const TICK_US: u16 = shared::calibration::RC_TICK_US;
 /// Control period: 20 ms, one Pixy frame (50 frames/s).
 pub const PERIOD_TICKS: u16 = 20_000 / TICK_US;
 /// RC discharge timeout: 2000 us, as in Pololu's Zumo library. A sensor
 /// still high after it reads this value.
-pub const RC_TIMEOUT_TICKS: u16 = 2_000 / TICK_US;
+pub const RC_TIMEOUT_TICKS: u16 = shared::calibration::RC_TIMEOUT_TICKS;
 /// How long the field sensors are charged before timing, in microseconds.
 pub const RC_CHARGE_US: u16 = 10;
 /// Most Pixy blocks kept per frame (the Pixy sends the largest first; a
-/// block costs about 2 ms on the bus at 100 kHz).
-pub const PIXY_MAX_BLOCKS: usize = 4;
+/// block costs about 2 ms on the bus at 100 kHz); in `shared` because the
+/// simulator's camera model keeps the same blocks.
+pub const PIXY_MAX_BLOCKS: usize = shared::camera::MAX_BLOCKS_PER_PERIOD;
 /// Most 16-bit words read from the Pixy in one control period: a frame
 /// start, [`PIXY_MAX_BLOCKS`] colour-code blocks and the end marker.
 pub const PIXY_MAX_WORDS: u8 = 2 + 8 * PIXY_MAX_BLOCKS as u8 + 1;

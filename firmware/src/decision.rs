@@ -82,16 +82,7 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
     pub fn decide(&self, times: &[u16; 3], blocks: &[PixyBlock]) -> Decision {
         let values = self.scales.values(times);
         let blobs = self.camera.classify(blocks);
-        let reading = SensorReading {
-            left: values[0],
-            mid: values[1],
-            right: values[2],
-            puck_left: blobs.puck_left,
-            puck_right: blobs.puck_right,
-            obstacle_left: blobs.obstacle_left,
-            obstacle_right: blobs.obstacle_right,
-        };
-        let state = self.hasher.hash(&reading);
+        let state = self.hasher.hash(&SensorReading::from_parts(values, blobs));
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
         let byte = self.policy.byte(PolicyTable::byte_index(masked));
         let action = PolicyTable::action_in_byte(byte, masked);

@@ -11,4 +11,5 @@ pub mod render;
 pub mod report;
 pub mod robot;
 pub mod scenario;
+pub mod sensor_choice;
 pub mod sim;

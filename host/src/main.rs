@@ -3,6 +3,7 @@ use clap::{Args, Parser, Subcommand};
 use host::bench::BenchVariant;
 use host::render::RenderOptions;
 use host::scenario::{run_timed, ControllerChoice, Scenario};
+use host::sensor_choice::SensorChoice;
 use host::sim::{BroadPhase, FieldSource};
 use shared::StateHasher;
 use std::io::Write;
@@ -170,6 +171,12 @@ struct ScenarioArgs {
     /// All-pairs contact checks instead of the spatial grid (same results).
     #[arg(long)]
     naive: bool,
+    /// Sensor model: disc (the thesis' sensor discs), robot (the Zumo's
+    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
+    /// or robot:CONFIG.json (the same with settings from a JSON file;
+    /// docs/robot-sensors.md).
+    #[arg(long, default_value = "disc", value_parser = parse_sensors)]
+    sensors: SensorChoice,
 }
 
 impl ScenarioArgs {
@@ -182,11 +189,16 @@ impl ScenarioArgs {
             seed: self.seed,
             broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
             arena_size: None,
+            sensors: self.sensors,
         }
     }
 }
 
 fn parse_controller(s: &str) -> Result<ControllerChoice, String> {
+    s.parse()
+}
+
+fn parse_sensors(s: &str) -> Result<SensorChoice, String> {
     s.parse()
 }
 

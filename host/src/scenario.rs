@@ -3,7 +3,8 @@
 //! thesis' experiments, and a timed run that summarises it.
 
 use crate::controller::{Controller, GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
-use crate::sim::{BroadPhase, FieldSource, SimConfig, Simulation, Thresholds, Totals};
+use crate::sensor_choice::{SelectedSensors, SensorChoice};
+use crate::sim::{BroadPhase, FieldSource, SensorModel, SimConfig, Simulation, Thresholds, Totals};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use shared::ActionTable;
@@ -66,6 +67,8 @@ pub struct Scenario {
     pub broad_phase: BroadPhase,
     /// Arena side; `None` for the default 800.
     pub arena_size: Option<f64>,
+    /// The robots' sensor model.
+    pub sensors: SensorChoice,
 }
 
 impl Default for Scenario {
@@ -80,6 +83,7 @@ impl Default for Scenario {
             seed: 1,
             broad_phase: BroadPhase::Grid,
             arena_size: None,
+            sensors: SensorChoice::Disc,
         }
     }
 }
@@ -110,7 +114,7 @@ impl Scenario {
 
     /// Loads the field and policy, validates the settings and builds the
     /// simulation and controller. Errors name the offending input.
-    pub fn build(&self) -> Result<(Simulation, Box<dyn Controller>)> {
+    pub fn build(&self) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>)> {
         let mut config = self.config();
         let controller: Box<dyn Controller> = match &self.controller {
             ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds)),
@@ -123,7 +127,8 @@ impl Scenario {
         };
         config.validate().context("invalid simulation settings")?;
         let field = Arc::new(self.field.load()?);
-        let sim = Simulation::new(config, field, self.seed).context("invalid simulation settings")?;
+        let sensors = self.sensors.build(&config)?;
+        let sim = Simulation::with_sensors(config, field, sensors, self.seed).context("invalid simulation settings")?;
         Ok((sim, controller))
     }
 }
@@ -170,7 +175,7 @@ impl fmt::Display for RunSummary {
 }
 
 /// Runs `steps` steps and summarises them with the measured speed.
-pub fn run_timed<C: Controller + ?Sized>(sim: &mut Simulation, controller: &mut C, steps: u64) -> RunSummary {
+pub fn run_timed<S: SensorModel, C: Controller + ?Sized>(sim: &mut Simulation<S>, controller: &mut C, steps: u64) -> RunSummary {
     let start = Instant::now();
     sim.run(controller, steps);
     RunSummary::new(sim.totals(), start.elapsed().as_secs_f64())

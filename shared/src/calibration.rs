@@ -23,6 +23,15 @@
 use crate::field::FieldValue;
 use serde::{Deserialize, Serialize};
 
+/// Length of one tick of the robot's RC timer in microseconds (Timer3 at
+/// clk/64, 16 MHz): the resolution of a discharge time. The firmware times
+/// the sensors in these ticks and the simulator's photo-transistor model
+/// quantises to them.
+pub const RC_TICK_US: u16 = 4;
+/// Discharge timeout, 2000 us as in Pololu's Zumo library: a sensor still
+/// high after this many ticks reads exactly this value.
+pub const RC_TIMEOUT_TICKS: u16 = 2_000 / RC_TICK_US;
+
 /// Index of each field sensor in the arrays of this module and of log frames.
 pub const LEFT: usize = 0;
 /// See [`LEFT`].

@@ -19,6 +19,13 @@ pub const IMAGE_WIDTH: u16 = 320;
 /// Height of the Pixy's image in its block coordinates (y is 0..=199).
 pub const IMAGE_HEIGHT: u16 = 200;
 
+/// Most blocks of one camera frame the robot reads per control period: the
+/// Pixy sends the largest blocks of each signature first (signature 1, then
+/// 2, ...), and each block costs over a millisecond on the bus. The
+/// firmware stops reading after this many; the simulator's camera model
+/// keeps the same ones.
+pub const MAX_BLOCKS_PER_PERIOD: usize = 4;
+
 /// One detected object as the Pixy reports it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct PixyBlock {

@@ -1,5 +1,6 @@
 //! One robot's perception in one control step.
 
+use crate::camera::BlobSummary;
 use crate::field::FieldValue;
 use serde::{Deserialize, Serialize};
 
@@ -22,4 +23,21 @@ pub struct SensorReading {
     pub obstacle_left: bool,
     /// The right obstacle sensor sees an obstacle.
     pub obstacle_right: bool,
+}
+
+impl SensorReading {
+    /// The reading of the robot's sensors: calibrated left, mid and right
+    /// field values and the camera's blob summary. The firmware and the
+    /// simulator's robot sensor model both build their readings here.
+    pub const fn from_parts(values: [FieldValue; 3], blobs: BlobSummary) -> SensorReading {
+        SensorReading {
+            left: values[0],
+            mid: values[1],
+            right: values[2],
+            puck_left: blobs.puck_left,
+            puck_right: blobs.puck_right,
+            obstacle_left: blobs.obstacle_left,
+            obstacle_right: blobs.obstacle_right,
+        }
+    }
 }

@@ -15,7 +15,7 @@ use std::cell::{Cell, RefCell};
 use std::collections::VecDeque;
 use std::ffi::c_void;
 use std::os::raw::{c_char, c_int};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::ptr::null_mut;
 use std::rc::Rc;
 use std::sync::Once;
@@ -28,6 +28,8 @@ pub const CYCLES_PER_TICK: u64 = 64;
 const OCR1A: usize = 0x88;
 /// OCR1B (left motor duty) in data memory.
 const OCR1B: usize = 0x8A;
+/// PORTB in data memory: the direction pins PB1 (right) and PB2 (left).
+const PORTB: usize = 0x25;
 /// GPIOR0, the firmware's decision marker, in data memory.
 const GPIOR0: u16 = 0x3E;
 /// The stack pointer (SPL, SPH) in data memory.
@@ -44,10 +46,16 @@ const PIXY_ADDRESS: u8 = 0x54;
 /// The release ELF `scripts/build-firmware` writes; panics with what to run
 /// if it is missing (the tests never skip silently).
 pub fn firmware_elf() -> PathBuf {
-    let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/avr-none/firmware/firmware.elf");
+    firmware_elf_in("firmware", "scripts/build-firmware")
+}
+
+/// The ELF a build wrote to `target/avr-none/<dir>/firmware.elf`; panics
+/// saying to run `build` (the command that writes it) if it is missing.
+pub fn firmware_elf_in(dir: &str, build: &str) -> PathBuf {
+    let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/avr-none").join(dir).join("firmware.elf");
     assert!(
         elf.exists(),
-        "the firmware ELF {} is missing: run `scripts/build-firmware` (needs gcc-avr, avr-libc and the rust-src \
+        "the firmware ELF {} is missing: run `{build}` (needs gcc-avr, avr-libc and the rust-src \
          component; `scripts/setup` installs them), or run everything with `./scripts/test`",
         elf.display()
     );
@@ -69,7 +77,7 @@ unsafe extern "C" fn capture_handle(avr: *mut ffi::avr_t, _: c_int, _: *const c_
 }
 
 /// Loads the ELF and returns simavr's handle of the new core.
-fn load(elf: &PathBuf) -> (AvrTester, *mut ffi::avr_t) {
+fn load(elf: &Path) -> (AvrTester, *mut ffi::avr_t) {
     static INSTALL: Once = Once::new();
     INSTALL.call_once(|| {
         // avr-tester installs its (silent) logger once, at its first load;
@@ -90,11 +98,18 @@ struct RcSensor {
 }
 
 /// The emulated Pixy: a byte queue refilled with the current scene once per
-/// camera frame (20 ms); zeros when it has nothing; NACK when absent.
+/// camera frame (20 ms), and at the first read after the scene changed;
+/// zeros when it has nothing; NACK when absent. A frame starts only with
+/// the first byte of a read transaction (a word), never between a word's
+/// two bytes.
 struct Pixy {
     avr: *mut ffi::avr_t,
     present: bool,
     scene: Vec<PixyBlock>,
+    /// The scene changed since the last frame was queued.
+    changed: bool,
+    /// The next byte is the first of a read transaction.
+    word_start: bool,
     bytes: VecDeque<u8>,
     last_frame: u64,
 }
@@ -102,7 +117,10 @@ struct Pixy {
 impl Pixy {
     fn next_byte(&mut self) -> u8 {
         let now = unsafe { (*self.avr).cycle };
-        if self.bytes.is_empty() && now.saturating_sub(self.last_frame) >= CLOCK_HZ / 50 {
+        let word_start = std::mem::replace(&mut self.word_start, false);
+        let due = self.changed || now.saturating_sub(self.last_frame) >= CLOCK_HZ / 50;
+        if self.bytes.is_empty() && word_start && due {
+            self.changed = false;
             self.last_frame = now;
             let mut words = [0u16; 128];
             let n = encode_frame(&self.scene, &mut words);
@@ -116,6 +134,7 @@ impl Pixy {
             return None;
         }
         if p.is_start() {
+            self.word_start = true;
             return Some(p.respond_ack());
         }
         if p.is_read() {
@@ -130,6 +149,8 @@ struct State {
     avr: *mut ffi::avr_t,
     uart: Vec<u8>,
     marks: Vec<(u8, u64)>,
+    /// Decision-end markers seen.
+    decisions: u64,
     ddr: [u8; 2],
     /// Discharge delay of each sensor in cycles; `None` = never (timeout).
     delays: [Option<u64>; 3],
@@ -149,6 +170,7 @@ unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v
         *(*avr).data.add(usize::from(addr)) = v;
         let state = &mut *(param as *mut State);
         state.marks.push((v, (*avr).cycle));
+        state.decisions += u64::from(v == 2);
     }
 }
 
@@ -210,11 +232,17 @@ impl Zumo {
     /// Loads the release ELF (erased EEPROM, Pixy present seeing nothing,
     /// sensors discharging after 1 ms) and runs its start-up.
     pub fn boot() -> Zumo {
-        let (tester, avr) = load(&firmware_elf());
+        Zumo::boot_elf(&firmware_elf())
+    }
+
+    /// [`Zumo::boot`] with another build of the firmware.
+    pub fn boot_elf(elf: &Path) -> Zumo {
+        let (tester, avr) = load(elf);
         let mut state = Box::new(State {
             avr,
             uart: Vec::new(),
             marks: Vec::new(),
+            decisions: 0,
             ddr: [0; 2],
             delays: [Some(CLOCK_HZ / 1000); 3],
             sensors: SENSOR_PINS.map(|(port, bit)| RcSensor {
@@ -237,7 +265,15 @@ impl Zumo {
             }
             ffi::avr_register_io_write(avr, GPIOR0, Some(on_gpior0), state_ptr as *mut c_void);
         }
-        let pixy = Rc::new(RefCell::new(Pixy { avr, present: true, scene: Vec::new(), bytes: VecDeque::new(), last_frame: 0 }));
+        let pixy = Rc::new(RefCell::new(Pixy {
+            avr,
+            present: true,
+            scene: Vec::new(),
+            changed: false,
+            word_start: false,
+            bytes: VecDeque::new(),
+            last_frame: 0,
+        }));
         let mut zumo = Zumo { tester, state, pixy: pixy.clone(), buttons: [0; 2], decoded: 0 };
         zumo.tester.twi0().attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
         zumo.set_button(b'B', 3, false);
@@ -264,12 +300,23 @@ impl Zumo {
     /// Sets the field sensors' discharge times in Timer3 ticks (`None`: the
     /// sensor never discharges and times out).
     pub fn set_sensor_ticks(&mut self, ticks: [Option<u16>; 3]) {
-        self.state.delays = ticks.map(|t| t.map(|t| u64::from(t) * CYCLES_PER_TICK));
+        self.set_sensor_cycles(ticks.map(|t| t.map(|t| u64::from(t) * CYCLES_PER_TICK)));
     }
 
-    /// What the Pixy sees from now on.
+    /// Sets the field sensors' discharge delays in CPU cycles after each
+    /// pin becomes an input (`None`: never discharges). Takes effect at
+    /// the next measurement.
+    pub fn set_sensor_cycles(&mut self, cycles: [Option<u64>; 3]) {
+        self.state.delays = cycles;
+    }
+
+    /// What the Pixy sees from now on: its next frame (served at the next
+    /// read) shows it.
     pub fn show(&mut self, blocks: &[PixyBlock]) {
-        self.pixy.borrow_mut().scene = blocks.to_vec();
+        let mut p = self.pixy.borrow_mut();
+        p.scene = blocks.to_vec();
+        p.bytes.clear();
+        p.changed = true;
     }
 
     /// Connects or disconnects the Pixy (disconnected: it NACKs its address).
@@ -317,6 +364,20 @@ impl Zumo {
         self.tester.run_for_ms(ms);
     }
 
+    /// Runs until the firmware ends its next decision (right after the
+    /// motor writes, before the period's log frame); returns the number of
+    /// decisions so far, which is the tick of that period's log frame.
+    /// Panics if no decision comes within 100 ms.
+    pub fn run_to_decision(&mut self) -> u64 {
+        let before = self.state.decisions;
+        let deadline = unsafe { (*self.state.avr).cycle } + CLOCK_HZ / 10;
+        while self.state.decisions == before {
+            self.tester.run();
+            assert!(unsafe { (*self.state.avr).cycle } < deadline, "no decision within 100 ms");
+        }
+        self.state.decisions
+    }
+
     fn data(&self, addr: usize) -> u8 {
         unsafe { *(*self.state.avr).data.add(addr) }
     }
@@ -328,6 +389,12 @@ impl Zumo {
     /// Motor duties as the firmware wrote them: (left = OCR1B, right = OCR1A).
     pub fn duties(&self) -> (u16, u16) {
         (self.word(OCR1B), self.word(OCR1A))
+    }
+
+    /// Direction pin levels (left = PB2, right = PB1); high = reverse.
+    pub fn directions(&self) -> (bool, bool) {
+        let b = self.data(PORTB);
+        (b & 0b100 != 0, b & 0b10 != 0)
     }
 
     /// Fills the free SRAM between the statics and the stack pointer with a

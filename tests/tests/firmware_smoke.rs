@@ -109,6 +109,23 @@ fn without_a_calibration_it_reports_and_does_not_drive() {
 }
 
 #[test]
+fn a_corrupt_calibration_is_refused_and_the_robot_does_not_drive() {
+    let mut record = calibration_record::encode(&CALIBRATION);
+    record[3] ^= 0x10;
+    let mut z = Zumo::boot();
+    z.write_eeprom(0, &record);
+    z.set_sensor_ticks(SENSOR_TICKS);
+    z.run_ms(60);
+    z.press_a();
+    z.run_ms(100);
+    for f in decoded(&mut z) {
+        assert!(f.faults.contains(Faults::NO_CALIBRATION), "{f:?}");
+        assert_eq!((f.mode, f.motors), (RunMode::Idle, MotorCommand::default()));
+    }
+    assert_eq!(z.duties(), (0, 0));
+}
+
+#[test]
 fn a_silent_camera_or_blind_sensors_stop_the_motors_until_readings_return() {
     let mut z = calibrated_zumo();
     z.run_ms(40);

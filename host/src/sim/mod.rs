@@ -1,7 +1,8 @@
 //! The simulator, one pipeline stage per module (like rapier's):
 //! [`world`] (bodies, arena, robots) -> [`physics`] (integration, the
 //! [`broadphase`] over a [`grid`], contacts in one canonical order,
-//! impulses) -> [`sensors`] -> controller (`crate::controller`) -> actions;
+//! impulses) -> [`sensors`] (the thesis' discs, or the robot's
+//! [`robot_sensors`]: [`photo_sensors`] and [`pixy_camera`]) -> controller (`crate::controller`) -> actions;
 //! with the scalar [`field`]s, [`eval`]uation and the episode loop in
 //! [`simulation`]. Everything random comes from a seeded [`SimRng`]; the
 //! whole state is serde-serialisable for bit-exact checkpoints.
@@ -14,7 +15,10 @@ pub mod eval;
 pub mod field;
 pub mod grid;
 pub mod letters;
+pub mod photo_sensors;
 pub mod physics;
+pub mod pixy_camera;
+pub mod robot_sensors;
 pub mod sensors;
 pub mod simulation;
 pub mod vec2;
@@ -25,6 +29,7 @@ pub use config::{BroadPhase, ConfigError, EpisodeConfig, PhysicsConfig, SimConfi
 pub use eval::{eval, eval_prime, EvalPrime, EvalTracker};
 pub use field::{FieldError, FieldSource, ScalarField};
 pub use letters::Letter;
+pub use robot_sensors::{RobotObservation, RobotSensorConfig, RobotSensors};
 pub use sensors::{DiscSensorConfig, DiscSensors, Footprint, FootprintKind, ObstacleTargets, SensorDisc, SensorModel};
 pub use simulation::{EpisodeEnd, Simulation, SimulationState, StepOutcome, Totals};
 pub use vec2::Vec2;

@@ -1,0 +1,341 @@
+//! Sim-vs-firmware decision equivalence on the real release firmware in
+//! simavr (`docs/equivalence.md`).
+//!
+//! For each hasher (8-bit and 10-bit), robot states are sampled from
+//! simulated episodes with the robot sensor model on the annulus and two
+//! letters, driven by the policy under test (`policies/robot-annulus-*`).
+//! Each state's stimulus goes on the emulated robot's pins (RC discharge
+//! delays on the three sensor pins) and bus (the camera frame served on
+//! I2C), one control period per state; the firmware's logged state and
+//! action and its OCR1A/OCR1B writes are compared with what the host
+//! computes from the stimulus:
+//! - exact check: times nudged at least two ticks from every quantisation
+//!   edge, 100 % agreement required;
+//! - negative controls: mirrored expectations and another policy disagree;
+//! - end to end: the model's own times, un-nudged; every disagreement must
+//!   be explained by a raw time moved by at most one tick.
+//!
+//! The ELFs come from `scripts/test` (or `scripts/build-firmware` with
+//! `FIRMWARE_OUT`); a missing or stale one fails with the command to run.
+
+use firmware::calibration_record;
+use host::sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
+use rand::{RngExt, SeedableRng};
+use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, RunMode, State, StateHasher};
+use std::collections::HashMap;
+use std::time::Instant;
+use tests::equivalence::{
+    check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, mirrored, nudge, read_policy, sample_states, Expectation,
+    Expected, Sample,
+};
+use tests::zumo::{firmware_elf_in, Zumo};
+
+/// States per field; three fields give over 1,000 per hasher.
+const PER_FIELD: usize = 340;
+const WARMUP_STEPS: u64 = 400;
+const SAMPLE_EVERY: u64 = 37;
+const BUDGET_CYCLES: u64 = 2_000;
+
+struct Variant {
+    policy: &'static str,
+    /// Directory under `target/avr-none` of the ELF built with that policy.
+    elf_dir: &'static str,
+    hasher: StateHasher,
+    build: &'static str,
+}
+
+const EIGHT_BIT: Variant = Variant {
+    policy: "robot-annulus-8bit.policy",
+    elf_dir: "robot-annulus-8bit",
+    hasher: StateHasher::Original,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-8bit.policy FIRMWARE_OUT=target/avr-none/robot-annulus-8bit \
+            scripts/build-firmware",
+};
+
+const TEN_BIT: Variant = Variant {
+    policy: "robot-annulus-10bit.policy",
+    elf_dir: "robot-annulus-10bit",
+    hasher: StateHasher::OriginalObstacle,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-10bit.policy FIRMWARE_HASHER=original-obstacle \
+            FIRMWARE_OUT=target/avr-none/robot-annulus-10bit scripts/build-firmware",
+};
+
+/// One period's stimulus.
+struct Stimulus<'a> {
+    /// RC delays in CPU cycles after each pin becomes an input.
+    cycles: [u64; 3],
+    /// The camera frame.
+    frame: &'a [PixyBlock],
+}
+
+/// What the firmware did in the period of one stimulus.
+struct Observed {
+    frame: LogFrame,
+    duties: (u16, u16),
+    directions: (bool, bool),
+}
+
+/// A calibrated Zumo running `elf`, driving, stopped right after a decision.
+fn driving_zumo(elf: &std::path::Path, model: &RobotSensors) -> Zumo {
+    let mut z = Zumo::boot_elf(elf);
+    z.write_eeprom(0, &calibration_record::encode(&model.calibration()));
+    z.run_ms(40);
+    z.press_a();
+    z.run_to_decision();
+    z
+}
+
+/// Plays one stimulus per control period and returns what the firmware did
+/// in each. A period whose camera frame is empty right after one that was
+/// not gets one more period first: the firmware uses a frame's blocks for
+/// two periods and the Pixy sends nothing when it sees nothing.
+fn play(z: &mut Zumo, stimuli: &[Stimulus<'_>], holding: &mut bool) -> Vec<Observed> {
+    let mut periods = Vec::with_capacity(stimuli.len());
+    for s in stimuli {
+        z.set_sensor_cycles(s.cycles.map(Some));
+        z.show(s.frame);
+        let mut tick = z.run_to_decision();
+        if s.frame.is_empty() && *holding {
+            tick = z.run_to_decision();
+        }
+        *holding = !s.frame.is_empty();
+        periods.push((tick, z.duties(), z.directions()));
+    }
+    z.run_ms(10);
+    let frames: HashMap<u64, LogFrame> = z
+        .frames()
+        .into_iter()
+        .map(|f| f.unwrap_or_else(|e| panic!("undecodable log frame: {e}")))
+        .map(|f| (u64::from(f.tick), f))
+        .collect();
+    periods
+        .into_iter()
+        .map(|(tick, duties, directions)| {
+            let frame = *frames.get(&tick).unwrap_or_else(|| panic!("no log frame for period {tick}"));
+            assert_eq!((frame.mode, frame.faults), (RunMode::Driving, Faults::NONE), "period {tick}: {frame:?}");
+            Observed { frame, duties, directions }
+        })
+        .collect()
+}
+
+/// Whether the firmware did exactly what was expected.
+fn matches(o: &Observed, e: &Expected) -> bool {
+    o.frame.state == e.state
+        && o.frame.action == e.action
+        && o.frame.motors == e.command
+        && o.duties == (e.outputs.left.duty, e.outputs.right.duty)
+        && o.directions == (e.outputs.left.dir_high, e.outputs.right.dir_high)
+}
+
+/// A policy of the same hasher and actions with seeded random entries.
+fn random_policy(like: &PolicyBlob, seed: u64) -> PolicyBlob {
+    let mut rng = SimRng::seed_from_u64(seed);
+    let mut table = PolicyTable::new(like.hasher());
+    for s in 0..like.hasher().num_states() as u16 {
+        table.set(State(s), ActionId(rng.random_range(0..like.actions().len() as u8)));
+    }
+    PolicyBlob::new(*like.actions(), table, like.provenance().clone()).expect("a valid blob")
+}
+
+fn samples_of(policy: &std::path::Path) -> Vec<Sample> {
+    let fields =
+        [(FieldSource::Annulus, 11), (FieldSource::Letter(Letter::T), 12), (FieldSource::Letter(Letter::L), 13)];
+    let mut samples = Vec::new();
+    for (field, seed) in fields {
+        let name = field.to_string();
+        let s = sample_states(policy, field, PER_FIELD, WARMUP_STEPS, SAMPLE_EVERY, seed)
+            .unwrap_or_else(|e| panic!("sampling on {name}: {e:#}"));
+        samples.extend(s);
+    }
+    samples
+}
+
+/// How often the firmware's raw time differs from the stimulus' ticks by
+/// each amount, over every sensor reading.
+fn offsets_of<'a>(pairs: impl Iterator<Item = (&'a [u16; 3], &'a LogFrame)>) -> Vec<(i32, usize)> {
+    let mut counts: HashMap<i32, usize> = HashMap::new();
+    for (ticks, frame) in pairs {
+        for (raw, t) in frame.raw_times.iter().zip(ticks) {
+            *counts.entry(i32::from(*raw) - i32::from(*t)).or_default() += 1;
+        }
+    }
+    let mut counts: Vec<_> = counts.into_iter().collect();
+    counts.sort();
+    counts
+}
+
+fn percent(n: usize, of: usize) -> f64 {
+    100.0 * n as f64 / of as f64
+}
+
+fn equivalence(v: &Variant) {
+    let started = Instant::now();
+    let (path, policy) = read_policy(v.policy).unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(policy.hasher(), v.hasher, "{} has the wrong hasher", path.display());
+    let elf = firmware_elf_in(v.elf_dir, v.build);
+    check_elf_embeds(&elf, &policy, v.build).unwrap_or_else(|e| panic!("{e:#}"));
+
+    let config = RobotSensorConfig::default();
+    let model = RobotSensors::new(&config, 10.0);
+    let expectation = Expectation::new(&model, &policy);
+    let samples = samples_of(&path);
+    assert!(samples.len() >= 1000, "{} samples", samples.len());
+    let state_of = |frame: &[PixyBlock]| {
+        let frame = frame.to_vec();
+        let e = &expectation;
+        move |t: &[u16; 3]| e.state(t, &frame)
+    };
+
+    // Exact check: nudged stimuli, mid-tick delays.
+    let nudged: Vec<[u16; 3]> = samples
+        .iter()
+        .map(|s| {
+            nudge(&s.observation.ticks, &state_of(&s.observation.frame))
+                .unwrap_or_else(|| panic!("no robust stimulus near {:?}", s.observation.ticks))
+        })
+        .collect();
+    let nudged_count = samples.iter().zip(&nudged).filter(|(s, n)| s.observation.ticks != **n).count();
+    let expected: Vec<Expected> =
+        samples.iter().zip(&nudged).map(|(s, t)| expectation.expect(t, &s.observation.frame)).collect();
+    let mut histogram = [0usize; 4];
+    for e in &expected {
+        histogram[e.action.index()] += 1;
+    }
+    assert!(histogram.iter().all(|&n| n > 0), "the sample does not exercise all four actions: {histogram:?}");
+
+    let mut z = driving_zumo(&elf, &model);
+    let mut holding = false;
+    let stimuli: Vec<Stimulus<'_>> = samples
+        .iter()
+        .zip(&nudged)
+        .map(|(s, t)| Stimulus {
+            cycles: t.map(|t| cycles_of_ticks(t, config.field.poll_latency_us)),
+            frame: &s.observation.frame,
+        })
+        .collect();
+    let observed = play(&mut z, &stimuli, &mut holding);
+    let mismatches: Vec<String> = observed
+        .iter()
+        .zip(&expected)
+        .zip(&samples)
+        .filter(|((o, e), _)| !matches(o, e))
+        .map(|((o, e), s)| {
+            format!(
+                "{} step {} robot {}: expected {e:?}, firmware {:?} duties {:?}",
+                s.field, s.step, s.robot, o.frame, o.duties
+            )
+        })
+        .collect();
+    let exact = samples.len() - mismatches.len();
+    let exact_offsets = offsets_of(nudged.iter().zip(&observed).map(|(t, o)| (t, &o.frame)));
+
+    // Negative controls on the same firmware periods.
+    let mirror_mismatches = samples
+        .iter()
+        .zip(&nudged)
+        .zip(&observed)
+        .filter(|((s, t), o)| {
+            let (mt, mf) = mirrored(t, &s.observation.frame);
+            !matches(o, &expectation.expect(&mt, &mf))
+        })
+        .count();
+    let other = random_policy(&policy, 99);
+    let other_expectation = Expectation::new(&model, &other);
+    let other_mismatches = samples
+        .iter()
+        .zip(&nudged)
+        .zip(&observed)
+        .filter(|((s, t), o)| !matches(o, &other_expectation.expect(t, &s.observation.frame)))
+        .count();
+
+    // End to end: the model's own discharge times, not nudged.
+    let stimuli: Vec<Stimulus<'_>> = samples
+        .iter()
+        .map(|s| Stimulus { cycles: s.observation.discharge_us.map(cycles_of_us), frame: &s.observation.frame })
+        .collect();
+    let observed_e2e = play(&mut z, &stimuli, &mut holding);
+    let (mut agree, mut explained, mut unexplained) = (0, Vec::new(), Vec::new());
+    let offsets = offsets_of(samples.iter().zip(&observed_e2e).map(|(s, o)| (&s.observation.ticks, &o.frame)));
+    for (s, o) in samples.iter().zip(&observed_e2e) {
+        let ticks = &s.observation.ticks;
+        // Whatever state the firmware reached, it must act on it as the policy says.
+        let own = expectation.expect(ticks, &s.observation.frame);
+        assert_eq!(o.frame.action, policy.table().action(o.frame.state), "the firmware's action is not its state's");
+        if o.frame.state == own.state {
+            agree += 1;
+        } else {
+            match explain(ticks, o.frame.state, &state_of(&s.observation.frame)) {
+                Some(m) => explained.push(m),
+                None => unexplained.push(format!(
+                    "{} step {} robot {}: model ticks {ticks:?} state {}, firmware raw {:?} state {}",
+                    s.field, s.step, s.robot, own.state, o.frame.raw_times, o.frame.state
+                )),
+            }
+        }
+    }
+    let e2e_action_agree = samples
+        .iter()
+        .zip(&observed_e2e)
+        .filter(|(s, o)| expectation.expect(&s.observation.ticks, &s.observation.frame).action == o.frame.action)
+        .count();
+
+    let cycles = z.decision_cycles();
+    let worst = *cycles.iter().max().expect("decision markers");
+    let mean = cycles.iter().sum::<u64>() as f64 / cycles.len() as f64;
+    let n = samples.len();
+    println!("== {} ({} hasher), {}", v.policy, v.hasher.name(), elf.display());
+    println!("samples: {n} (annulus, letter:T, letter:L; {PER_FIELD} each); actions over the sample {histogram:?}");
+    println!(
+        "exact check: {exact}/{n} match ({:.1} %), {nudged_count} stimuli nudged ({:.1} %)",
+        percent(exact, n),
+        percent(nudged_count, n)
+    );
+    println!("exact check: firmware raw time minus stimulus ticks (per sensor reading): {exact_offsets:?}");
+    println!(
+        "negative controls: mirrored expectations mismatch {mirror_mismatches}/{n} ({:.1} %), another policy {other_mismatches}/{n} ({:.1} %)",
+        percent(mirror_mismatches, n),
+        percent(other_mismatches, n)
+    );
+    println!(
+        "end to end: state agreement {agree}/{n} ({:.1} %), action agreement {e2e_action_agree}/{n} ({:.1} %), \
+         {} disagreements explained by a one-tick move, {} unexplained",
+        percent(agree, n),
+        percent(e2e_action_agree, n),
+        explained.len(),
+        unexplained.len()
+    );
+    println!("end to end: firmware raw time minus model ticks (per sensor reading): {offsets:?}");
+    println!(
+        "cycles per decision over {} decisions: min {}, mean {mean:.0}, max {worst}",
+        cycles.len(),
+        cycles.iter().min().unwrap_or(&0)
+    );
+    println!("wall time {:.1} s", started.elapsed().as_secs_f64());
+
+    assert!(
+        mismatches.is_empty(),
+        "{} of {n} periods differ, first: {:#?}",
+        mismatches.len(),
+        &mismatches[..mismatches.len().min(5)]
+    );
+    assert!(
+        mirror_mismatches * 10 >= n,
+        "mirrored expectations mismatch only {mirror_mismatches} of {n}: the check is too weak"
+    );
+    assert!(
+        other_mismatches * 4 >= n,
+        "another policy mismatches only {other_mismatches} of {n}: the check is too weak"
+    );
+    assert!(unexplained.is_empty(), "unexplained end-to-end disagreements: {unexplained:#?}");
+    assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles, budget {BUDGET_CYCLES}");
+}
+
+#[test]
+fn the_8bit_firmware_decides_as_the_simulator() {
+    equivalence(&EIGHT_BIT);
+}
+
+#[test]
+fn the_10bit_firmware_decides_as_the_simulator() {
+    equivalence(&TEN_BIT);
+}
