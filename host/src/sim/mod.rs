@@ -26,7 +26,7 @@ pub use eval::{eval, eval_prime, EvalPrime};
 pub use field::{FieldError, FieldSource, ScalarField};
 pub use letters::Letter;
 pub use sensors::{DiscSensorConfig, DiscSensors, Footprint, FootprintKind, ObstacleTargets, SensorDisc, SensorModel};
-pub use simulation::{EpisodeEnd, Simulation, SimulationState, StepOutcome, Totals};
+pub use simulation::{EpisodeEnd, EpisodeStart, Simulation, SimulationState, StepOutcome, Totals};
 pub use vec2::Vec2;
 pub use world::{World, WorldState};
 
