@@ -65,6 +65,12 @@ enum Command {
         #[arg(long, default_value_t = 1_000_000)]
         steps: u64,
     },
+    /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
+    /// blob for the firmware) and <out>/<name>.ckpt (the complete training
+    /// state), and prints formations, stuck episodes, speed and state
+    /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
+    /// hasher, 2,000,000 steps, into out/.
+    Train(host::train::TrainArgs),
     /// Work with policy blob files.
     #[command(subcommand)]
     Policy(PolicyCommand),
@@ -163,6 +169,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench { naive, scale, steps } => {
             let rate = host::bench::run(BenchVariant { naive, scale }, steps)?;
             println!("{rate:.0} steps/s");
+            Ok(())
+        }
+        Command::Train(args) => {
+            let report = host::train::train(&args)?;
+            println!("{report}");
             Ok(())
         }
         Command::Policy(PolicyCommand::Inspect { file }) => {

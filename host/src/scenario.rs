@@ -1,12 +1,15 @@
 //! A simulation and its controller from the CLI's choices (`--field`,
-//! `--controller`, counts, seed), with the per-field defaults of the
-//! thesis' experiments, and a timed run that summarises it.
+//! `--controller`, `--sensors`, counts, seed), with the per-field defaults
+//! of the thesis' experiments, and a timed run that summarises it.
 
 use crate::controller::{Controller, GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
-use crate::sim::{BroadPhase, FieldSource, SimConfig, Simulation, Thresholds, Totals};
+use crate::sim::{
+    BroadPhase, DiscSensors, FieldSource, Footprint, ScalarField, SensorModel, SimConfig, Simulation, Thresholds,
+    Totals, World,
+};
 use anyhow::{Context, Result};
-use serde::Serialize;
-use shared::ActionTable;
+use serde::{Deserialize, Serialize};
+use shared::{ActionTable, SensorReading};
 use std::fmt;
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -84,26 +87,42 @@ impl Default for Scenario {
     }
 }
 
+/// The settings of a field's experiments: the reference defaults with the
+/// given counts; the annulus thresholds and 150,000-step stuck limit on the
+/// annulus, thresholds 1.0 and a 50,000-step limit on letters and images.
+/// Every robot is an outie.
+pub fn field_config(field: &FieldSource, robots: usize, pucks: usize) -> SimConfig {
+    let mut c = SimConfig::default();
+    c.world.robots = robots;
+    c.world.pucks = pucks;
+    if !field.has_cavity() {
+        c.thresholds = Thresholds::LETTERS;
+        c.episode.stuck_limit = 50_000;
+    }
+    c
+}
+
+/// The number of innies orbital construction uses: half the robots on a
+/// field with a cavity (the annulus), none otherwise (thesis Tables 1, 4).
+pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
+    if field.has_cavity() {
+        robots / 2
+    } else {
+        0
+    }
+}
+
 impl Scenario {
-    /// The settings: the reference defaults, the annulus thresholds and
-    /// 150,000-step stuck limit on the annulus, thresholds 1.0 and a
-    /// 50,000-step limit on letters and images; half the robots innies for
-    /// orbital construction on the annulus, none otherwise.
+    /// The settings: [`field_config`] with this scenario's counts, contact
+    /// search and arena, and [`orbital_innies`] for orbital construction.
     pub fn config(&self) -> SimConfig {
-        let mut c = SimConfig::default();
-        c.world.robots = self.robots;
-        c.world.pucks = self.pucks;
+        let mut c = field_config(&self.field, self.robots, self.pucks);
         c.world.broad_phase = self.broad_phase;
         if let Some(size) = self.arena_size {
             c.world.arena_size = size;
         }
-        let cavity = self.field.has_cavity();
-        if !cavity {
-            c.thresholds = Thresholds::LETTERS;
-            c.episode.stuck_limit = 50_000;
-        }
-        if self.controller == ControllerChoice::Orbital && cavity {
-            c.world.innies = self.robots / 2;
+        if self.controller == ControllerChoice::Orbital {
+            c.world.innies = orbital_innies(&self.field, self.robots);
         }
         c
     }
@@ -125,6 +144,81 @@ impl Scenario {
         let field = Arc::new(self.field.load()?);
         let sim = Simulation::new(config, field, self.seed).context("invalid simulation settings")?;
         Ok((sim, controller))
+    }
+}
+
+/// Which sensor model the robots carry (`--sensors`, `sensors = ...` in
+/// config files). Adding a model is one variant, its name and one arm of
+/// [`SensorChoice::build`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum SensorChoice {
+    /// The reference model's disc sensors ([`DiscSensors`], `disc`).
+    #[default]
+    Disc,
+}
+
+/// A sensor model chosen at run time.
+pub type DynSensors = Box<dyn SensorModel + Send>;
+
+impl SensorChoice {
+    /// Every model, for help texts.
+    pub const ALL: [SensorChoice; 1] = [SensorChoice::Disc];
+
+    /// The CLI / config name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SensorChoice::Disc => "disc",
+        }
+    }
+
+    /// The model with the geometry of `config`.
+    pub fn build(self, config: &SimConfig) -> DynSensors {
+        match self {
+            SensorChoice::Disc => Box::new(DiscSensors::new(&config.sensors, config.world.robot_radius)),
+        }
+    }
+}
+
+impl FromStr for SensorChoice {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<SensorChoice, String> {
+        SensorChoice::ALL.into_iter().find(|c| c.name() == s).ok_or_else(|| {
+            let names: Vec<&str> = SensorChoice::ALL.iter().map(|c| c.name()).collect();
+            format!("unknown sensor model {s:?}: expected {}", names.join(", "))
+        })
+    }
+}
+
+impl TryFrom<String> for SensorChoice {
+    type Error = String;
+
+    fn try_from(s: String) -> Result<SensorChoice, String> {
+        s.parse()
+    }
+}
+
+impl From<SensorChoice> for String {
+    fn from(c: SensorChoice) -> String {
+        c.name().to_string()
+    }
+}
+
+impl fmt::Display for SensorChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Forwards every call, so a boxed model chosen at run time is a model.
+impl<S: SensorModel + ?Sized> SensorModel for Box<S> {
+    fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
+        (**self).sense(world, field, out)
+    }
+
+    fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
+        (**self).footprints(world, robot, out)
     }
 }
 

@@ -188,3 +188,58 @@ impl Controller for QLearner {
         self.last_signal = signal;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
+    use rand::SeedableRng;
+    use shared::{PolicyTable, SensorReading};
+
+    /// Two robots in the same state take the same action and reach the
+    /// same state: the second update sees the first.
+    #[test]
+    fn updates_are_applied_in_robot_order_each_seeing_the_last() {
+        let config = SimConfig::default();
+        let robots = [(Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie), (Vec2::new(300.0, 300.0), 0.0, RobotKind::Outie)];
+        let world = World::scene(&config, &robots, &[], 1);
+        let field = ScalarField::annulus();
+        let mut policy = PolicyTable::new(StateHasher::Original);
+        let reading = SensorReading { puck_left: true, ..SensorReading::default() };
+        let s = StateHasher::Original.hash(&reading);
+        policy.set(s, ActionId(0));
+        let learn = LearnConfig::default();
+        let mut learner = QLearner::with_table(learn.clone(), QTable::from_policy(&policy, 4, 1.0)).unwrap();
+
+        // no pucks: Eval stays 1, so the reference reward is 0 - 1 = -1
+        learner.episode_start(&EpisodeStart { world: &world, field: &field, config: &config });
+        let readings = [reading; 2];
+        let mut turns = [0.0; 2];
+        let perception = Perception { readings: &readings, robots: world.robots(), episode_step: 0 };
+        learner.decide(&perception, &mut turns, &mut SimRng::seed_from_u64(1));
+        assert_eq!(turns, [learn.actions[0]; 2]);
+        learner.observe(&StepOutcome {
+            episode_step: 1,
+            eval: Some(1.0),
+            end: None,
+            robot_contacts: 0,
+            world: &world,
+            field: &field,
+            config: &config,
+            readings: &readings,
+        });
+        // first: 2 + 0.2 (-1 + 0.9 x 2 - 2) = 1.76; second sees it:
+        // 1.76 + 0.2 (-1 + 0.9 x 1.76 - 1.76) = 1.5248
+        let q = learner.table();
+        assert!((q.value(s, ActionId(0)) - 1.5248).abs() < 1e-12, "{}", q.value(s, ActionId(0)));
+        assert_eq!(q.visits(s, ActionId(0)), 2);
+        assert_eq!(learner.signal(), 1.0);
+    }
+
+    #[test]
+    fn a_seed_table_of_another_shape_is_refused() {
+        let q = QTable::new(StateHasher::Bits9, 4, 1.0);
+        let e = QLearner::with_table(LearnConfig::default(), q).unwrap_err().to_string();
+        assert!(e.contains("bits9") && e.contains("original"), "{e}");
+    }
+}
