@@ -4,6 +4,7 @@ use host::bench::BenchVariant;
 use host::render::RenderOptions;
 use host::scenario::{run_timed, ControllerChoice, Scenario};
 use host::sim::{BroadPhase, FieldSource};
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -71,6 +72,10 @@ enum Command {
     /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
     /// hasher, 2,000,000 steps, into out/.
     Train(host::train::TrainArgs),
+    /// Run one of the thesis' experiments (trials in parallel, resumable)
+    /// and write CSV, JSON, a markdown table beside the thesis' numbers and
+    /// PNG figures into --out.
+    Experiment(host::experiment::ExperimentArgs),
     /// Work with policy blob files.
     #[command(subcommand)]
     Policy(PolicyCommand),
@@ -174,6 +179,22 @@ fn run(cli: Cli) -> Result<()> {
         Command::Train(args) => {
             let report = host::train::train(&args)?;
             println!("{report}");
+            Ok(())
+        }
+        Command::Experiment(args) => {
+            let spec = host::experiment::ExperimentSpec::load(&args.experiment)?;
+            // progress lines; a closed stdout must not stop the trials
+            let log = |line: &str| {
+                let _ = writeln!(std::io::stdout().lock(), "{line}");
+            };
+            let report = host::experiment::run(&spec, &args.options(), &log)?;
+            println!(
+                "done in {:.0} s: {} trials run, {} skipped; wrote {}",
+                report.seconds,
+                report.trials_run,
+                report.trials_skipped,
+                report.outputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            );
             Ok(())
         }
         Command::Policy(PolicyCommand::Inspect { file }) => {
