@@ -18,6 +18,7 @@ pub enum Metric {
     /// Step of the first formation, over the trials that formed one.
     FirstFormation,
     /// Robot-robot collisions per 1000 steps.
+    #[serde(rename = "collisions_per_1000")]
     CollisionsPer1000,
     /// Mean formations over those of the table's `ratio_to` arm.
     FormationsRatio,
