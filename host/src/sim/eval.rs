@@ -9,6 +9,7 @@
 
 use super::config::Thresholds;
 use super::field::ScalarField;
+use super::vec2::Vec2;
 use super::world::World;
 use serde::{Deserialize, Serialize};
 
@@ -23,16 +24,80 @@ pub fn band_distance(value: f64, t: &Thresholds) -> f64 {
     }
 }
 
+/// One unit of band distance in the fixed point Eval sums in: 2^-32.
+const DISTANCE_ONE: f64 = 4_294_967_296.0;
+
+/// A puck's band distance in fixed point. Summing integers makes Eval
+/// independent of the order of the sum, so [`EvalTracker`]'s running total
+/// equals a fresh [`eval`] exactly; the rounding (at most 2^-33 per puck)
+/// is far below anything Eval is compared with.
+fn fixed_distance(p: Vec2, arena_size: f64, field: &ScalarField, t: &Thresholds) -> u64 {
+    let d = band_distance(f64::from(field.evaluate(p, arena_size)), t);
+    (d * DISTANCE_ONE).round() as u64
+}
+
+/// Eval from the sum of the pucks' fixed-point distances.
+fn eval_of(total: u64, pucks: usize, t: &Thresholds) -> f64 {
+    let scale = t.outie.max(1.0 - t.innie);
+    if pucks == 0 || scale <= 0.0 {
+        return 1.0;
+    }
+    1.0 - total as f64 / DISTANCE_ONE / pucks as f64 / scale
+}
+
 /// Eval of the pucks' positions, 1 when every puck is in the band.
 pub fn eval(world: &World, field: &ScalarField, t: &Thresholds) -> f64 {
     let size = world.config().arena_size;
-    let pucks = world.pucks();
-    let scale = t.outie.max(1.0 - t.innie);
-    if pucks.is_empty() || scale <= 0.0 {
-        return 1.0;
+    let total = world.pucks().iter().map(|p| fixed_distance(p.pos, size, field, t)).sum();
+    eval_of(total, world.pucks().len(), t)
+}
+
+/// Eval kept current as the world steps: only the pucks that moved since
+/// the last update are looked up again, so Eval every step (a learner's
+/// reward) costs a few lookups instead of one per puck. Always equal to
+/// [`eval`] right after an update.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EvalTracker {
+    /// Each body's fixed-point distance (0 for robots).
+    distances: Vec<u64>,
+    total: u64,
+}
+
+impl EvalTracker {
+    /// A tracker of `world`'s current pucks.
+    pub fn new(world: &World, field: &ScalarField, t: &Thresholds) -> EvalTracker {
+        let mut tracker = EvalTracker { distances: vec![0; world.bodies().len()], total: 0 };
+        tracker.rebuild(world, field, t);
+        tracker
     }
-    let total: f64 = pucks.iter().map(|p| band_distance(f64::from(field.evaluate(p.pos, size)), t)).sum();
-    1.0 - total / pucks.len() as f64 / scale
+
+    /// Looks every puck up again (after a reset), without allocating.
+    pub fn rebuild(&mut self, world: &World, field: &ScalarField, t: &Thresholds) {
+        self.distances.fill(0);
+        let size = world.config().arena_size;
+        for i in world.puck_range() {
+            self.distances[i] = fixed_distance(world.bodies()[i].pos, size, field, t);
+        }
+        self.total = self.distances.iter().sum();
+    }
+
+    /// Catches up with the world: looks up the pucks that moved since the
+    /// last update (the world's moved set, which this empties).
+    pub fn update(&mut self, world: &mut World, field: &ScalarField, t: &Thresholds) {
+        let (first_puck, size) = (world.puck_range().start, world.config().arena_size);
+        world.drain_moved(|i, body| {
+            if i >= first_puck {
+                let d = fixed_distance(body.pos, size, field, t);
+                self.total = self.total - self.distances[i] + d;
+                self.distances[i] = d;
+            }
+        });
+    }
+
+    /// Eval of the world as of the last update.
+    pub fn eval(&self, world: &World, t: &Thresholds) -> f64 {
+        eval_of(self.total, world.pucks().len(), t)
+    }
 }
 
 /// The two readings of the thesis' collision-aware Eval'.

@@ -22,7 +22,7 @@ pub mod world;
 
 pub use body::{Body, Robot, RobotKind};
 pub use config::{BroadPhase, ConfigError, EpisodeConfig, PhysicsConfig, SimConfig, Thresholds, WorldConfig};
-pub use eval::{eval, eval_prime, EvalPrime};
+pub use eval::{eval, eval_prime, EvalPrime, EvalTracker};
 pub use field::{FieldError, FieldSource, ScalarField};
 pub use letters::Letter;
 pub use sensors::{DiscSensorConfig, DiscSensors, Footprint, FootprintKind, ObstacleTargets, SensorDisc, SensorModel};

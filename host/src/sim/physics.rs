@@ -49,6 +49,9 @@ pub struct PhysicsScratch {
     /// Bodies still to take their turn: awake ones and those pushed by an
     /// earlier turn.
     pending: BitSet,
+    /// Bodies whose position changed since [`PhysicsScratch::drain_moved`]
+    /// last emptied the set (for incremental Eval).
+    moved: BitSet,
     contacts: Vec<Contact>,
     candidates: Vec<u32>,
     robot_pairs: Vec<(u32, u32)>,
@@ -69,6 +72,7 @@ impl PhysicsScratch {
             live,
             awake: BitSet::new(n),
             pending: BitSet::new(n),
+            moved: BitSet::new(n),
             contacts: Vec::with_capacity(8 * n + 64),
             candidates: Vec::with_capacity(n),
             robot_pairs: Vec::with_capacity(robots * robots / 2 + 1),
@@ -83,6 +87,17 @@ impl PhysicsScratch {
     /// Distinct robot-robot pairs in contact in the last step.
     pub fn robot_contacts(&self) -> usize {
         self.robot_pairs.len()
+    }
+
+    /// Calls `f` for every body whose position changed since the last
+    /// call, ascending, and empties the set.
+    pub fn drain_moved(&mut self, mut f: impl FnMut(usize)) {
+        let mut next = self.moved.next_from(0);
+        while let Some(i) = next {
+            next = self.moved.next_from(i + 1);
+            f(i);
+        }
+        self.moved.clear();
     }
 }
 
@@ -138,6 +153,7 @@ impl StepContext<'_> {
                 b.pos += b.vel;
                 b.vel = b.vel * keep;
                 self.index.moved(i, b.pos);
+                sc.moved.insert(i);
             } else {
                 b.vel = Vec2::ZERO;
             }
@@ -230,7 +246,7 @@ impl StepContext<'_> {
             }
             let normal = if d > 0.0 { delta * (1.0 / d) } else { inward };
             self.bodies[i].pos += normal * overlap;
-            self.index.moved(i, self.bodies[i].pos);
+            self.relocated(i);
             self.record(Contact::Wall { body: i as u32, point, velocity: -b.vel });
         }
     }
@@ -273,7 +289,7 @@ impl StepContext<'_> {
         if d2 == 0.0 {
             let nudge = Vec2::new(self.rng.random_range(-1.0..1.0), self.rng.random_range(-1.0..1.0));
             self.bodies[j].pos += nudge;
-            self.index.moved(j, self.bodies[j].pos);
+            self.relocated(j);
             delta = self.bodies[j].pos - self.bodies[i].pos;
             d2 = delta.length_squared();
             if d2 == 0.0 {
@@ -287,8 +303,8 @@ impl StepContext<'_> {
         let total = mi + mj;
         self.bodies[i].pos -= normal * (overlap * mj / total);
         self.bodies[j].pos += normal * (overlap * mi / total);
-        self.index.moved(i, self.bodies[i].pos);
-        self.index.moved(j, self.bodies[j].pos);
+        self.relocated(i);
+        self.relocated(j);
         self.scratch.pending.insert(j);
         self.record(Contact::Bodies(i as u32, j as u32));
         true
@@ -301,8 +317,15 @@ impl StepContext<'_> {
         let clamped = Vec2::new(b.pos.x.clamp(lo, hi), b.pos.y.clamp(lo, hi));
         if clamped != b.pos {
             b.pos = clamped;
-            self.index.moved(i, clamped);
+            self.relocated(i);
         }
+    }
+
+    /// Records that body `i`'s position changed during overlap resolution.
+    #[inline]
+    fn relocated(&mut self, i: usize) {
+        self.index.moved(i, self.bodies[i].pos);
+        self.scratch.moved.insert(i);
     }
 
     fn apply_impulses(&mut self) {

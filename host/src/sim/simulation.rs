@@ -14,7 +14,7 @@
 //! trajectory bit for bit.
 
 use super::config::{ConfigError, SimConfig};
-use super::eval::eval;
+use super::eval::{eval, EvalTracker};
 use super::field::ScalarField;
 use super::sensors::{DiscSensors, SensorModel};
 use super::world::World;
@@ -132,6 +132,7 @@ pub struct Simulation<S: SensorModel = DiscSensors> {
     state: SimulationState,
     field: Arc<ScalarField>,
     sensors: S,
+    evaluation: EvalTracker,
     turns: Vec<f32>,
 }
 
@@ -167,7 +168,8 @@ impl<S: SensorModel> Simulation<S> {
             state.readings = vec![SensorReading::default(); robots];
             sensors.sense(&state.world, &field, &mut state.readings);
         }
-        Simulation { state, field, sensors, turns: vec![0.0; robots] }
+        let evaluation = EvalTracker::new(&state.world, &field, &state.config.thresholds);
+        Simulation { state, field, sensors, evaluation, turns: vec![0.0; robots] }
     }
 
     /// The state to save for a bit-exact resume.
@@ -228,8 +230,10 @@ impl<S: SensorModel> Simulation<S> {
 
         let episode = &s.config.episode;
         let check = s.episode_step % episode.check_interval == 0;
-        let eval = (check || controller.wants_eval_every_step())
-            .then(|| eval(&s.world, &self.field, &s.config.thresholds));
+        let eval = (check || controller.wants_eval_every_step()).then(|| {
+            self.evaluation.update(&mut s.world, &self.field, &s.config.thresholds);
+            self.evaluation.eval(&s.world, &s.config.thresholds)
+        });
         let mut end = None;
         if let (true, Some(e)) = (check, eval) {
             s.totals.eval_sum += e;
@@ -262,6 +266,7 @@ impl<S: SensorModel> Simulation<S> {
         if end.is_some() {
             s.world.reset();
             s.episode_step = 0;
+            self.evaluation.rebuild(&s.world, &self.field, &s.config.thresholds);
             self.sensors.sense(&s.world, &self.field, &mut s.readings);
         }
         end

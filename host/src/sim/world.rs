@@ -159,6 +159,13 @@ impl World {
         self.scratch.robot_contacts()
     }
 
+    /// Calls `f` with every body whose position changed since the last
+    /// call (or since the world was built or reset), ascending by index.
+    pub fn drain_moved(&mut self, mut f: impl FnMut(usize, &Body)) {
+        let bodies = &self.state.bodies;
+        self.scratch.drain_moved(|i| f(i, &bodies[i]))
+    }
+
     /// The contacts of the last step, in the order they were found.
     pub fn contacts(&self) -> &[super::physics::Contact] {
         self.scratch.contacts()
