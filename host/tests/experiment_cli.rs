@@ -100,3 +100,22 @@ fn bad_experiment_inputs_are_refused() {
     let e = fails(&["experiment", bad.to_str().unwrap()]);
     assert!(e.contains("bad.toml") && e.contains("arm \"a\"") && e.contains("hasher"), "{e}");
 }
+
+#[test]
+fn results_do_not_depend_on_the_number_of_threads() {
+    let out = tempfile::tempdir().unwrap();
+    let run = |threads: &str| {
+        let dir = out.path().join(threads);
+        let args = ["experiment", "annulus", "--trials", "3", "--scale", "0.0006", "--threads", threads, "--out"];
+        assert!(host().args(args).arg(&dir).output().unwrap().status.success());
+        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("trials.json")).unwrap()).unwrap();
+        let mut trials = json.as_array().unwrap().clone();
+        for t in &mut trials {
+            let t = t.as_object_mut().unwrap();
+            t.remove("steps_per_second");
+            t.remove("seconds");
+        }
+        trials
+    };
+    assert_eq!(run("1"), run("2"));
+}

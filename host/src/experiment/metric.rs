@@ -106,7 +106,7 @@ pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialRe
             _ => Value::Missing,
         },
         Metric::FirstFormation => mean_of(&|t| t.formation_steps.first().map(|&s| s as f64)),
-        Metric::CollisionsPer1000 => mean_of(&|t| Some(t.collisions_per_1000())),
+        Metric::CollisionsPer1000 => mean_of(&|t| Some(t.collisions_per_1000)),
         Metric::FormationsRatio => match (mean_formations(trials), reference.and_then(mean_formations)) {
             (Some(a), Some(b)) if b > 0.0 => Value::Derived(a / b),
             _ => Value::Missing,

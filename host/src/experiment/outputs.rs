@@ -56,7 +56,7 @@ pub fn csv(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
             r.formations,
             r.stuck,
             opt(r.formation_steps.first().map(u64::to_string)),
-            r.collisions_per_1000(),
+            r.collisions_per_1000,
             opt(r.states_visited.map(|v| v.to_string())),
             opt(r.states_total.map(|v| v.to_string())),
             r.steps_per_second,

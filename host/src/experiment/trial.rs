@@ -43,8 +43,8 @@ pub struct TrialResult {
     pub stuck: u64,
     /// The step (from 1) at which each formation happened.
     pub formation_steps: Vec<u64>,
-    /// Robot-robot contacts over the whole trial.
-    pub robot_contacts: u64,
+    /// Robot-robot contacts per 1000 steps over the whole trial.
+    pub collisions_per_1000: f64,
     /// Robot-robot contacts in each full block of [`BLOCK_STEPS`] steps.
     pub collisions_per_block: Vec<u64>,
     /// States of the Q-table with at least one update at the end
@@ -56,17 +56,6 @@ pub struct TrialResult {
     pub steps_per_second: f64,
     /// Wall time of the trial's run.
     pub seconds: f64,
-}
-
-impl TrialResult {
-    /// Robot-robot contacts per 1000 steps over the trial.
-    pub fn collisions_per_1000(&self) -> f64 {
-        if self.steps == 0 {
-            0.0
-        } else {
-            self.robot_contacts as f64 * 1000.0 / self.steps as f64
-        }
-    }
 }
 
 /// Follows a run step by step: formation times and collision blocks.
@@ -130,7 +119,7 @@ pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> 
         formations: totals.formations,
         stuck: totals.stuck,
         formation_steps: recorder.formation_steps,
-        robot_contacts: totals.robot_contacts,
+        collisions_per_1000: totals.collisions_per_1000(),
         collisions_per_block: recorder.collisions_per_block,
         states_visited: states.map(|s| s.0),
         states_total: states.map(|s| s.1),

@@ -53,6 +53,7 @@ impl<S: SensorModel> Trainer<S> {
     /// Continues a saved run on `field`, which must be the field it
     /// trained on.
     pub fn resume(state: TrainingState, field: Arc<ScalarField>, sensors: S) -> Result<Self> {
+        state.config.validate()?;
         let crc = field_fingerprint(&field);
         if crc != state.field_crc {
             bail!(
