@@ -143,24 +143,16 @@ fn resume(args: &TrainArgs, path: &Path) -> Result<(Trainer<DynSensors>, u64)> {
 pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     let learn = &config.learn;
-    let (hasher, actions, table) = if bytes.starts_with(b"QPOL") {
+    let (table, speeds) = if bytes.starts_with(b"QPOL") {
         let blob = shared::PolicyBlob::decode(&bytes).map_err(|e| anyhow::anyhow!("policy file {}: {e}", path.display()))?;
-        if blob.actions().angular_speeds() != learn.actions.as_slice() && blob.actions().len() == learn.actions.len() {
-            bail!(
-                "policy file {}: its actions {:?} are not this run's {:?}",
-                path.display(),
-                blob.actions().angular_speeds(),
-                learn.actions
-            );
-        }
         let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
-        (blob.hasher(), blob.actions().len(), q)
+        (q, Some(blob.actions().angular_speeds().to_vec()))
     } else {
         let state: TrainingState =
             checkpoint::decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))?;
-        let q = state.learner.table().clone();
-        (q.hasher(), q.num_actions(), q)
+        (state.learner.table().clone(), None)
     };
+    let (hasher, actions) = (table.hasher(), table.num_actions());
     if hasher != learn.hasher.0 || actions != learn.actions.len() {
         bail!(
             "{} was trained with hasher {hasher} and {actions} actions, but this run uses hasher {} and {} actions",
@@ -168,6 +160,9 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
             learn.hasher.0,
             learn.actions.len()
         );
+    }
+    if let Some(speeds) = speeds.filter(|s| s != &learn.actions) {
+        bail!("policy file {}: its actions {speeds:?} are not this run's {:?}", path.display(), learn.actions);
     }
     Ok(table)
 }
