@@ -4,6 +4,7 @@
 pub mod atomic;
 pub mod bench;
 pub mod controller;
+pub mod experiment;
 pub mod inspect;
 pub mod learn;
 pub mod policy_file;
@@ -13,3 +14,4 @@ pub mod robot;
 pub mod scenario;
 pub mod sensor_choice;
 pub mod sim;
+pub mod train;

@@ -71,6 +71,16 @@ enum Command {
         #[arg(long, default_value_t = 1_000_000)]
         steps: u64,
     },
+    /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
+    /// blob for the firmware) and <out>/<name>.ckpt (the complete training
+    /// state), and prints formations, stuck episodes, speed and state
+    /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
+    /// hasher, 2,000,000 steps, into out/.
+    Train(host::train::TrainArgs),
+    /// Run one of the thesis' experiments (trials in parallel, resumable)
+    /// and write CSV, JSON, a markdown table beside the thesis' numbers and
+    /// PNG figures into --out.
+    Experiment(host::experiment::ExperimentArgs),
     /// Work with policy blob files.
     #[command(subcommand)]
     Policy(PolicyCommand),
@@ -254,6 +264,27 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench { naive, scale, steps } => {
             let rate = host::bench::run(BenchVariant { naive, scale }, steps)?;
             println!("{rate:.0} steps/s");
+            Ok(())
+        }
+        Command::Train(args) => {
+            let report = host::train::train(&args)?;
+            println!("{report}");
+            Ok(())
+        }
+        Command::Experiment(args) => {
+            let spec = host::experiment::ExperimentSpec::load(&args.experiment)?;
+            // progress lines; a closed stdout must not stop the trials
+            let log = |line: &str| {
+                let _ = writeln!(std::io::stdout().lock(), "{line}");
+            };
+            let report = host::experiment::run(&spec, &args.options(), &log)?;
+            println!(
+                "done in {:.0} s: {} trials run, {} skipped; wrote {}",
+                report.seconds,
+                report.trials_run,
+                report.trials_skipped,
+                report.outputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+            );
             Ok(())
         }
         Command::Policy(PolicyCommand::Inspect { file }) => {

@@ -1,6 +1,6 @@
 //! A simulation and its controller from the CLI's choices (`--field`,
-//! `--controller`, counts, seed), with the per-field defaults of the
-//! thesis' experiments, and a timed run that summarises it.
+//! `--controller`, `--sensors`, counts, seed), with the per-field defaults
+//! of the thesis' experiments, and a timed run that summarises it.
 
 use crate::controller::{Controller, GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
 use crate::sensor_choice::{SelectedSensors, SensorChoice};
@@ -88,26 +88,42 @@ impl Default for Scenario {
     }
 }
 
+/// The settings of a field's experiments: the reference defaults with the
+/// given counts; the annulus thresholds and 150,000-step stuck limit on the
+/// annulus, thresholds 1.0 and a 50,000-step limit on letters and images.
+/// Every robot is an outie.
+pub fn field_config(field: &FieldSource, robots: usize, pucks: usize) -> SimConfig {
+    let mut c = SimConfig::default();
+    c.world.robots = robots;
+    c.world.pucks = pucks;
+    if !field.has_cavity() {
+        c.thresholds = Thresholds::LETTERS;
+        c.episode.stuck_limit = 50_000;
+    }
+    c
+}
+
+/// The number of innies orbital construction uses: half the robots on a
+/// field with a cavity (the annulus), none otherwise (thesis Tables 1, 4).
+pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
+    if field.has_cavity() {
+        robots / 2
+    } else {
+        0
+    }
+}
+
 impl Scenario {
-    /// The settings: the reference defaults, the annulus thresholds and
-    /// 150,000-step stuck limit on the annulus, thresholds 1.0 and a
-    /// 50,000-step limit on letters and images; half the robots innies for
-    /// orbital construction on the annulus, none otherwise.
+    /// The settings: [`field_config`] with this scenario's counts, contact
+    /// search and arena, and [`orbital_innies`] for orbital construction.
     pub fn config(&self) -> SimConfig {
-        let mut c = SimConfig::default();
-        c.world.robots = self.robots;
-        c.world.pucks = self.pucks;
+        let mut c = field_config(&self.field, self.robots, self.pucks);
         c.world.broad_phase = self.broad_phase;
         if let Some(size) = self.arena_size {
             c.world.arena_size = size;
         }
-        let cavity = self.field.has_cavity();
-        if !cavity {
-            c.thresholds = Thresholds::LETTERS;
-            c.episode.stuck_limit = 50_000;
-        }
-        if self.controller == ControllerChoice::Orbital && cavity {
-            c.world.innies = self.robots / 2;
+        if self.controller == ControllerChoice::Orbital {
+            c.world.innies = orbital_innies(&self.field, self.robots);
         }
         c
     }

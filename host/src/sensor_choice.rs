@@ -9,13 +9,16 @@
 
 use crate::sim::{DiscSensors, Footprint, RobotSensorConfig, RobotSensors, ScalarField, SensorModel, SimConfig, World};
 use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// The `--sensors` choice.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+/// The `--sensors` choice (`sensors = "..."` in training and experiment
+/// files, with the same names).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
 pub enum SensorChoice {
     /// The thesis' disc sensors of `SimConfig::sensors`.
     #[default]
@@ -36,6 +39,20 @@ impl FromStr for SensorChoice {
                 _ => Err(format!("unknown sensor model {s:?}: expected disc, robot or robot:CONFIG.json")),
             },
         }
+    }
+}
+
+impl TryFrom<String> for SensorChoice {
+    type Error = String;
+
+    fn try_from(s: String) -> Result<SensorChoice, String> {
+        s.parse()
+    }
+}
+
+impl From<SensorChoice> for String {
+    fn from(c: SensorChoice) -> String {
+        c.to_string()
     }
 }
 

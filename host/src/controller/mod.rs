@@ -3,12 +3,14 @@
 //! One [`Controller`] drives the whole swarm, so a learner can share one
 //! table between robots and apply their updates in robot order. Each step
 //! the simulation
-//! 1. senses: one [`SensorReading`] per robot;
-//! 2. calls [`Controller::decide`], which writes each robot's angular speed;
-//! 3. turns the robots and runs physics;
-//! 4. calls [`Controller::observe`] with the [`StepOutcome`]: Eval when
-//!    requested or at a formation check, and whether the episode ended (it is
-//!    reset right after `observe` returns).
+//! 1. at an episode's first step, calls [`Controller::episode_start`] with
+//!    the fresh world;
+//! 2. calls [`Controller::decide`] with one [`SensorReading`] per robot,
+//!    which writes each robot's angular speed;
+//! 3. turns the robots, runs physics and senses again;
+//! 4. calls [`Controller::observe`] with the [`StepOutcome`]: the new
+//!    readings, Eval when requested or at a formation check, and whether the
+//!    episode ended (it is reset right after `observe` returns).
 
 pub mod greedy;
 pub mod orbital;
@@ -18,7 +20,7 @@ pub use greedy::GreedyPolicy;
 pub use orbital::{OrbitalConfig, OrbitalConstruction};
 pub use random::RandomTurns;
 
-use crate::sim::{Robot, StepOutcome, SimRng};
+use crate::sim::{EpisodeStart, Robot, SimRng, StepOutcome};
 use shared::SensorReading;
 
 /// What a controller sees before choosing: every robot's reading and kind.
@@ -45,6 +47,10 @@ pub trait Controller {
         false
     }
 
+    /// Called before the first decision of every episode (the first step
+    /// of a simulation and the step after each reset).
+    fn episode_start(&mut self, _start: &EpisodeStart<'_>) {}
+
     /// Called after every physics step, before an ended episode is reset.
     fn observe(&mut self, _outcome: &StepOutcome<'_>) {}
 }
@@ -57,6 +63,10 @@ impl<C: Controller + ?Sized> Controller for Box<C> {
 
     fn wants_eval_every_step(&self) -> bool {
         (**self).wants_eval_every_step()
+    }
+
+    fn episode_start(&mut self, start: &EpisodeStart<'_>) {
+        (**self).episode_start(start)
     }
 
     fn observe(&mut self, outcome: &StepOutcome<'_>) {
@@ -72,6 +82,10 @@ impl<C: Controller + ?Sized> Controller for &mut C {
 
     fn wants_eval_every_step(&self) -> bool {
         (**self).wants_eval_every_step()
+    }
+
+    fn episode_start(&mut self, start: &EpisodeStart<'_>) {
+        (**self).episode_start(start)
     }
 
     fn observe(&mut self, outcome: &StepOutcome<'_>) {

@@ -3,7 +3,7 @@
 use super::qtable::{QParams, QTable};
 use super::reward::Reward;
 use crate::controller::{Controller, Perception};
-use crate::sim::{ScalarField, SimConfig, SimRng, StepOutcome, World};
+use crate::sim::{EpisodeStart, SimRng, StepOutcome};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
@@ -98,20 +98,20 @@ impl LearnConfig {
 }
 
 /// Tabular Q-learning as a [`Controller`]: each step every robot hashes its
-/// reading, picks an epsilon-greedy action from the one shared table; after
-/// the physics step every robot's (s, a, r, s') is applied in robot order
-/// with the same global reward.
+/// reading and picks an epsilon-greedy action from the one shared table;
+/// after the physics step every robot's (s, a, r, s') is applied in robot
+/// order with the same global reward, each update seeing the ones before.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QLearner {
     config: LearnConfig,
     q: QTable,
-    /// Each robot's (state, action) of the step in flight.
+    /// Each robot's (state, action) of the step in flight; refilled by
+    /// every decision, so not part of a checkpoint.
+    #[serde(skip)]
     chosen: Vec<(State, ActionId)>,
-    /// The reward signal of the world before the step in flight (set at
-    /// every episode start).
-    last_signal: Option<f64>,
-    /// Whether learning is on (off: act greedily, change nothing).
-    learning: bool,
+    /// The reward signal (Eval or Eval') of the world before the step in
+    /// flight; set at every episode start.
+    last_signal: f64,
 }
 
 impl QLearner {
@@ -119,7 +119,7 @@ impl QLearner {
     pub fn new(config: LearnConfig) -> Result<QLearner> {
         config.validate()?;
         let q = QTable::new(config.hasher.0, config.actions.len(), config.initial_q);
-        Ok(QLearner { config, q, chosen: Vec::new(), last_signal: None, learning: true })
+        Ok(QLearner { config, q, chosen: Vec::new(), last_signal: 0.0 })
     }
 
     /// A learner that starts from another run's table (the thesis' RL2 and
@@ -140,11 +140,6 @@ impl QLearner {
         Ok(learner)
     }
 
-    /// Turns learning on or off.
-    pub fn set_learning(&mut self, on: bool) {
-        self.learning = on;
-    }
-
     /// The Q-table.
     pub fn table(&self) -> &QTable {
         &self.q
@@ -153,6 +148,12 @@ impl QLearner {
     /// The settings.
     pub fn config(&self) -> &LearnConfig {
         &self.config
+    }
+
+    /// The reward signal (Eval, or Eval' for the collision rewards) of the
+    /// world after the last step.
+    pub fn signal(&self) -> f64 {
+        self.last_signal
     }
 }
 
@@ -169,24 +170,76 @@ impl Controller for QLearner {
     }
 
     fn wants_eval_every_step(&self) -> bool {
-        self.learning
+        true
     }
 
-    fn episode_start(&mut self, world: &World, field: &ScalarField, config: &SimConfig) {
-        self.last_signal = Some(self.config.reward.signal(world, field, config, None));
+    fn episode_start(&mut self, start: &EpisodeStart<'_>) {
+        self.last_signal = self.config.reward.signal(start.world, start.field, start.config, None);
     }
 
     fn observe(&mut self, outcome: &StepOutcome<'_>) {
-        if !self.learning {
-            return;
-        }
         let signal = self.config.reward.signal(outcome.world, outcome.field, outcome.config, outcome.eval);
-        let reward = self.config.reward.reward(self.last_signal.unwrap_or(signal), signal);
+        let reward = self.config.reward.reward(self.last_signal, signal);
         let hasher = self.q.hasher();
         let params = self.config.params();
         for (&(s, a), reading) in self.chosen.iter().zip(outcome.readings) {
             self.q.update(s, a, reward, hasher.hash(reading), params);
         }
-        self.last_signal = Some(signal);
+        self.last_signal = signal;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
+    use rand::SeedableRng;
+    use shared::{PolicyTable, SensorReading};
+
+    /// Two robots in the same state take the same action and reach the
+    /// same state: the second update sees the first.
+    #[test]
+    fn updates_are_applied_in_robot_order_each_seeing_the_last() {
+        let config = SimConfig::default();
+        let robots = [(Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie), (Vec2::new(300.0, 300.0), 0.0, RobotKind::Outie)];
+        let world = World::scene(&config, &robots, &[], 1);
+        let field = ScalarField::annulus();
+        let mut policy = PolicyTable::new(StateHasher::Original);
+        let reading = SensorReading { puck_left: true, ..SensorReading::default() };
+        let s = StateHasher::Original.hash(&reading);
+        policy.set(s, ActionId(0));
+        let learn = LearnConfig::default();
+        let mut learner = QLearner::with_table(learn.clone(), QTable::from_policy(&policy, 4, 1.0)).unwrap();
+
+        // no pucks: Eval stays 1, so the reference reward is 0 - 1 = -1
+        learner.episode_start(&EpisodeStart { world: &world, field: &field, config: &config });
+        let readings = [reading; 2];
+        let mut turns = [0.0; 2];
+        let perception = Perception { readings: &readings, robots: world.robots(), episode_step: 0 };
+        learner.decide(&perception, &mut turns, &mut SimRng::seed_from_u64(1));
+        assert_eq!(turns, [learn.actions[0]; 2]);
+        learner.observe(&StepOutcome {
+            episode_step: 1,
+            eval: Some(1.0),
+            end: None,
+            robot_contacts: 0,
+            world: &world,
+            field: &field,
+            config: &config,
+            readings: &readings,
+        });
+        // first: 2 + 0.2 (-1 + 0.9 x 2 - 2) = 1.76; second sees it:
+        // 1.76 + 0.2 (-1 + 0.9 x 1.76 - 1.76) = 1.5248
+        let q = learner.table();
+        assert!((q.value(s, ActionId(0)) - 1.5248).abs() < 1e-12, "{}", q.value(s, ActionId(0)));
+        assert_eq!(q.visits(s, ActionId(0)), 2);
+        assert_eq!(learner.signal(), 1.0);
+    }
+
+    #[test]
+    fn a_seed_table_of_another_shape_is_refused() {
+        let q = QTable::new(StateHasher::Bits9, 4, 1.0);
+        let e = QLearner::with_table(LearnConfig::default(), q).unwrap_err().to_string();
+        assert!(e.contains("bits9") && e.contains("original"), "{e}");
     }
 }

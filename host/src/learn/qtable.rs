@@ -16,6 +16,10 @@ pub struct QTable {
     visits: Vec<u64>,
 }
 
+/// How much a policy's action is preferred in [`QTable::from_policy`]:
+/// enough to win every greedy choice until learning says otherwise.
+pub const POLICY_PREFERENCE: f64 = 1.0;
+
 /// Learning-rate and discount of the Q-update.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct QParams {
@@ -117,6 +121,19 @@ impl QTable {
         table
     }
 
+    /// A table that acts like a greedy policy: every value `initial`, plus
+    /// [`POLICY_PREFERENCE`] on each state's policy action, no visits. Used
+    /// to start learning from a policy blob, which carries no Q-values.
+    pub fn from_policy(policy: &PolicyTable, actions: usize, initial: f64) -> QTable {
+        let mut q = QTable::new(policy.hasher(), actions, initial);
+        for (state, action) in policy.entries() {
+            if action.index() < actions {
+                q.values[state.index() * actions + action.index()] += POLICY_PREFERENCE;
+            }
+        }
+        q
+    }
+
     /// Whether another table has the same shape (hasher and action count),
     /// so that its values can seed this run.
     pub fn same_shape(&self, other: &QTable) -> bool {
@@ -169,6 +186,18 @@ mod tests {
         for c in counts {
             assert!((c as i64 - 10_000).abs() < 435, "{counts:?}");
         }
+    }
+
+    #[test]
+    fn a_table_from_a_policy_acts_like_it() {
+        let mut policy = PolicyTable::new(StateHasher::Bits7);
+        policy.set(State(5), ActionId(3));
+        let q = QTable::from_policy(&policy, 4, 1.0);
+        let mut rng = Pcg64Mcg::seed_from_u64(1);
+        assert_eq!(q.greedy(State(5), &mut rng), ActionId(3));
+        assert_eq!(q.greedy(State(6), &mut rng), ActionId(0));
+        assert_eq!(q.greedy_policy(), policy);
+        assert_eq!(q.states_visited(), 0);
     }
 
     #[test]

@@ -31,7 +31,7 @@ pub use field::{FieldError, FieldSource, ScalarField};
 pub use letters::Letter;
 pub use robot_sensors::{RobotObservation, RobotSensorConfig, RobotSensors};
 pub use sensors::{DiscSensorConfig, DiscSensors, Footprint, FootprintKind, ObstacleTargets, SensorDisc, SensorModel};
-pub use simulation::{EpisodeEnd, Simulation, SimulationState, StepOutcome, Totals};
+pub use simulation::{EpisodeEnd, EpisodeStart, Simulation, SimulationState, StepOutcome, Totals};
 pub use vec2::Vec2;
 pub use world::{World, WorldState};
 

@@ -1,5 +1,11 @@
-//! The step loop: sense, decide, act, step physics, evaluate, and end and
+//! The step loop: decide, act, step physics, sense, evaluate, and end and
 //! reset episodes.
+//!
+//! Sensing happens once per step, after physics: the readings a step's
+//! controller sees after acting (s' of a learner's update) are exactly the
+//! ones the next step decides on. Only an episode reset senses again, so
+//! that the first decision of an episode sees the fresh world; s' of an
+//! episode's last step is still the pre-reset world's.
 //!
 //! [`Simulation`] owns the world, the field (shared, read-only), the sensor
 //! model and the counters; the controller is passed to each call so the
@@ -47,6 +53,23 @@ pub struct StepOutcome<'a> {
     pub world: &'a World,
     /// The field.
     pub field: &'a ScalarField,
+    /// The settings (thresholds, Eval' weights).
+    pub config: &'a SimConfig,
+    /// Every robot's reading sensed after the step (before any reset): the
+    /// states the robots reached.
+    pub readings: &'a [SensorReading],
+}
+
+/// The fresh world of an episode, shown to the controller before its first
+/// decision (for example to reset a reward's baseline).
+#[derive(Clone, Copy, Debug)]
+pub struct EpisodeStart<'a> {
+    /// The world at the episode's start.
+    pub world: &'a World,
+    /// The field.
+    pub field: &'a ScalarField,
+    /// The settings.
+    pub config: &'a SimConfig,
 }
 
 /// Counters over the simulation's life.
@@ -99,6 +122,9 @@ pub struct SimulationState {
     pub episode_step: u64,
     /// Counters.
     pub totals: Totals,
+    /// Every robot's current reading, which the next decision uses (sensed
+    /// after the last step, or after the last reset).
+    pub readings: Vec<SensorReading>,
 }
 
 /// A running simulation with sensor model `S`.
@@ -107,7 +133,6 @@ pub struct Simulation<S: SensorModel = DiscSensors> {
     field: Arc<ScalarField>,
     sensors: S,
     evaluation: EvalTracker,
-    readings: Vec<SensorReading>,
     turns: Vec<f32>,
 }
 
@@ -129,22 +154,22 @@ impl<S: SensorModel> Simulation<S> {
     pub fn with_sensors(config: SimConfig, field: Arc<ScalarField>, sensors: S, seed: u64) -> Result<Self, ConfigError> {
         let world = World::new(&config, seed)?;
         let controller_rng = SimRng::seed_from_u64(seed.wrapping_add(CONTROLLER_STREAM));
-        let state = SimulationState { config, world, controller_rng, episode_step: 0, totals: Totals::default() };
+        let state =
+            SimulationState { config, world, controller_rng, episode_step: 0, totals: Totals::default(), readings: Vec::new() };
         Ok(Simulation::resume(state, field, sensors))
     }
 
-    /// Continues from a saved state.
-    pub fn resume(state: SimulationState, field: Arc<ScalarField>, sensors: S) -> Self {
+    /// Continues from a saved state. Its readings are used as saved; a
+    /// state without one reading per robot (a fresh or hand-made one) is
+    /// sensed first.
+    pub fn resume(mut state: SimulationState, field: Arc<ScalarField>, mut sensors: S) -> Self {
         let robots = state.world.robots().len();
-        let evaluation = EvalTracker::new(&state.world, &field, &state.config.thresholds);
-        Simulation {
-            state,
-            field,
-            sensors,
-            evaluation,
-            readings: vec![SensorReading::default(); robots],
-            turns: vec![0.0; robots],
+        if state.readings.len() != robots {
+            state.readings = vec![SensorReading::default(); robots];
+            sensors.sense(&state.world, &field, &mut state.readings);
         }
+        let evaluation = EvalTracker::new(&state.world, &field, &state.config.thresholds);
+        Simulation { state, field, sensors, evaluation, turns: vec![0.0; robots] }
     }
 
     /// The state to save for a bit-exact resume.
@@ -177,9 +202,10 @@ impl<S: SensorModel> Simulation<S> {
         &self.state.totals
     }
 
-    /// The readings of the last step's sensing.
+    /// The readings the next decision uses: sensed after the last step
+    /// (or the last reset).
     pub fn readings(&self) -> &[SensorReading] {
-        &self.readings
+        &self.state.readings
     }
 
     /// Eval of the current world.
@@ -187,15 +213,19 @@ impl<S: SensorModel> Simulation<S> {
         eval(&self.state.world, &self.field, &self.state.config.thresholds)
     }
 
-    /// One step: sense, decide, turn and move, evaluate, report to the
-    /// controller, and reset the world if the episode ended. Returns how the
-    /// episode ended, if it did.
+    /// One step: announce a new episode to the controller, decide on the
+    /// current readings, turn and move, sense, evaluate, report to the
+    /// controller, and reset (and re-sense) the world if the episode ended.
+    /// Returns how the episode ended, if it did.
     pub fn step<C: Controller + ?Sized>(&mut self, controller: &mut C) -> Option<EpisodeEnd> {
         let s = &mut self.state;
-        self.sensors.sense(&s.world, &self.field, &mut self.readings);
-        let perception = Perception { readings: &self.readings, robots: s.world.robots(), episode_step: s.episode_step };
+        if s.episode_step == 0 {
+            controller.episode_start(&EpisodeStart { world: &s.world, field: &self.field, config: &s.config });
+        }
+        let perception = Perception { readings: &s.readings, robots: s.world.robots(), episode_step: s.episode_step };
         controller.decide(&perception, &mut self.turns, &mut s.controller_rng);
         s.world.step(&self.turns);
+        self.sensors.sense(&s.world, &self.field, &mut s.readings);
         s.episode_step += 1;
 
         let episode = &s.config.episode;
@@ -225,6 +255,8 @@ impl<S: SensorModel> Simulation<S> {
             robot_contacts,
             world: &s.world,
             field: &self.field,
+            config: &s.config,
+            readings: &s.readings,
         });
         match end {
             Some(EpisodeEnd::Formed) => s.totals.formations += 1,
@@ -235,6 +267,7 @@ impl<S: SensorModel> Simulation<S> {
             s.world.reset();
             s.episode_step = 0;
             self.evaluation.rebuild(&s.world, &self.field, &s.config.thresholds);
+            self.sensors.sense(&s.world, &self.field, &mut s.readings);
         }
         end
     }

@@ -1,0 +1,197 @@
+//! Running an experiment: pre-trainings, then trials, in parallel (rayon),
+//! each result written atomically when it finishes and skipped on a rerun
+//! when its stored config hash matches; then the reports.
+//!
+//! Layout of the output directory:
+//! - `pretrained/<hash>.ckpt`: pre-trained tables (checkpoints);
+//! - `trials/<arm>/trial-<NN>.json`: one [`TrialResult`] per trial;
+//! - `trials.csv`, `trials.json`, `table.md` and the PNG figures.
+
+use super::outputs;
+use super::plan::{plans, PretrainPlan, TrialPlan};
+use super::spec::ExperimentSpec;
+use super::trial::{self, TrialResult, RESULT_FORMAT};
+use crate::train::checkpoint;
+use anyhow::{bail, Context, Result};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+/// How to run an experiment (`host experiment` options).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunOptions {
+    /// Trials per arm.
+    pub trials: usize,
+    /// Fraction of the file's step counts (runs and pre-trainings).
+    pub scale: f64,
+    /// Output directory; `None` for `out/experiments/<name>`.
+    pub out: Option<PathBuf>,
+    /// Experiment seed; `None` for the file's.
+    pub seed: Option<u64>,
+    /// Worker threads; `None` for one per core.
+    pub threads: Option<usize>,
+}
+
+impl Default for RunOptions {
+    /// 10 trials at full scale, the default directory, seed and threads.
+    fn default() -> RunOptions {
+        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None }
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunReport {
+    /// The output directory.
+    pub dir: PathBuf,
+    /// Trials run now.
+    pub trials_run: usize,
+    /// Trials found finished and skipped.
+    pub trials_skipped: usize,
+    /// Pre-trainings run now.
+    pub pretrained_run: usize,
+    /// Pre-trainings found finished and skipped.
+    pub pretrained_skipped: usize,
+    /// The report files written.
+    pub outputs: Vec<PathBuf>,
+    /// Wall time of the whole run.
+    pub seconds: f64,
+}
+
+/// A file name for an arm: its name with anything but letters, digits,
+/// `-` and `_` replaced by `_`.
+pub fn slug(name: &str) -> String {
+    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+}
+
+/// Runs the experiment; `log` receives progress lines (from any thread).
+pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: &(dyn Fn(&str) + Sync)) -> Result<RunReport> {
+    if options.trials == 0 {
+        bail!("--trials 0: at least one trial is needed");
+    }
+    if !(options.scale.is_finite() && options.scale > 0.0) {
+        bail!("--scale {}: must be a positive number", options.scale);
+    }
+    let mut slugs = BTreeMap::new();
+    for arm in &spec.arms {
+        if let Some(other) = slugs.insert(slug(&arm.name), &arm.name) {
+            bail!("arms {other:?} and {:?} would share the directory trials/{}", arm.name, slug(&arm.name));
+        }
+    }
+    let started = Instant::now();
+    let dir = options.out.clone().unwrap_or_else(|| Path::new("out/experiments").join(&spec.name));
+    let seed = options.seed.unwrap_or(spec.seed);
+    let plans = plans(spec, options.trials, options.scale, seed);
+    log(&format!(
+        "experiment {}: {} arms x {} trials, scale {}, seed {seed}, writing to {}",
+        spec.name,
+        spec.arms.len(),
+        options.trials,
+        options.scale,
+        dir.display()
+    ));
+    let pool = match options.threads {
+        Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n).build().context("cannot start worker threads")?),
+        None => None,
+    };
+    let in_pool = |job: &(dyn Fn() -> Result<()> + Sync)| match &pool {
+        Some(p) => p.install(job),
+        None => job(),
+    };
+
+    // Pre-trainings, each distinct one once.
+    let mut distinct: BTreeMap<&str, &PretrainPlan> = BTreeMap::new();
+    for p in plans.iter().filter_map(|p| p.pretrain.as_ref()) {
+        distinct.insert(&p.hash, p);
+    }
+    let (pre_done, pre_todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) =
+        distinct.values().partition(|p| pretrained_table(&dir, p).is_ok());
+    if !distinct.is_empty() {
+        log(&format!("pre-training: {} tables, {} already done (skipped)", distinct.len(), pre_done.len()));
+    }
+    let count = AtomicUsize::new(0);
+    in_pool(&|| {
+        pre_todo.par_iter().try_for_each(|p| {
+            let t = trial::pretrain(&p.config)?;
+            checkpoint::save(&pretrained_path(&dir, p), &t.state())?;
+            let k = count.fetch_add(1, Ordering::Relaxed) + 1;
+            log(&format!("[{k}/{}] pre-trained {} steps: {} formations", pre_todo.len(), p.config.steps, t.totals().formations));
+            Ok(())
+        })
+    })?;
+
+    // Trials.
+    let mut results: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
+    let todo: Vec<usize> = (0..plans.len()).filter(|&i| results[i].is_none()).collect();
+    log(&format!("trials: {}, {} already done (skipped)", plans.len(), plans.len() - todo.len()));
+    let count = AtomicUsize::new(0);
+    let fresh = std::sync::Mutex::new(Vec::new());
+    in_pool(&|| {
+        todo.par_iter().try_for_each(|&i| {
+            let plan = &plans[i];
+            let seed_table = match &plan.pretrain {
+                Some(p) => Some(pretrained_table(&dir, p)?),
+                None => None,
+            };
+            let result = trial::run(plan, seed_table).with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
+            let path = trial_path(&dir, plan);
+            let json = serde_json::to_vec_pretty(&result).context("cannot encode a trial result")?;
+            crate::atomic::write(&path, &json)?;
+            let k = count.fetch_add(1, Ordering::Relaxed) + 1;
+            log(&format!(
+                "[{k}/{}] {} trial {}: {} formations, {} stuck, {} steps at {:.0} steps/s",
+                todo.len(),
+                plan.arm,
+                plan.trial,
+                result.formations,
+                result.stuck,
+                result.steps,
+                result.steps_per_second
+            ));
+            if let Ok(mut f) = fresh.lock() {
+                f.push((i, result));
+            }
+            Ok(())
+        })
+    })?;
+    for (i, r) in fresh.into_inner().unwrap_or_default() {
+        results[i] = Some(r);
+    }
+    let results: Vec<TrialResult> = results.into_iter().flatten().collect();
+    let outputs = outputs::write(spec, &dir, &results, options.scale, seed)?;
+    Ok(RunReport {
+        dir,
+        trials_run: todo.len(),
+        trials_skipped: plans.len() - todo.len(),
+        pretrained_run: pre_todo.len(),
+        pretrained_skipped: pre_done.len(),
+        outputs,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {
+    dir.join("pretrained").join(format!("{}.ckpt", p.hash))
+}
+
+/// The stored pre-trained table, if it exists and is for this plan.
+fn pretrained_table(dir: &Path, p: &PretrainPlan) -> Result<crate::learn::QTable> {
+    let state = checkpoint::load(&pretrained_path(dir, p))?;
+    if state.config != p.config {
+        bail!("pre-trained table {} has other settings", pretrained_path(dir, p).display());
+    }
+    Ok(state.learner.table().clone())
+}
+
+fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
+    dir.join("trials").join(slug(&plan.arm)).join(format!("trial-{:02}.json", plan.trial))
+}
+
+/// The stored result of a trial, if it exists and its hash matches.
+fn finished(dir: &Path, plan: &TrialPlan) -> Option<TrialResult> {
+    let bytes = std::fs::read(trial_path(dir, plan)).ok()?;
+    let r: TrialResult = serde_json::from_slice(&bytes).ok()?;
+    (r.format == RESULT_FORMAT && r.config_hash == plan.hash).then_some(r)
+}

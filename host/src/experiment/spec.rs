@@ -1,0 +1,374 @@
+//! Experiment files: what an experiment compares (its arms), how its table
+//! and figures are laid out, and the thesis' figures to show beside ours.
+//!
+//! An arm is a [`TrainConfig`]: the file's `[defaults]` table with the
+//! arm's own keys merged over it (nested tables such as `learn` key by
+//! key), plus the arm-only keys `name`, `row`, `column`, `controller`,
+//! `pretrain` and `thesis`. See docs/training.md for the format.
+
+use super::metric::Metric;
+use crate::train::TrainConfig;
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// The experiments shipped in `experiments/`, built into the binary so that
+/// `host experiment NAME` works from any directory.
+pub const BUILT_IN: [(&str, &str); 6] = [
+    ("annulus", include_str!("../../../experiments/annulus.toml")),
+    ("transfer", include_str!("../../../experiments/transfer.toml")),
+    ("letters", include_str!("../../../experiments/letters.toml")),
+    ("state-bits", include_str!("../../../experiments/state-bits.toml")),
+    ("obstacle", include_str!("../../../experiments/obstacle.toml")),
+    ("collisions", include_str!("../../../experiments/collisions.toml")),
+];
+
+/// A parsed experiment file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExperimentSpec {
+    /// Short name (the file stem): names the output directory.
+    pub name: String,
+    /// Heading of the report.
+    pub title: String,
+    /// Which thesis table or figures it reproduces.
+    pub thesis: String,
+    /// The experiment seed every trial seed derives from.
+    pub seed: u64,
+    /// Points of the formations-over-time curves.
+    pub sample_points: usize,
+    /// The results table.
+    pub table: TableSpec,
+    /// The arms, in file order.
+    pub arms: Vec<ArmSpec>,
+    /// The charts.
+    pub figures: Vec<FigureSpec>,
+}
+
+/// How the markdown table is laid out: one line per distinct `row`, one
+/// group of columns per distinct `column`, one column per metric (ours,
+/// then the thesis' where it has one).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TableSpec {
+    /// Caption under the table.
+    pub caption: String,
+    /// Header of the row-label column.
+    pub row_header: String,
+    /// The metrics shown.
+    pub metrics: Vec<Metric>,
+    /// The arm that `formations_ratio` divides by.
+    pub ratio_to: Option<String>,
+}
+
+impl Default for TableSpec {
+    fn default() -> TableSpec {
+        TableSpec {
+            caption: String::new(),
+            row_header: "Arm".into(),
+            metrics: vec![Metric::Formations, Metric::Stuck],
+            ratio_to: None,
+        }
+    }
+}
+
+/// Which controller an arm runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ArmController {
+    /// Orbital construction, innies on fields with a cavity.
+    Oc,
+    /// Q-learning, on-line from the first step.
+    Learn,
+}
+
+impl ArmController {
+    /// The name in experiment files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ArmController::Oc => "oc",
+            ArmController::Learn => "learn",
+        }
+    }
+}
+
+/// A Q-table trained before the arm's run, which the run starts from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PretrainSpec {
+    /// Steps of pre-training.
+    pub steps: u64,
+    /// Robots during pre-training; `None` for the arm's count.
+    pub robots: Option<usize>,
+}
+
+/// One arm: a controller on a configuration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArmSpec {
+    /// Unique name, used in outputs and seeds.
+    pub name: String,
+    /// Table row label.
+    pub row: String,
+    /// Table column group label.
+    pub column: String,
+    /// The controller.
+    pub controller: ArmController,
+    /// The run (seed and output keys are set per trial).
+    pub config: TrainConfig,
+    /// Pre-training (`learn` arms only).
+    pub pretrain: Option<PretrainSpec>,
+    /// The thesis' values of this arm, by metric.
+    pub thesis: BTreeMap<Metric, f64>,
+}
+
+/// What a chart shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FigureKind {
+    /// Formations over time: mean and 95 % band per arm (Figure 15).
+    Formations,
+    /// Robot-robot collisions per 1000 steps with least-squares lines (Figure 24).
+    Collisions,
+}
+
+/// One chart.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FigureSpec {
+    /// PNG file name in the output directory.
+    pub file: String,
+    /// What it shows.
+    pub kind: FigureKind,
+    /// Title; `None` for a default.
+    #[serde(default)]
+    pub title: Option<String>,
+    /// Arms drawn, by name; empty for all.
+    #[serde(default)]
+    pub arms: Vec<String>,
+}
+
+/// The file as written, before arms are merged with the defaults.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExperimentFile {
+    title: String,
+    #[serde(default)]
+    thesis: String,
+    #[serde(default = "default_seed")]
+    seed: u64,
+    #[serde(default = "default_sample_points")]
+    sample_points: usize,
+    #[serde(default)]
+    table: TableSpec,
+    #[serde(default)]
+    defaults: toml::Table,
+    arms: Vec<toml::Table>,
+    #[serde(default)]
+    figures: Vec<FigureSpec>,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+
+fn default_sample_points() -> usize {
+    100
+}
+
+/// The arm-only keys.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ArmKeys {
+    name: String,
+    row: Option<String>,
+    #[serde(default)]
+    column: String,
+    #[serde(default = "default_controller")]
+    controller: ArmController,
+    pretrain: Option<PretrainSpec>,
+    #[serde(default)]
+    thesis: BTreeMap<Metric, f64>,
+}
+
+fn default_controller() -> ArmController {
+    ArmController::Learn
+}
+
+const ARM_KEYS: [&str; 6] = ["name", "row", "column", "controller", "pretrain", "thesis"];
+
+impl ExperimentSpec {
+    /// A built-in experiment by name, or a file by path.
+    pub fn load(name_or_path: &str) -> Result<ExperimentSpec> {
+        if let Some((name, text)) = BUILT_IN.iter().find(|(n, _)| *n == name_or_path) {
+            return ExperimentSpec::parse(name, text).with_context(|| format!("built-in experiment {name}"));
+        }
+        let path = Path::new(name_or_path);
+        if !path.exists() && !name_or_path.contains(['/', '.']) {
+            let names: Vec<&str> = BUILT_IN.iter().map(|(n, _)| *n).collect();
+            bail!("unknown experiment {name_or_path:?}: expected one of {} or a path to a TOML file", names.join(", "));
+        }
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read experiment file {}", path.display()))?;
+        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "experiment".into());
+        ExperimentSpec::parse(&stem, &text).with_context(|| format!("experiment file {}", path.display()))
+    }
+
+    /// Parses an experiment's TOML text; errors name the line or the arm.
+    pub fn parse(name: &str, text: &str) -> Result<ExperimentSpec> {
+        let file: ExperimentFile = toml::from_str(text)?;
+        if file.arms.is_empty() {
+            bail!("no [[arms]]");
+        }
+        if file.defaults.contains_key("output") {
+            bail!("[defaults]: output settings are chosen by the experiment runner");
+        }
+        let mut arms: Vec<ArmSpec> = Vec::new();
+        for (i, table) in file.arms.into_iter().enumerate() {
+            let arm = arm(&file.defaults, table).with_context(|| format!("arm {}", i + 1))?;
+            if arms.iter().any(|a| a.name == arm.name) {
+                bail!("two arms are named {:?}", arm.name);
+            }
+            if let Some(other) = arms.iter().find(|a| a.row == arm.row && a.column == arm.column) {
+                bail!("arms {:?} and {:?} share the table cell (row {:?}, column {:?})", other.name, arm.name, arm.row, arm.column);
+            }
+            arms.push(arm);
+        }
+        let known = |n: &String| arms.iter().any(|a| &a.name == n);
+        if let Some(r) = file.table.ratio_to.as_ref().filter(|r| !known(r)) {
+            bail!("[table] ratio_to = {r:?} is not an arm");
+        }
+        for f in &file.figures {
+            if let Some(n) = f.arms.iter().find(|n| !known(n)) {
+                bail!("figure {}: {n:?} is not an arm", f.file);
+            }
+        }
+        let figures = if file.figures.is_empty() {
+            vec![
+                FigureSpec { file: "formations.png".into(), kind: FigureKind::Formations, title: None, arms: vec![] },
+                FigureSpec { file: "collisions.png".into(), kind: FigureKind::Collisions, title: None, arms: vec![] },
+            ]
+        } else {
+            file.figures
+        };
+        Ok(ExperimentSpec {
+            name: name.to_string(),
+            title: file.title,
+            thesis: file.thesis,
+            seed: file.seed,
+            sample_points: file.sample_points.max(2),
+            table: file.table,
+            arms,
+            figures,
+        })
+    }
+
+    /// The arm of that name.
+    pub fn arm(&self, name: &str) -> Option<&ArmSpec> {
+        self.arms.iter().find(|a| a.name == name)
+    }
+}
+
+/// One arm: its own keys, and the rest merged over the defaults.
+fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
+    let mut own = toml::Table::new();
+    for key in ARM_KEYS {
+        if let Some(v) = table.remove(key) {
+            own.insert(key.to_string(), v);
+        }
+    }
+    let keys: ArmKeys = toml::Value::Table(own).try_into()?;
+    let context = || format!("arm {:?}", keys.name);
+    if table.contains_key("output") {
+        bail!("{}: output settings are chosen by the experiment runner", context());
+    }
+    let mut merged = defaults.clone();
+    merge(&mut merged, table);
+    let config: TrainConfig = toml::Value::Table(merged).try_into().with_context(context)?;
+    config.validate().with_context(context)?;
+    if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
+        bail!("{}: only learning arms can be pre-trained", context());
+    }
+    Ok(ArmSpec {
+        row: keys.row.unwrap_or_else(|| keys.name.clone()),
+        name: keys.name,
+        column: keys.column,
+        controller: keys.controller,
+        config,
+        pretrain: keys.pretrain,
+        thesis: keys.thesis,
+    })
+}
+
+/// Writes `over` into `base`, merging nested tables key by key.
+fn merge(base: &mut toml::Table, over: toml::Table) {
+    for (key, value) in over {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FILE: &str = r#"
+title = "t"
+[table]
+metrics = ["formations", "formations_ratio"]
+ratio_to = "A"
+[defaults]
+robots = 4
+[defaults.learn]
+alpha = 0.3
+gamma = 0.5
+[[arms]]
+name = "A"
+controller = "oc"
+thesis = { formations = 12.5 }
+[[arms]]
+name = "B"
+row = "b"
+robots = 2
+pretrain = { steps = 100, robots = 1 }
+[arms.learn]
+alpha = 0.1
+"#;
+
+    #[test]
+    fn arms_merge_over_the_defaults_key_by_key() {
+        let spec = ExperimentSpec::parse("x", FILE).unwrap();
+        let (a, b) = (&spec.arms[0], &spec.arms[1]);
+        assert_eq!((a.controller, a.config.robots, a.row.as_str()), (ArmController::Oc, 4, "A"));
+        assert_eq!(a.thesis[&Metric::Formations], 12.5);
+        assert_eq!((b.config.robots, b.config.learn.alpha, b.config.learn.gamma), (2, 0.1, 0.5));
+        assert_eq!(b.pretrain, Some(PretrainSpec { steps: 100, robots: Some(1) }));
+        assert_eq!(spec.figures.len(), 2, "default figures");
+    }
+
+    #[test]
+    fn mistakes_are_named() {
+        let e = |text: &str| format!("{:#}", ExperimentSpec::parse("x", text).unwrap_err());
+        let typo = FILE.replace("robots = 2", "robts = 2");
+        assert!(e(&typo).contains("arm \"B\"") && e(&typo).contains("robts"), "{}", e(&typo));
+        let bad = FILE.replace("ratio_to = \"A\"", "ratio_to = \"Z\"");
+        assert!(e(&bad).contains("\"Z\" is not an arm"));
+        let syntax = FILE.replace("[table]", "[table");
+        assert!(e(&syntax).contains("line 3"), "{}", e(&syntax));
+        let metric = FILE.replace("\"formations_ratio\"", "\"speed\"");
+        assert!(e(&metric).contains("speed"), "{}", e(&metric));
+        let range = FILE.replace("alpha = 0.1", "alpha = 3.0");
+        assert!(e(&range).contains("learn.alpha = 3"), "{}", e(&range));
+    }
+
+    #[test]
+    fn every_built_in_experiment_parses() {
+        for (name, text) in BUILT_IN {
+            let spec = ExperimentSpec::parse(name, text).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+            assert!(!spec.arms.is_empty());
+        }
+    }
+}

@@ -1,0 +1,137 @@
+//! One trial: an arm's controller on its configuration for its steps, with
+//! what the reports need recorded on the way.
+
+use super::plan::TrialPlan;
+use super::spec::ArmController;
+use crate::controller::{OrbitalConfig, OrbitalConstruction};
+use crate::learn::QTable;
+use crate::scenario::orbital_innies;
+use crate::sim::{EpisodeEnd, Simulation, Totals};
+use crate::train::{TrainConfig, Trainer};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Version of [`TrialResult`]'s layout and meaning; part of the config
+/// hash, so results of another version are re-run, not mixed in.
+pub const RESULT_FORMAT: u32 = 1;
+
+/// Steps per collision block (the thesis' chapter 6 metric).
+pub const BLOCK_STEPS: u64 = 1000;
+
+/// Everything recorded about one finished trial (one JSON file).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrialResult {
+    /// [`RESULT_FORMAT`].
+    pub format: u32,
+    /// Hash of everything that determines the trial (see `plan`).
+    pub config_hash: String,
+    /// The experiment's name.
+    pub experiment: String,
+    /// The arm's name.
+    pub arm: String,
+    /// Trial index, from 0.
+    pub trial: usize,
+    /// The trial's seed.
+    pub seed: u64,
+    /// Steps run.
+    pub steps: u64,
+    /// Episodes that formed the shape.
+    pub formations: u64,
+    /// Episodes reset at the stuck limit.
+    pub stuck: u64,
+    /// The step (from 1) at which each formation happened.
+    pub formation_steps: Vec<u64>,
+    /// Robot-robot contacts per 1000 steps over the whole trial.
+    pub collisions_per_1000: f64,
+    /// Robot-robot contacts in each full block of [`BLOCK_STEPS`] steps.
+    pub collisions_per_block: Vec<u64>,
+    /// States of the Q-table with at least one update at the end
+    /// (learning arms; pre-training included).
+    pub states_visited: Option<usize>,
+    /// States of the hasher (learning arms).
+    pub states_total: Option<usize>,
+    /// Speed of the trial's run (pre-training excluded).
+    pub steps_per_second: f64,
+    /// Wall time of the trial's run.
+    pub seconds: f64,
+}
+
+/// Follows a run step by step: formation times and collision blocks.
+#[derive(Clone, Debug, Default)]
+struct Recorder {
+    formation_steps: Vec<u64>,
+    collisions_per_block: Vec<u64>,
+    contacts_at_block_start: u64,
+}
+
+impl Recorder {
+    fn after_step(&mut self, end: Option<EpisodeEnd>, totals: &Totals) {
+        if end == Some(EpisodeEnd::Formed) {
+            self.formation_steps.push(totals.steps);
+        }
+        if totals.steps % BLOCK_STEPS == 0 {
+            self.collisions_per_block.push(totals.robot_contacts - self.contacts_at_block_start);
+            self.contacts_at_block_start = totals.robot_contacts;
+        }
+    }
+}
+
+/// Runs a trial; `seed_table` is the pre-trained table of a pre-trained arm.
+pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> {
+    let c = &plan.config;
+    let field = Arc::new(c.field.load()?);
+    let mut recorder = Recorder::default();
+    let start = Instant::now();
+    let (totals, states) = match plan.controller {
+        ArmController::Oc => {
+            let mut config = c.sim_config();
+            config.world.innies = orbital_innies(&c.field, c.robots);
+            let mut oc = OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds);
+            let sensors = c.sensors.build(&config)?;
+            let mut sim = Simulation::with_sensors(config, field, sensors, c.seed).context("invalid settings")?;
+            for _ in 0..c.steps {
+                let end = sim.step(&mut oc);
+                recorder.after_step(end, sim.totals());
+            }
+            (sim.totals().clone(), None)
+        }
+        ArmController::Learn => {
+            let mut trainer = Trainer::new(c.clone(), field.clone(), c.sensors.build(&c.sim_config())?, seed_table)?;
+            for _ in 0..c.steps {
+                let end = trainer.step();
+                recorder.after_step(end, trainer.totals());
+            }
+            let q = trainer.learner().table();
+            (trainer.totals().clone(), Some((q.states_visited(), q.hasher().num_states())))
+        }
+    };
+    let seconds = start.elapsed().as_secs_f64();
+    Ok(TrialResult {
+        format: RESULT_FORMAT,
+        config_hash: plan.hash.clone(),
+        experiment: plan.experiment.clone(),
+        arm: plan.arm.clone(),
+        trial: plan.trial,
+        seed: c.seed,
+        steps: totals.steps,
+        formations: totals.formations,
+        stuck: totals.stuck,
+        formation_steps: recorder.formation_steps,
+        collisions_per_1000: totals.collisions_per_1000(),
+        collisions_per_block: recorder.collisions_per_block,
+        states_visited: states.map(|s| s.0),
+        states_total: states.map(|s| s.1),
+        steps_per_second: if seconds > 0.0 { totals.steps as f64 / seconds } else { f64::INFINITY },
+        seconds,
+    })
+}
+
+/// Pre-trains a Q-table: a plain training run of `config`.
+pub fn pretrain(config: &TrainConfig) -> Result<Trainer<crate::sensor_choice::SelectedSensors>> {
+    let field = Arc::new(config.field.load()?);
+    let mut trainer = Trainer::new(config.clone(), field, config.sensors.build(&config.sim_config())?, None)?;
+    trainer.run(config.steps);
+    Ok(trainer)
+}

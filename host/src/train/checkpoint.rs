@@ -1,0 +1,155 @@
+//! The checkpoint file: a complete [`TrainingState`], from which training
+//! resumes bit for bit.
+//!
+//! Layout, format version 1 (integers little-endian):
+//!
+//! | offset | size | content                                              |
+//! |--------|------|------------------------------------------------------|
+//! | 0      | 8    | magic `ZSWMCKPT`                                     |
+//! | 8      | 2    | format version (1), u16                              |
+//! | 10     | 8    | body length `n`, u64                                 |
+//! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
+//! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
+//!
+//! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
+//! bit-exactly. Files are written atomically (temporary file, then rename):
+//! a run killed at any moment leaves the old checkpoint or the new one.
+
+use super::trainer::TrainingState;
+use anyhow::{Context, Result};
+use crc::{Crc, CRC_32_ISO_HDLC};
+use std::fmt;
+use std::io::Write;
+use std::path::Path;
+
+/// The first eight bytes of every checkpoint.
+pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
+/// The format version this build writes and reads.
+pub const VERSION: u16 = 1;
+const HEADER_LEN: usize = 18;
+const CRC_LEN: usize = 4;
+const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
+/// The policy blob's magic, recognised to say what the file is instead.
+const POLICY_MAGIC: &[u8; 4] = b"QPOL";
+
+/// Why bytes are not a checkpoint this build can resume from.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CheckpointError {
+    /// The input ends before the checkpoint does (a torn or cut file).
+    Truncated {
+        /// Bytes the checkpoint needs.
+        needed: u64,
+        /// Bytes there are.
+        found: u64,
+    },
+    /// The file is a policy blob, which holds no Q-values.
+    PolicyBlob,
+    /// The first bytes are not the checkpoint magic: some other file.
+    WrongMagic,
+    /// A format version this build does not read.
+    UnsupportedVersion(u16),
+    /// Bytes after the end the header declares.
+    TrailingBytes {
+        /// Length the header declares, CRC included.
+        expected: u64,
+        /// Length of the input.
+        found: u64,
+    },
+    /// The stored CRC does not match the content.
+    CrcMismatch {
+        /// CRC stored in the file.
+        stored: u32,
+        /// CRC of the content.
+        computed: u32,
+    },
+    /// The body does not decode as a training state.
+    Malformed(String),
+}
+
+impl fmt::Display for CheckpointError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CheckpointError::Truncated { needed, found } => {
+                write!(f, "checkpoint is truncated: {found} bytes, the checkpoint needs {needed}")
+            }
+            CheckpointError::PolicyBlob => f.write_str("this is a policy blob, not a checkpoint (it holds no Q-values)"),
+            CheckpointError::WrongMagic => f.write_str("not a checkpoint: the file does not start with ZSWMCKPT"),
+            CheckpointError::UnsupportedVersion(v) => {
+                write!(f, "checkpoint format version {v} is not supported (this build reads version {VERSION})")
+            }
+            CheckpointError::TrailingBytes { expected, found } => {
+                write!(f, "checkpoint has {found} bytes, {} more than its header declares", found - expected)
+            }
+            CheckpointError::CrcMismatch { stored, computed } => {
+                write!(f, "checkpoint is corrupt: CRC-32 is {computed:#010x}, the file says {stored:#010x}")
+            }
+            CheckpointError::Malformed(why) => write!(f, "checkpoint body does not decode: {why}"),
+        }
+    }
+}
+
+impl std::error::Error for CheckpointError {}
+
+/// Encodes a training state into `w`.
+pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
+    let body = postcard::to_stdvec(state).map_err(std::io::Error::other)?;
+    let mut head = Vec::with_capacity(HEADER_LEN);
+    head.extend_from_slice(&MAGIC);
+    head.extend_from_slice(&VERSION.to_le_bytes());
+    head.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    let mut digest = CRC32.digest();
+    digest.update(&head);
+    digest.update(&body);
+    w.write_all(&head)?;
+    w.write_all(&body)?;
+    w.write_all(&digest.finalize().to_le_bytes())
+}
+
+/// Decodes a checkpoint, checking in order: header length, magic, version,
+/// declared length, CRC, then the body.
+pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
+    let found = bytes.len() as u64;
+    if bytes.starts_with(POLICY_MAGIC) {
+        return Err(CheckpointError::PolicyBlob);
+    }
+    if bytes.len() < HEADER_LEN {
+        if !MAGIC.starts_with(bytes) {
+            return Err(CheckpointError::WrongMagic);
+        }
+        return Err(CheckpointError::Truncated { needed: HEADER_LEN as u64, found });
+    }
+    if bytes[..8] != MAGIC {
+        return Err(CheckpointError::WrongMagic);
+    }
+    let version = u16::from_le_bytes([bytes[8], bytes[9]]);
+    if version != VERSION {
+        return Err(CheckpointError::UnsupportedVersion(version));
+    }
+    let mut len = [0u8; 8];
+    len.copy_from_slice(&bytes[10..18]);
+    let needed = u64::from_le_bytes(len).saturating_add((HEADER_LEN + CRC_LEN) as u64);
+    if found < needed {
+        return Err(CheckpointError::Truncated { needed, found });
+    }
+    if found > needed {
+        return Err(CheckpointError::TrailingBytes { expected: needed, found });
+    }
+    let crc_at = bytes.len() - CRC_LEN;
+    let stored = u32::from_le_bytes([bytes[crc_at], bytes[crc_at + 1], bytes[crc_at + 2], bytes[crc_at + 3]]);
+    let computed = CRC32.checksum(&bytes[..crc_at]);
+    if stored != computed {
+        return Err(CheckpointError::CrcMismatch { stored, computed });
+    }
+    postcard::from_bytes(&bytes[HEADER_LEN..crc_at]).map_err(|e| CheckpointError::Malformed(e.to_string()))
+}
+
+/// Writes a checkpoint atomically.
+pub fn save(path: &Path, state: &TrainingState) -> Result<()> {
+    crate::atomic::write_with(path, |w| write_to(w, state))
+}
+
+/// Reads a checkpoint; errors name the file and what is wrong with it.
+pub fn load(path: &Path) -> Result<TrainingState> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read checkpoint {}", path.display()))?;
+    decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))
+}

@@ -1,0 +1,232 @@
+//! `host train`: settings from a file and flags, a new or resumed run with
+//! a progress bar, periodic atomic checkpoints, the policy blob, and a
+//! summary.
+
+use super::checkpoint;
+use super::config::{TrainConfig, TrainOverrides};
+use super::trainer::{Trainer, TrainingState};
+use crate::learn::QTable;
+use crate::sensor_choice::SelectedSensors;
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::fmt;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Steps between progress-bar updates.
+const PROGRESS_CHUNK: u64 = 20_000;
+
+/// The `host train` arguments.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct TrainArgs {
+    /// TOML file with any of the settings (docs/training.md); flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The settings flags.
+    #[command(flatten)]
+    pub overrides: TrainOverrides,
+    /// Steps to run [default: 2000000; when resuming, the checkpoint's run length].
+    #[arg(long)]
+    pub steps: Option<u64>,
+    /// Directory for <name>.policy and <name>.ckpt [default: out].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Name of the output files and of the policy [default: <field>-<hasher>].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Steps between checkpoints, 0 for only at the end [default: 1000000].
+    #[arg(long)]
+    pub checkpoint_every: Option<u64>,
+    /// Continue a run from its checkpoint, with its settings, for --steps more steps.
+    #[arg(long, conflicts_with_all = ["config", "init_from"])]
+    pub resume: Option<PathBuf>,
+    /// Start from the Q-table of a checkpoint (the thesis' RL2), or from a
+    /// policy blob (its actions preferred); hasher and actions must match.
+    #[arg(long)]
+    pub init_from: Option<PathBuf>,
+}
+
+/// What a training session did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TrainReport {
+    /// Steps run in this session.
+    pub steps: u64,
+    /// Steps since the run began (resumed sessions included).
+    pub total_steps: u64,
+    /// Formations since the run began.
+    pub formations: u64,
+    /// Stuck episodes since the run began.
+    pub stuck: u64,
+    /// Speed of this session.
+    pub steps_per_second: f64,
+    /// States with at least one update.
+    pub states_visited: usize,
+    /// States of the hasher.
+    pub states_total: usize,
+    /// The policy blob written.
+    pub policy: PathBuf,
+    /// The checkpoint written.
+    pub checkpoint: PathBuf,
+}
+
+impl fmt::Display for TrainReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "steps                {} (run total {})", self.steps, self.total_steps)?;
+        writeln!(f, "formations           {}", self.formations)?;
+        writeln!(f, "stuck episodes       {}", self.stuck)?;
+        writeln!(f, "steps per second     {:.0}", self.steps_per_second)?;
+        writeln!(f, "states visited       {} of {}", self.states_visited, self.states_total)?;
+        writeln!(f, "policy               {}", self.policy.display())?;
+        write!(f, "checkpoint           {}", self.checkpoint.display())
+    }
+}
+
+/// Runs `host train`.
+pub fn train(args: &TrainArgs) -> Result<TrainReport> {
+    let (mut trainer, steps) = match &args.resume {
+        Some(path) => resume(args, path)?,
+        None => start(args)?,
+    };
+    let out = trainer.output_mut();
+    if let Some(dir) = &args.out {
+        out.dir = dir.clone();
+    }
+    if let Some(name) = &args.name {
+        out.name = Some(name.clone());
+    }
+    if let Some(every) = args.checkpoint_every {
+        out.checkpoint_every = every;
+    }
+    trainer.config().validate()?;
+    run(&mut trainer, steps)
+}
+
+/// A new run from the config file, the flags and `--init-from`.
+fn start(args: &TrainArgs) -> Result<(Trainer<SelectedSensors>, u64)> {
+    let mut config = match &args.config {
+        Some(path) => TrainConfig::from_file(path)?,
+        None => TrainConfig::default(),
+    };
+    args.overrides.apply(&mut config);
+    if let Some(steps) = args.steps {
+        config.steps = steps;
+    }
+    config.validate()?;
+    let seed_table = args.init_from.as_deref().map(|path| seed_table(path, &config)).transpose()?;
+    let field = Arc::new(config.field.load()?);
+    let sensors = config.sensors.build(&config.sim_config())?;
+    let steps = config.steps;
+    Ok((Trainer::new(config, field, sensors, seed_table)?, steps))
+}
+
+/// A run continued from its checkpoint, with its own settings.
+fn resume(args: &TrainArgs, path: &Path) -> Result<(Trainer<SelectedSensors>, u64)> {
+    let given = args.overrides.given();
+    if !given.is_empty() {
+        bail!(
+            "--resume continues a run with the settings in its checkpoint; {} cannot change them",
+            given.join(", ")
+        );
+    }
+    let state = checkpoint::load(path)?;
+    let field = Arc::new(state.config.field.load()?);
+    let sensors = state.config.sensors.build(&state.sim.config)?;
+    let steps = args.steps.unwrap_or(state.config.steps);
+    let trainer = Trainer::resume(state, field, sensors).with_context(|| format!("cannot resume {}", path.display()))?;
+    Ok((trainer, steps))
+}
+
+/// The Q-table `--init-from` names: a checkpoint's, or one acting like a
+/// policy blob. Its hasher and actions must be the run's.
+pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let learn = &config.learn;
+    let (table, speeds) = if bytes.starts_with(b"QPOL") {
+        let blob = shared::PolicyBlob::decode(&bytes).map_err(|e| anyhow::anyhow!("policy file {}: {e}", path.display()))?;
+        let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
+        (q, Some(blob.actions().angular_speeds().to_vec()))
+    } else {
+        let state: TrainingState =
+            checkpoint::decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))?;
+        (state.learner.table().clone(), None)
+    };
+    let (hasher, actions) = (table.hasher(), table.num_actions());
+    if hasher != learn.hasher.0 || actions != learn.actions.len() {
+        bail!(
+            "{} was trained with hasher {hasher} and {actions} actions, but this run uses hasher {} and {} actions",
+            path.display(),
+            learn.hasher.0,
+            learn.actions.len()
+        );
+    }
+    if let Some(speeds) = speeds.filter(|s| s != &learn.actions) {
+        bail!("policy file {}: its actions {speeds:?} are not this run's {:?}", path.display(), learn.actions);
+    }
+    Ok(table)
+}
+
+/// Runs `steps` steps with a progress bar, checkpointing on the way, then
+/// writes the policy and the final checkpoint.
+fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport> {
+    let out = trainer.config().output.clone();
+    let name = trainer.config().name();
+    let policy_path = out.dir.join(format!("{name}.policy"));
+    let checkpoint_path = out.dir.join(format!("{name}.ckpt"));
+    let bar = progress_bar(steps);
+    let start = Instant::now();
+    let mut done = 0;
+    while done < steps {
+        let total = trainer.totals().steps;
+        let mut chunk = PROGRESS_CHUNK.min(steps - done);
+        if out.checkpoint_every > 0 {
+            chunk = chunk.min(out.checkpoint_every - total % out.checkpoint_every);
+        }
+        trainer.run(chunk);
+        done += chunk;
+        if out.checkpoint_every > 0 && trainer.totals().steps % out.checkpoint_every == 0 && done < steps {
+            checkpoint::save(&checkpoint_path, &trainer.state())?;
+        }
+        let t = trainer.totals();
+        bar.set_position(done);
+        bar.set_message(format!(
+            "formations {}  stuck {}  Eval {:.3}",
+            t.formations,
+            t.stuck,
+            trainer.learner().signal()
+        ));
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    checkpoint::save(&checkpoint_path, &trainer.state())?;
+    crate::policy_file::write(&policy_path, &trainer.policy()?)?;
+    let totals = trainer.totals();
+    let q = trainer.learner().table();
+    Ok(TrainReport {
+        steps,
+        total_steps: totals.steps,
+        formations: totals.formations,
+        stuck: totals.stuck,
+        steps_per_second: if seconds > 0.0 { steps as f64 / seconds } else { f64::INFINITY },
+        states_visited: q.states_visited(),
+        states_total: q.hasher().num_states(),
+        policy: policy_path,
+        checkpoint: checkpoint_path,
+    })
+}
+
+/// A bar on stderr with steps per second, hidden unless both stdout and
+/// stderr are terminals.
+fn progress_bar(steps: u64) -> ProgressBar {
+    let target = if std::io::stdout().is_terminal() && std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(steps), target);
+    if let Ok(style) = ProgressStyle::with_template("{bar:30} {percent:>3}%  {human_pos}/{human_len} steps  {per_sec}  {msg}") {
+        bar.set_style(style);
+    }
+    bar
+}

@@ -1,0 +1,273 @@
+//! What a training run is: [`TrainConfig`], read from a TOML file and/or
+//! the `host train` flags ([`TrainOverrides`]), flags winning.
+
+use crate::learn::{LearnConfig, Reward, StateHasherName};
+use crate::scenario::field_config;
+use crate::sensor_choice::SensorChoice;
+use crate::sim::{FieldSource, SimConfig};
+use anyhow::{bail, Context, Result};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// Steps `host train` runs by default: on the annulus with 8 robots and
+/// 250 pucks, about 13 s at 150,000 steps/s, forming dozens of shapes
+/// (see docs/training.md for the measurement).
+pub const DEFAULT_STEPS: u64 = 2_000_000;
+
+/// Steps between checkpoints by default.
+pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
+
+/// A training run: world, learner and outputs. Every key of a config file
+/// is optional; missing ones keep the defaults (the thesis' Table 1 run).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TrainConfig {
+    /// The field: `annulus`, `letter:T` or an image path.
+    pub field: FieldSource,
+    /// The robots' sensor model.
+    pub sensors: SensorChoice,
+    /// Number of robots.
+    pub robots: usize,
+    /// Number of pucks.
+    pub pucks: usize,
+    /// Steps to run.
+    pub steps: u64,
+    /// Seed of every random choice.
+    pub seed: u64,
+    /// Steps before an unformed episode counts as stuck; `None` for the
+    /// field's default (150,000 on the annulus, 50,000 otherwise).
+    pub stuck_limit: Option<u64>,
+    /// The learner.
+    pub learn: LearnConfig,
+    /// Where results go.
+    pub output: OutputConfig,
+}
+
+/// Where a training run writes, and how often it checkpoints.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OutputConfig {
+    /// Directory of `<name>.policy` and `<name>.ckpt`.
+    pub dir: PathBuf,
+    /// File name stem (at most 32 bytes, no path separators); `None` for
+    /// `<field>-<hasher>`, e.g. `annulus-original`.
+    pub name: Option<String>,
+    /// Steps between checkpoints (0: only at the end).
+    pub checkpoint_every: u64,
+}
+
+impl Default for OutputConfig {
+    /// `out/`, the derived name, a checkpoint every 1,000,000 steps.
+    fn default() -> OutputConfig {
+        OutputConfig { dir: PathBuf::from("out"), name: None, checkpoint_every: DEFAULT_CHECKPOINT_EVERY }
+    }
+}
+
+impl Default for TrainConfig {
+    /// Annulus, disc sensors, 8 robots, 250 pucks, [`DEFAULT_STEPS`],
+    /// seed 1, the thesis' learner.
+    fn default() -> TrainConfig {
+        TrainConfig {
+            field: FieldSource::Annulus,
+            sensors: SensorChoice::Disc,
+            robots: 8,
+            pucks: 250,
+            steps: DEFAULT_STEPS,
+            seed: 1,
+            stuck_limit: None,
+            learn: LearnConfig::default(),
+            output: OutputConfig::default(),
+        }
+    }
+}
+
+/// Longest run name: the policy blob's name field.
+const MAX_NAME_LEN: usize = shared::blob::MAX_NAME_LEN;
+
+impl TrainConfig {
+    /// Reads a TOML file; syntax errors and unknown keys name the file, the
+    /// line and the column.
+    pub fn from_file(path: &Path) -> Result<TrainConfig> {
+        let text =
+            std::fs::read_to_string(path).with_context(|| format!("cannot read config file {}", path.display()))?;
+        toml::from_str(&text).with_context(|| format!("config file {} is not a valid training config", path.display()))
+    }
+
+    /// The simulation settings: the field's defaults ([`field_config`])
+    /// with this run's counts and stuck limit; every robot an outie.
+    pub fn sim_config(&self) -> SimConfig {
+        let mut c = field_config(&self.field, self.robots, self.pucks);
+        if let Some(limit) = self.stuck_limit {
+            c.episode.stuck_limit = limit;
+        }
+        c
+    }
+
+    /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
+    pub fn name(&self) -> String {
+        match &self.output.name {
+            Some(name) => name.clone(),
+            None => truncate(&format!("{}-{}", field_label(&self.field).replace(':', "-"), self.learn.hasher.0.name())),
+        }
+    }
+
+    /// Checks every setting before a run; errors name the setting.
+    pub fn validate(&self) -> Result<()> {
+        self.sim_config().validate().context("invalid simulation settings")?;
+        self.learn.validate()?;
+        if self.steps == 0 {
+            bail!("steps = 0: must be positive");
+        }
+        let name = self.name();
+        if name.is_empty() || name.len() > MAX_NAME_LEN || name.contains(['/', '\\']) || name.starts_with('.') {
+            bail!(
+                "name {name:?}: must be 1 to {MAX_NAME_LEN} bytes, without path separators, not starting with a dot"
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The field as a blob's provenance names it: the source for the annulus
+/// and letters, an image's file name; at most 32 bytes.
+pub fn field_label(field: &FieldSource) -> String {
+    match field {
+        FieldSource::Image(path) => {
+            truncate(&path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "image".into()))
+        }
+        other => truncate(&other.to_string()),
+    }
+}
+
+/// The longest prefix of `s` of at most [`MAX_NAME_LEN`] bytes.
+fn truncate(s: &str) -> String {
+    let mut end = s.len().min(MAX_NAME_LEN);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    s[..end].to_string()
+}
+
+/// The `host train` flags that change a [`TrainConfig`]; each overrides
+/// the config file's value when given.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct TrainOverrides {
+    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    #[arg(long, value_parser = parse_field)]
+    pub field: Option<FieldSource>,
+    /// Sensor model: disc.
+    #[arg(long)]
+    pub sensors: Option<SensorChoice>,
+    /// Number of robots [default: 8].
+    #[arg(long)]
+    pub robots: Option<usize>,
+    /// Number of pucks [default: 250].
+    #[arg(long)]
+    pub pucks: Option<usize>,
+    /// Seed of every random choice [default: 1].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
+    /// 7, 9) [default: original].
+    #[arg(long)]
+    pub hasher: Option<StateHasherName>,
+    /// Reward: reference, thesis, collision, collision-spread [default:
+    /// reference].
+    #[arg(long)]
+    pub reward: Option<Reward>,
+    /// Learning rate [default: 0.2].
+    #[arg(long)]
+    pub alpha: Option<f64>,
+    /// Discount [default: 0.9].
+    #[arg(long)]
+    pub gamma: Option<f64>,
+    /// Exploration probability [default: 0].
+    #[arg(long)]
+    pub epsilon: Option<f64>,
+}
+
+fn parse_field(s: &str) -> Result<FieldSource, String> {
+    s.parse().map_err(|e: crate::sim::FieldError| e.to_string())
+}
+
+impl TrainOverrides {
+    /// Writes every given flag into `config`.
+    pub fn apply(&self, config: &mut TrainConfig) {
+        if let Some(v) = &self.field {
+            config.field = v.clone();
+        }
+        set(&mut config.sensors, self.sensors.clone());
+        set(&mut config.robots, self.robots);
+        set(&mut config.pucks, self.pucks);
+        set(&mut config.seed, self.seed);
+        set(&mut config.learn.hasher, self.hasher);
+        set(&mut config.learn.reward, self.reward);
+        set(&mut config.learn.alpha, self.alpha);
+        set(&mut config.learn.gamma, self.gamma);
+        set(&mut config.learn.epsilon, self.epsilon);
+    }
+
+    /// The names of the flags given, for refusing them where they cannot
+    /// apply (a resumed run keeps its settings).
+    pub fn given(&self) -> Vec<&'static str> {
+        let flags = [
+            ("--field", self.field.is_some()),
+            ("--sensors", self.sensors.is_some()),
+            ("--robots", self.robots.is_some()),
+            ("--pucks", self.pucks.is_some()),
+            ("--seed", self.seed.is_some()),
+            ("--hasher", self.hasher.is_some()),
+            ("--reward", self.reward.is_some()),
+            ("--alpha", self.alpha.is_some()),
+            ("--gamma", self.gamma.is_some()),
+            ("--epsilon", self.epsilon.is_some()),
+        ];
+        flags.into_iter().filter(|f| f.1).map(|f| f.0).collect()
+    }
+}
+
+fn set<T>(slot: &mut T, value: Option<T>) {
+    if let Some(v) = value {
+        *slot = v;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_file_names_what_it_changes_and_flags_win() {
+        let text = "robots = 4\nfield = \"letter:L\"\n[learn]\nhasher = \"bits7\"\nalpha = 0.5\n[output]\nname = \"x\"\n";
+        let mut c: TrainConfig = toml::from_str(text).unwrap();
+        assert_eq!((c.robots, c.pucks, c.learn.alpha), (4, 250, 0.5));
+        assert_eq!(c.sim_config().episode.stuck_limit, 50_000);
+        let flags = TrainOverrides { alpha: Some(0.1), robots: Some(2), ..Default::default() };
+        flags.apply(&mut c);
+        assert_eq!((c.robots, c.learn.alpha, c.learn.hasher.0.bits()), (2, 0.1, 7));
+        assert_eq!(flags.given(), ["--robots", "--alpha"]);
+        c.validate().unwrap();
+    }
+
+    #[test]
+    fn malformed_files_give_the_line() {
+        let e = toml::from_str::<TrainConfig>("robots = 4\npucks = = 3\n").unwrap_err().to_string();
+        assert!(e.contains("line 2"), "{e}");
+        let e = toml::from_str::<TrainConfig>("robots = 4\n\nalpah = 0.3\n").unwrap_err().to_string();
+        assert!(e.contains("line 3") && e.contains("alpah"), "{e}");
+        let e = toml::from_str::<TrainConfig>("[learn]\nhasher = \"bits12\"\n").unwrap_err().to_string();
+        assert!(e.contains("bits12") && e.contains("line 2"), "{e}");
+    }
+
+    #[test]
+    fn names_derive_from_field_and_hasher_and_are_checked() {
+        let mut c = TrainConfig::default();
+        assert_eq!(c.name(), "annulus-original");
+        c.field = FieldSource::Letter(crate::sim::Letter::T);
+        assert_eq!(c.name(), "letter-T-original");
+        c.output.name = Some("../escape".into());
+        assert!(c.validate().unwrap_err().to_string().contains("path separators"));
+        c.output.name = Some("x".repeat(33));
+        assert!(c.validate().is_err());
+    }
+}

@@ -1,0 +1,12 @@
+//! Training: a run's settings ([`config`]), the learning loop over any
+//! sensor model ([`trainer`]), its checkpoint file ([`checkpoint`]) and the
+//! `host train` command ([`command`]).
+
+pub mod checkpoint;
+pub mod command;
+pub mod config;
+pub mod trainer;
+
+pub use command::{train, TrainArgs, TrainReport};
+pub use config::{OutputConfig, TrainConfig, TrainOverrides};
+pub use trainer::{Trainer, TrainingState};

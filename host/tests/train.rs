@@ -1,0 +1,202 @@
+//! Training: determinism, exact resume from checkpoints, torn writes, and
+//! the one-sensing-per-step contract a learner relies on.
+
+use host::controller::{Controller, Perception};
+use host::learn::{QLearner, Reward};
+use host::sensor_choice::SensorChoice;
+use host::sim::{EpisodeStart, SimRng, StepOutcome};
+use host::train::checkpoint::{self, CheckpointError};
+use host::train::{TrainConfig, Trainer, TrainingState};
+use shared::SensorReading;
+use std::io::Write;
+use std::sync::Arc;
+
+/// A small, quick run: 4 robots, 60 pucks, a short stuck limit so that
+/// episodes end and reset within the test.
+fn small(seed: u64) -> TrainConfig {
+    TrainConfig { robots: 4, pucks: 60, seed, stuck_limit: Some(700), ..TrainConfig::default() }
+}
+
+fn trainer(config: TrainConfig) -> Trainer<host::sensor_choice::SelectedSensors> {
+    let field = Arc::new(config.field.load().unwrap());
+    let sensors = config.sensors.build(&config.sim_config()).unwrap();
+    Trainer::new(config, field, sensors, None).unwrap()
+}
+
+/// Everything that evolves: Q-values, visits, counters, world, generators.
+fn evolving(state: &TrainingState) -> Vec<u8> {
+    let mut bytes = postcard::to_stdvec(&state.sim).unwrap();
+    bytes.extend(postcard::to_stdvec(&state.learner).unwrap());
+    bytes
+}
+
+#[test]
+fn same_seed_same_q_table() {
+    let run = |seed| {
+        let mut t = trainer(small(seed));
+        t.run(3000);
+        t.state()
+    };
+    let (a, b, c) = (run(4), run(4), run(5));
+    assert_eq!(a.learner.table(), b.learner.table());
+    assert_eq!(evolving(&a), evolving(&b));
+    assert_ne!(a.learner.table(), c.learner.table(), "another seed learns another table");
+    assert!(a.sim.totals.stuck >= 3, "episodes ended and reset: {:?}", a.sim.totals);
+    assert!(a.learner.table().states_visited() > 20);
+}
+
+#[test]
+fn train_then_resume_equals_one_long_run() {
+    let mut straight = trainer(small(9));
+    straight.run(2500);
+
+    let mut first = trainer(small(9));
+    first.run(1400);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.ckpt");
+    checkpoint::save(&path, &first.state()).unwrap();
+    drop(first);
+
+    let state = checkpoint::load(&path).unwrap();
+    let field = Arc::new(state.config.field.load().unwrap());
+    let sensors = SensorChoice::Disc.build(&state.sim.config).unwrap();
+    let mut resumed = Trainer::resume(state, field, sensors).unwrap();
+    resumed.run(1100);
+    assert_eq!(resumed.learner().table(), straight.learner().table());
+    assert_eq!(resumed.totals(), straight.totals());
+    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+    assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
+}
+
+#[test]
+fn a_resume_refuses_a_changed_field() {
+    let t = trainer(small(1));
+    let letter = Arc::new(host::sim::Letter::T.field());
+    let sensors = SensorChoice::Disc.build(&t.state().sim.config).unwrap();
+    let e = Trainer::resume(t.state(), letter, sensors).err().unwrap().to_string();
+    assert!(e.contains("differs from the one the checkpoint trained on"), "{e}");
+}
+
+/// Fails after `budget` bytes, like a full disk or a killed process.
+struct FailingWriter<'a> {
+    inner: &'a mut dyn Write,
+    budget: usize,
+}
+
+impl Write for FailingWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.budget == 0 {
+            return Err(std::io::Error::other("disk full"));
+        }
+        let n = buf.len().min(self.budget);
+        self.budget -= n;
+        self.inner.write(&buf[..n])
+    }
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+#[test]
+fn a_failing_writer_leaves_the_previous_checkpoint() {
+    let mut t = trainer(small(2));
+    t.run(500);
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("run.ckpt");
+    checkpoint::save(&path, &t.state()).unwrap();
+    let before = std::fs::read(&path).unwrap();
+
+    t.run(500);
+    let newer = t.state();
+    for budget in [0, 10, 100, 5000] {
+        let r = host::atomic::write_with(&path, |w| checkpoint::write_to(&mut FailingWriter { inner: w, budget }, &newer));
+        assert!(r.is_err());
+        assert_eq!(std::fs::read(&path).unwrap(), before, "torn after {budget} bytes");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "temporary file left behind");
+    }
+    assert_eq!(checkpoint::load(&path).unwrap().sim.totals.steps, 500);
+}
+
+#[test]
+fn damaged_or_foreign_checkpoints_are_refused_with_the_reason() {
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, &trainer(small(3)).state()).unwrap();
+    assert!(checkpoint::decode(&bytes).is_ok());
+
+    let short = checkpoint::decode(&bytes[..bytes.len() - 9]).unwrap_err();
+    assert!(matches!(short, CheckpointError::Truncated { .. }), "{short}");
+    assert!(matches!(checkpoint::decode(&bytes[..5]), Err(CheckpointError::Truncated { needed: 18, found: 5 })));
+    let mut long = bytes.clone();
+    long.push(0);
+    assert!(matches!(checkpoint::decode(&long), Err(CheckpointError::TrailingBytes { .. })));
+    let mut flipped = bytes.clone();
+    flipped[40] ^= 1;
+    assert!(matches!(checkpoint::decode(&flipped), Err(CheckpointError::CrcMismatch { .. })));
+    let mut version = bytes.clone();
+    version[8] = 9;
+    assert_eq!(checkpoint::decode(&version).unwrap_err(), CheckpointError::UnsupportedVersion(9));
+    assert_eq!(checkpoint::decode(b"PNG\x89 not a checkpoint at all").unwrap_err(), CheckpointError::WrongMagic);
+    assert_eq!(checkpoint::decode(b"QPOL\x01").unwrap_err(), CheckpointError::PolicyBlob);
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("cut.ckpt");
+    std::fs::write(&path, &bytes[..100]).unwrap();
+    let e = format!("{:#}", checkpoint::load(&path).unwrap_err());
+    assert!(e.contains("cut.ckpt") && e.contains("truncated"), "{e}");
+}
+
+/// Records what a learner would see: the readings each decision used and
+/// the readings after each step.
+struct Probe {
+    decided: Vec<Vec<SensorReading>>,
+    after: Vec<(Vec<SensorReading>, bool)>,
+    starts: u64,
+}
+
+impl Controller for Probe {
+    fn decide(&mut self, p: &Perception<'_>, turns: &mut [f32], rng: &mut SimRng) {
+        self.decided.push(p.readings.to_vec());
+        for t in turns.iter_mut() {
+            *t = rand::RngExt::random_range(rng, -0.3..0.3);
+        }
+    }
+    fn episode_start(&mut self, _start: &EpisodeStart<'_>) {
+        self.starts += 1;
+    }
+    fn observe(&mut self, o: &StepOutcome<'_>) {
+        self.after.push((o.readings.to_vec(), o.end.is_some()));
+    }
+}
+
+#[test]
+fn the_state_reached_is_the_state_decided_on_next() {
+    let config = small(6).sim_config();
+    let field = Arc::new(host::sim::ScalarField::annulus());
+    let mut sim = host::sim::Simulation::new(config, field, 6).unwrap();
+    let mut probe = Probe { decided: Vec::new(), after: Vec::new(), starts: 0 };
+    sim.run(&mut probe, 2000);
+    let ends = probe.after.iter().filter(|a| a.1).count();
+    assert!(ends >= 2, "the test needs episode ends");
+    assert_eq!(probe.starts, 1 + ends as u64, "one start per episode");
+    for t in 0..1999 {
+        let (reached, ended) = &probe.after[t];
+        if *ended {
+            assert_ne!(reached, &probe.decided[t + 1], "after a reset the next decision sees the new world");
+        } else {
+            assert_eq!(reached, &probe.decided[t + 1], "step {t}");
+        }
+    }
+}
+
+#[test]
+fn every_reward_variant_learns_something() {
+    for reward in Reward::ALL {
+        let mut config = small(7);
+        config.learn.reward = reward;
+        let mut t = trainer(config);
+        t.run(300);
+        let q: &QLearner = t.learner();
+        assert!(q.table().states_visited() > 5, "{reward}");
+        assert!(q.signal().is_finite());
+    }
+}
