@@ -155,7 +155,9 @@ pub struct TrainOverrides {
     /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, value_parser = parse_field)]
     pub field: Option<FieldSource>,
-    /// Sensor model: disc.
+    /// Sensor model: disc (the thesis' sensor discs), robot (the Zumo's
+    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
+    /// or robot:CONFIG.json (docs/robot-sensors.md).
     #[arg(long)]
     pub sensors: Option<SensorChoice>,
     /// Number of robots [default: 8].
