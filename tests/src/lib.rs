@@ -3,9 +3,7 @@
 //! [`zumo::Zumo`] runs the firmware's release ELF in simavr on an emulated
 //! Zumo 32U4 (field sensors, Pixy, buttons, motors, serial log);
 //! [`equivalence`] samples robot states from simulated episodes and
-//! computes what the firmware must do with them; [`standin`] makes the
-//! stand-in policies those tests use until trained ones are shipped.
+//! computes what the firmware must do with them.
 
 pub mod equivalence;
-pub mod standin;
 pub mod zumo;
