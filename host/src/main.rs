@@ -127,8 +127,9 @@ struct ReplayArgs {
     /// The policy blob the robot was flashed with.
     #[arg(long)]
     policy: PathBuf,
-    /// Training visit counts per state (JSON, docs/robot-logs.md): reports
-    /// the states the robot met that training never visited.
+    /// The policy's training checkpoint (`host train`'s .ckpt), or a JSON
+    /// file of visit counts per state (docs/robot-logs.md): reports the
+    /// states the robot met that training never visited.
     #[arg(long)]
     visits: Option<PathBuf>,
     /// Print one JSON object instead of text.

@@ -2,11 +2,10 @@
 //! a robot met with these, to show where the robot ran on states the policy
 //! never learned (their action is the table's default).
 //!
-//! File format (JSON, `--visits FILE`):
+//! `--visits FILE` takes either a training checkpoint (`host train`'s
+//! `.ckpt`: its Q-table's visit counts) or a JSON file
 //! `{"hasher": "original", "visits": [n0, n1, ...]}`, one count per state
-//! (`2^bits` of them), a state's visits summed over its actions. A Q-table
-//! gives one with [`TrainingVisits::from_qtable`]; a trainer checkpoint
-//! that holds a Q-table plugs in through it.
+//! (`2^bits` of them), a state's visits summed over its actions.
 
 use crate::learn::QTable;
 use anyhow::{bail, Context, Result};
@@ -54,9 +53,17 @@ impl TrainingVisits {
         self.visits.get(state.index()).copied().unwrap_or(0)
     }
 
-    /// Reads a visits file; errors name the file and the problem.
+    /// Reads a training checkpoint's visit counts, or a visits file; errors
+    /// name the file and the problem.
     pub fn read(path: &Path) -> Result<TrainingVisits> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read visits file {}", path.display()))?;
+        let bytes = std::fs::read(path).with_context(|| format!("cannot read visits file {}", path.display()))?;
+        if bytes.starts_with(&crate::train::checkpoint::MAGIC) {
+            let state = crate::train::checkpoint::decode(&bytes)
+                .with_context(|| format!("training checkpoint {}", path.display()))?;
+            return Ok(TrainingVisits::from_qtable(state.learner.table()));
+        }
+        let text = String::from_utf8(bytes)
+            .with_context(|| format!("visits file {} is neither a training checkpoint nor JSON", path.display()))?;
         let file: VisitsFile =
             serde_json::from_str(&text).with_context(|| format!("visits file {} is not valid JSON of the visits format", path.display()))?;
         let hasher = StateHasher::from_name(&file.hasher).with_context(|| {
@@ -98,5 +105,27 @@ mod tests {
         assert!(e.contains("v.json") && e.contains("2 visit counts") && e.contains("256 states"), "{e}");
         std::fs::write(&path, r#"{"hasher": "twelve", "visits": []}"#).unwrap();
         assert!(format!("{:#}", TrainingVisits::read(&path).unwrap_err()).contains("\"twelve\""));
+    }
+
+    #[test]
+    fn from_a_training_checkpoint() {
+        use crate::train::{checkpoint, TrainConfig, Trainer};
+        let config = TrainConfig { robots: 2, pucks: 40, ..TrainConfig::default() };
+        let field = std::sync::Arc::new(config.field.load().unwrap());
+        let sensors = config.sensors.build(&config.sim_config()).unwrap();
+        let mut trainer = Trainer::new(config, field, sensors, None).unwrap();
+        trainer.run(500);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.ckpt");
+        checkpoint::save(&path, &trainer.state()).unwrap();
+        let v = TrainingVisits::read(&path).unwrap();
+        assert_eq!(v, TrainingVisits::from_qtable(trainer.state().learner.table()));
+        assert_eq!((0..256).map(|s| v.of(State(s))).sum::<u64>(), 1000, "2 robots x 500 updates");
+
+        let mut bytes = std::fs::read(&path).unwrap();
+        bytes.truncate(bytes.len() - 3);
+        std::fs::write(&path, &bytes).unwrap();
+        let e = format!("{:#}", TrainingVisits::read(&path).unwrap_err());
+        assert!(e.contains("run.ckpt"), "{e}");
     }
 }
