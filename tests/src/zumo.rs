@@ -359,6 +359,18 @@ impl Zumo {
         self.set_button(b'D', 5, false);
     }
 
+    /// Presses button B and plays the calibration sweep: the robot spins
+    /// over bright (100 ticks) and dark (400 ticks) field, alternating every
+    /// 20 ms period, until the sweep ends (215 periods).
+    pub fn calibrate(&mut self) {
+        self.press_b();
+        for i in 0..215u16 {
+            let t = if i % 2 == 0 { 100 } else { 400 };
+            self.set_sensor_ticks([Some(t), Some(t + 10), Some(t + 20)]);
+            self.run_ms(20);
+        }
+    }
+
     /// Runs the firmware for `ms` simulated milliseconds.
     pub fn run_ms(&mut self, ms: u64) {
         self.tester.run_for_ms(ms);

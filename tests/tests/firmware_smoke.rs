@@ -164,13 +164,8 @@ fn a_silent_camera_or_blind_sensors_stop_the_motors_until_readings_return() {
 fn button_b_sweeps_stores_the_calibration_in_eeprom_and_enables_driving() {
     let mut z = Zumo::boot();
     z.run_ms(40);
-    z.press_b();
     // The robot spins over bright and dark field: alternate every period.
-    for i in 0..215u16 {
-        let t = if i % 2 == 0 { 100 } else { 400 };
-        z.set_sensor_ticks([Some(t), Some(t + 10), Some(t + 20)]);
-        z.run_ms(20);
-    }
+    z.calibrate();
     let frames = decoded(&mut z);
     let sweeping: Vec<_> = frames.iter().filter(|f| f.mode == RunMode::Calibrating).collect();
     assert!(sweeping.len() >= 190, "{} calibrating frames", sweeping.len());

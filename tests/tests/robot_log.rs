@@ -32,12 +32,7 @@ const EVENT_TIMEOUT: Duration = Duration::from_secs(60);
 fn session() -> Vec<u8> {
     let mut z = Zumo::boot();
     z.run_ms(40);
-    z.press_b();
-    for i in 0..215u16 {
-        let t = if i % 2 == 0 { 100 } else { 400 };
-        z.set_sensor_ticks([Some(t), Some(t + 10), Some(t + 20)]);
-        z.run_ms(20);
-    }
+    z.calibrate();
     z.show(&[PUCK_LEFT]);
     z.press_a();
     for i in 0..40u16 {
