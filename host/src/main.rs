@@ -182,7 +182,8 @@ struct ScenarioArgs {
     /// All-pairs contact checks instead of the spatial grid (same results).
     #[arg(long)]
     naive: bool,
-    /// Sensor model: disc (the thesis' sensor discs), robot (the Zumo's
+    /// Sensor model: disc (the reference model's discs), disc-thesis (with
+    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
     /// photo-transistors and Pixy camera, through the firmware's arithmetic)
     /// or robot:CONFIG.json (the same with settings from a JSON file;
     /// docs/robot-sensors.md).

@@ -1,13 +1,16 @@
 //! `--sensors`: which sensor model the simulated robots have.
 //!
-//! - `disc`: the thesis' disc sensors (the reference model; default);
+//! - `disc`: the disc sensors of the reference model (default; obstacle
+//!   discs as in the original code: radius r/4, any body);
+//! - `disc-thesis`: the same with the obstacle discs the thesis describes
+//!   (section 5.2: the size of a puck sensor, robots only);
 //! - `robot`: the Zumo's real senses ([`RobotSensors`]: photo-transistors
 //!   through the firmware's RC timing and calibration, the Pixy camera
 //!   through the firmware's blob classification), default settings;
 //! - `robot:FILE`: the same with the settings of a JSON [`RobotSensorConfig`]
 //!   file (every field optional; `docs/robot-sensors.md`).
 
-use crate::sim::{DiscSensors, Footprint, RobotSensorConfig, RobotSensors, ScalarField, SensorModel, SimConfig, World};
+use crate::sim::{DiscSensorConfig, DiscSensors, Footprint, RobotSensorConfig, RobotSensors, ScalarField, SensorModel, SimConfig, World};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
@@ -23,6 +26,9 @@ pub enum SensorChoice {
     /// The thesis' disc sensors of `SimConfig::sensors`.
     #[default]
     Disc,
+    /// The disc sensors with the thesis' obstacle discs
+    /// ([`DiscSensorConfig::thesis_obstacles`]).
+    DiscThesis,
     /// The robot sensor model, with the settings of a JSON file if given.
     Robot(Option<PathBuf>),
 }
@@ -33,10 +39,11 @@ impl FromStr for SensorChoice {
     fn from_str(s: &str) -> Result<SensorChoice, String> {
         match s {
             "disc" => Ok(SensorChoice::Disc),
+            "disc-thesis" => Ok(SensorChoice::DiscThesis),
             "robot" => Ok(SensorChoice::Robot(None)),
             _ => match s.strip_prefix("robot:") {
                 Some(path) if !path.is_empty() => Ok(SensorChoice::Robot(Some(PathBuf::from(path)))),
-                _ => Err(format!("unknown sensor model {s:?}: expected disc, robot or robot:CONFIG.json")),
+                _ => Err(format!("unknown sensor model {s:?}: expected disc, disc-thesis, robot or robot:CONFIG.json")),
             },
         }
     }
@@ -60,6 +67,7 @@ impl fmt::Display for SensorChoice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SensorChoice::Disc => f.write_str("disc"),
+            SensorChoice::DiscThesis => f.write_str("disc-thesis"),
             SensorChoice::Robot(None) => f.write_str("robot"),
             SensorChoice::Robot(Some(p)) => write!(f, "robot:{}", p.display()),
         }
@@ -82,6 +90,15 @@ impl SensorChoice {
         let radius = config.world.robot_radius;
         Ok(match self {
             SensorChoice::Disc => SelectedSensors::Disc(DiscSensors::new(&config.sensors, radius)),
+            SensorChoice::DiscThesis => {
+                let thesis = DiscSensorConfig::thesis_obstacles();
+                let discs = DiscSensorConfig {
+                    obstacle: thesis.obstacle,
+                    obstacle_targets: thesis.obstacle_targets,
+                    ..config.sensors.clone()
+                };
+                SelectedSensors::Disc(DiscSensors::new(&discs, radius))
+            }
             SensorChoice::Robot(file) => {
                 let robot = match file {
                     Some(path) => read_robot_config(path)?,
@@ -124,7 +141,7 @@ mod tests {
 
     #[test]
     fn choices_parse_print_and_errors_name_the_input() {
-        for s in ["disc", "robot", "robot:cam.json"] {
+        for s in ["disc", "disc-thesis", "robot", "robot:cam.json"] {
             assert_eq!(s.parse::<SensorChoice>().unwrap().to_string(), s);
         }
         let e = "pixy".parse::<SensorChoice>().unwrap_err();

@@ -155,7 +155,8 @@ pub struct TrainOverrides {
     /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, value_parser = parse_field)]
     pub field: Option<FieldSource>,
-    /// Sensor model: disc (the thesis' sensor discs), robot (the Zumo's
+    /// Sensor model: disc (the reference model's discs), disc-thesis (with
+    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
     /// photo-transistors and Pixy camera, through the firmware's arithmetic)
     /// or robot:CONFIG.json (docs/robot-sensors.md).
     #[arg(long)]
