@@ -6,7 +6,7 @@
 
 use super::body::Body;
 use super::config::BroadPhase;
-use super::grid::SpatialGrid;
+use super::grid::{Neighbour, SpatialGrid};
 use super::vec2::Vec2;
 
 /// The neighbour index of a world.
@@ -15,25 +15,16 @@ pub enum NeighbourIndex {
     /// Bodies binned in a [`SpatialGrid`].
     Grid(SpatialGrid),
     /// No index: every body is a candidate.
-    Naive {
-        /// Number of bodies.
-        bodies: usize,
-    },
+    Naive,
 }
 
 impl NeighbourIndex {
-    /// An index of the given kind over `positions` in a `size` x `size`
-    /// arena. Contact candidates are complete for centre distances up to
-    /// `reach` (the largest contact distance plus the candidate margin).
-    pub fn new(
-        kind: BroadPhase,
-        size: f64,
-        reach: f64,
-        positions: impl ExactSizeIterator<Item = Vec2>,
-    ) -> NeighbourIndex {
+    /// An index of the given kind over `bodies` in a `size` x `size`
+    /// arena, with grid cells of at least `cell` units.
+    pub fn new(kind: BroadPhase, size: f64, cell: f64, bodies: &[Body]) -> NeighbourIndex {
         match kind {
-            BroadPhase::Grid => NeighbourIndex::Grid(SpatialGrid::new(size, reach, positions)),
-            BroadPhase::Naive => NeighbourIndex::Naive { bodies: positions.len() },
+            BroadPhase::Grid => NeighbourIndex::Grid(SpatialGrid::new(size, cell, cell, bodies.iter().map(|b| (b.pos, b.radius)))),
+            BroadPhase::Naive => NeighbourIndex::Naive,
         }
     }
 
@@ -47,42 +38,49 @@ impl NeighbourIndex {
 
     /// Fills `out` with every body `j` (other than `body`, with an index
     /// above `after` if given) whose centre is closer to `body`'s than
-    /// `r_body + r_j + margin`, in ascending order. `r_body + r_j + margin`
-    /// must not exceed the `reach` the index was built with.
-    pub fn contact_candidates(&self, bodies: &[Body], body: usize, after: Option<usize>, margin: f64, out: &mut Vec<u32>) {
+    /// `r_body + r_j + margin`, in ascending order; `max_radius` bounds
+    /// every `r_j`.
+    pub fn contact_candidates(
+        &self,
+        bodies: &[Body],
+        body: usize,
+        after: Option<usize>,
+        max_radius: f64,
+        margin: f64,
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
-        let first = after.map_or(0, |a| a + 1);
-        let b = &bodies[body];
-        let consider = |j: usize| {
-            if j == body || j < first {
-                return;
-            }
-            let reach = b.radius + bodies[j].radius + margin;
-            if (bodies[j].pos - b.pos).length_squared() >= reach * reach {
-                return;
+        let first = after.map_or(0, |a| a as u32 + 1);
+        let (pos, radius) = (bodies[body].pos, bodies[body].radius);
+        let half = radius + max_radius + margin;
+        self.any_in_box(bodies, pos - Vec2::new(half, half), pos + Vec2::new(half, half), |n| {
+            let j = n.body;
+            let reach = radius + n.radius + margin;
+            if j as usize == body || j < first || (n.pos - pos).length_squared() >= reach * reach {
+                return false;
             }
             // Insertion keeps the short list sorted without a sort call.
-            out.push(j as u32);
+            out.push(j);
             let mut k = out.len() - 1;
-            while k > 0 && out[k - 1] as usize > j {
+            while k > 0 && out[k - 1] > j {
                 out[k] = out[k - 1];
                 k -= 1;
             }
-            out[k] = j as u32;
-        };
-        match self {
-            NeighbourIndex::Grid(g) => g.for_each_near_cell(g.cell_of(body), consider),
-            NeighbourIndex::Naive { bodies } => (0..*bodies).for_each(consider),
-        }
+            out[k] = j;
+            false
+        });
     }
 
     /// Whether `pred` holds for some body of a superset of those whose
     /// centres lie in the box `min ..= max`; stops at the first.
     #[inline]
-    pub fn any_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(usize) -> bool) -> bool {
+    pub fn any_in_box(&self, bodies: &[Body], min: Vec2, max: Vec2, mut pred: impl FnMut(&Neighbour) -> bool) -> bool {
         match self {
             NeighbourIndex::Grid(g) => g.any_in_box(min, max, pred),
-            NeighbourIndex::Naive { bodies } => (0..*bodies).any(pred),
+            NeighbourIndex::Naive => bodies
+                .iter()
+                .enumerate()
+                .any(|(j, b)| pred(&Neighbour { pos: b.pos, radius: b.radius, body: j as u32 })),
         }
     }
 }

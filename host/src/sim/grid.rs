@@ -1,133 +1,154 @@
-//! The spatial grid broad phase: square cells, each an intrusive doubly
-//! linked list of the bodies whose centres lie in it.
+//! The spatial grid broad phase: square cells in row-major order whose
+//! bodies are stored cell by cell in one array, so that the cells of a
+//! row that a query covers are one contiguous slice.
 //!
-//! The grid is updated whenever a body moves, so it always matches the
-//! current positions. With a cell side of at least the largest contact
-//! distance (twice the largest radius), every body that can overlap a body
-//! in cell C lies in the 3 x 3 cells around C. Updates and queries allocate
-//! nothing.
+//! Each slot holds a copy of a body's centre and radius: a query reads
+//! nothing else. The grid is updated whenever a body moves, so it always
+//! matches the current positions; a body that changes cell is carried
+//! there by swaps along the cells in between. Updates and queries
+//! allocate nothing.
 
 use super::vec2::Vec2;
 
-const NONE: u32 = u32::MAX;
+/// A body as a neighbour query sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbour {
+    /// Centre.
+    pub pos: Vec2,
+    /// Radius.
+    pub radius: f64,
+    /// Body index.
+    pub body: u32,
+}
 
 /// Bodies binned by the cell of their centre. Positions outside the arena
 /// fall in the border cells, which keeps every query a superset of the
 /// bodies it must find.
 #[derive(Clone, Debug)]
 pub struct SpatialGrid {
-    cells_per_unit: f64,
+    cols_per_unit: f64,
+    rows_per_unit: f64,
     cols: usize,
-    head: Vec<u32>,
-    next: Vec<u32>,
-    prev: Vec<u32>,
-    /// Each body's cell as `row << 16 | col`.
+    rows: usize,
+    /// Cell `c` holds the slots `start[c] .. start[c + 1]`.
+    start: Vec<u32>,
+    slots: Vec<Neighbour>,
+    /// Each body's slot.
+    slot_of: Vec<u32>,
+    /// Each body's cell, `row * cols + col`.
     cell_of: Vec<u32>,
 }
 
 impl SpatialGrid {
     /// A grid over a `size` x `size` arena with cells of at least
-    /// `min_cell` units, holding `positions`.
-    pub fn new(size: f64, min_cell: f64, positions: impl ExactSizeIterator<Item = Vec2>) -> SpatialGrid {
-        let cols = ((size / min_cell).floor() as usize).clamp(1, u16::MAX as usize);
-        let n = positions.len();
+    /// `min_cell` units, holding bodies of the given centres and radii.
+    pub fn new(size: f64, cell_width: f64, cell_height: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
+        let count = |side: f64| ((size / side).floor() as usize).clamp(1, u16::MAX as usize);
+        let (cols, rows) = (count(cell_width), count(cell_height));
         let mut grid = SpatialGrid {
-            cells_per_unit: cols as f64 / size,
+            cols_per_unit: cols as f64 / size,
+            rows_per_unit: rows as f64 / size,
             cols,
-            head: vec![NONE; cols * cols],
-            next: vec![NONE; n],
-            prev: vec![NONE; n],
-            cell_of: vec![NONE; n],
+            rows,
+            start: vec![0; cols * rows + 1],
+            slots: bodies.enumerate().map(|(body, (pos, radius))| Neighbour { pos, radius, body: body as u32 }).collect(),
+            slot_of: Vec::new(),
+            cell_of: Vec::new(),
         };
-        for (body, p) in positions.enumerate() {
-            grid.insert(body as u32, grid.cell(p));
+        // A counting sort: bodies per cell, their running sum, placement.
+        grid.cell_of = grid.slots.iter().map(|n| grid.cell(n.pos)).collect();
+        for &cell in &grid.cell_of {
+            grid.start[cell as usize + 1] += 1;
+        }
+        for c in 1..grid.start.len() {
+            grid.start[c] += grid.start[c - 1];
+        }
+        let mut next = grid.start.clone();
+        grid.slot_of = grid.cell_of.iter().map(|&cell| {
+            next[cell as usize] += 1;
+            next[cell as usize] - 1
+        }).collect();
+        let unsorted = grid.slots.clone();
+        for n in unsorted {
+            grid.slots[grid.slot_of[n.body as usize] as usize] = n;
         }
         grid
     }
 
-    /// Column or row index of a coordinate, clamped to the grid. (`as`
+    /// Column index of a coordinate, clamped to the grid. (`as`
     /// truncates, which is the floor for the non-negative values it sees;
     /// `floor` would be a libm call on baseline x86-64, and a cast to `u32`
     /// is cheaper than one to `usize`.)
     #[inline]
-    fn axis(&self, v: f64) -> usize {
-        ((v * self.cells_per_unit) as u32 as usize).min(self.cols - 1)
+    fn col(&self, x: f64) -> usize {
+        ((x * self.cols_per_unit) as u32 as usize).min(self.cols - 1)
+    }
+
+    /// Row index of a coordinate, like [`SpatialGrid::col`].
+    #[inline]
+    fn row(&self, y: f64) -> usize {
+        ((y * self.rows_per_unit) as u32 as usize).min(self.rows - 1)
     }
 
     #[inline]
     fn cell(&self, p: Vec2) -> u32 {
-        ((self.axis(p.y) as u32) << 16) | self.axis(p.x) as u32
-    }
-
-    #[inline]
-    fn unpack(&self, cell: u32) -> (usize, usize) {
-        ((cell >> 16) as usize, (cell & 0xFFFF) as usize)
-    }
-
-    fn insert(&mut self, body: u32, cell: u32) {
-        let (row, col) = self.unpack(cell);
-        let slot = row * self.cols + col;
-        let b = body as usize;
-        let old_head = self.head[slot];
-        self.next[b] = old_head;
-        self.prev[b] = NONE;
-        if old_head != NONE {
-            self.prev[old_head as usize] = body;
-        }
-        self.head[slot] = body;
-        self.cell_of[b] = cell;
-    }
-
-    fn remove(&mut self, body: u32) {
-        let b = body as usize;
-        let (prev, next) = (self.prev[b], self.next[b]);
-        if prev == NONE {
-            let (row, col) = self.unpack(self.cell_of[b]);
-            self.head[row * self.cols + col] = next;
-        } else {
-            self.next[prev as usize] = next;
-        }
-        if next != NONE {
-            self.prev[next as usize] = prev;
-        }
+        (self.row(p.y) * self.cols + self.col(p.x)) as u32
     }
 
     /// Records that `body` is now at `p`.
     #[inline]
     pub fn moved(&mut self, body: usize, p: Vec2) {
         let cell = self.cell(p);
-        if cell != self.cell_of[body] {
-            self.relink(body as u32, cell);
+        let from = self.cell_of[body];
+        if cell != from {
+            self.relink(body, from, cell);
+        }
+        self.slots[self.slot_of[body] as usize].pos = p;
+    }
+
+    /// Carries a body from cell `from` to cell `to` (the rare case of
+    /// [`SpatialGrid::moved`]): at each cell boundary on the way it swaps
+    /// places with the cell's end slot and the boundary moves past it.
+    #[cold]
+    #[inline(never)]
+    fn relink(&mut self, body: usize, from: u32, to: u32) {
+        let mut slot = self.slot_of[body];
+        if from < to {
+            for boundary in from as usize + 1..=to as usize {
+                let last = self.start[boundary] - 1;
+                self.swap_slots(slot, last);
+                slot = last;
+                self.start[boundary] = last;
+            }
+        } else {
+            for boundary in (to as usize + 1..=from as usize).rev() {
+                let first = self.start[boundary];
+                self.swap_slots(slot, first);
+                slot = first;
+                self.start[boundary] = first + 1;
+            }
+        }
+        self.cell_of[body] = to;
+    }
+
+    fn swap_slots(&mut self, a: u32, b: u32) {
+        if a != b {
+            self.slots.swap(a as usize, b as usize);
+            self.slot_of[self.slots[a as usize].body as usize] = a;
+            self.slot_of[self.slots[b as usize].body as usize] = b;
         }
     }
 
-    /// Moves a body to another cell (the rare case of [`SpatialGrid::moved`]).
-    #[cold]
-    #[inline(never)]
-    fn relink(&mut self, body: u32, cell: u32) {
-        self.remove(body);
-        self.insert(body, cell);
-    }
-
-    /// The cell a body is registered in.
-    #[inline]
-    pub fn cell_of(&self, body: usize) -> u32 {
-        self.cell_of[body]
-    }
-
     /// Calls `visit` for every body in the cells of rows `rows` and columns
-    /// `cols` (half-open ranges) until it returns true; returns whether it did.
+    /// `cols` (inclusive ranges) until it returns true; returns whether it did.
     #[inline]
-    fn visit(&self, rows: (usize, usize), cols: (usize, usize), mut visit: impl FnMut(usize) -> bool) -> bool {
-        for row in rows.0..rows.1 {
-            let start = row * self.cols;
-            for &first in &self.head[start + cols.0..start + cols.1] {
-                let mut b = first;
-                while b != NONE {
-                    if visit(b as usize) {
-                        return true;
-                    }
-                    b = self.next[b as usize];
+    fn visit(&self, rows: (usize, usize), cols: (usize, usize), mut visit: impl FnMut(&Neighbour) -> bool) -> bool {
+        for row in rows.0..=rows.1 {
+            let base = row * self.cols;
+            let (from, to) = (self.start[base + cols.0], self.start[base + cols.1 + 1]);
+            for n in &self.slots[from as usize..to as usize] {
+                if visit(n) {
+                    return true;
                 }
             }
         }
@@ -138,19 +159,8 @@ impl SpatialGrid {
     /// overlaps the box `min ..= max` (a superset of the bodies inside the
     /// box); stops at the first.
     #[inline]
-    pub fn any_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(usize) -> bool) -> bool {
-        self.visit((self.axis(min.y), self.axis(max.y) + 1), (self.axis(min.x), self.axis(max.x) + 1), pred)
-    }
-
-    /// Calls `f` for every body in the 3 x 3 cells around `cell`.
-    #[inline]
-    pub fn for_each_near_cell(&self, cell: u32, mut f: impl FnMut(usize)) {
-        let (row, col) = self.unpack(cell);
-        let end = self.cols;
-        self.visit((row.saturating_sub(1), (row + 2).min(end)), (col.saturating_sub(1), (col + 2).min(end)), |b| {
-            f(b);
-            false
-        });
+    pub fn any_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&Neighbour) -> bool) -> bool {
+        self.visit((self.row(min.y), self.row(max.y)), (self.col(min.x), self.col(max.x)), pred)
     }
 }
 
@@ -158,10 +168,14 @@ impl SpatialGrid {
 mod tests {
     use super::*;
 
-    fn found(g: &SpatialGrid, min: Vec2, max: Vec2) -> Vec<usize> {
+    fn grid(size: f64, cell: f64, pts: &[Vec2]) -> SpatialGrid {
+        SpatialGrid::new(size, cell, cell, pts.iter().map(|&p| (p, 1.0)))
+    }
+
+    fn found(g: &SpatialGrid, min: Vec2, max: Vec2) -> Vec<u32> {
         let mut v = Vec::new();
-        g.any_in_box(min, max, |b| {
-            v.push(b);
+        g.any_in_box(min, max, |n| {
+            v.push(n.body);
             false
         });
         v.sort();
@@ -171,28 +185,53 @@ mod tests {
     #[test]
     fn moved_bodies_are_found_in_their_new_cell_only() {
         let pts = [Vec2::new(5.0, 5.0), Vec2::new(100.0, 100.0), Vec2::new(-3.0, 900.0)];
-        let mut g = SpatialGrid::new(800.0, 20.0, pts.iter().copied());
+        let mut g = grid(800.0, 20.0, &pts);
         assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), vec![0]);
         // clamped into the bottom-left border cell
         assert_eq!(found(&g, Vec2::new(0.0, 790.0), Vec2::new(1.0, 799.0)), vec![2]);
         g.moved(0, Vec2::new(101.0, 99.0));
-        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), Vec::<usize>::new());
+        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), Vec::<u32>::new());
         assert_eq!(found(&g, Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0)), vec![0, 1]);
-        let mut near = Vec::new();
-        g.for_each_near_cell(g.cell_of(1), |b| near.push(b));
-        near.sort();
-        assert_eq!(near, vec![0, 1]);
+        let mut seen = Vec::new();
+        g.any_in_box(Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0), |n| {
+            seen.push((n.body, n.pos));
+            false
+        });
+        seen.sort_by_key(|s| s.0);
+        assert_eq!(seen, vec![(0, Vec2::new(101.0, 99.0)), (1, pts[1])]);
     }
 
     #[test]
     fn queries_in_wide_grids() {
         let pts: Vec<Vec2> = (0..100).map(|i| Vec2::new(i as f64 * 20.0 + 10.0, 30.0)).collect();
-        let g = SpatialGrid::new(2000.0, 20.0, pts.iter().copied());
+        let g = grid(2000.0, 20.0, &pts);
         assert_eq!(found(&g, Vec2::new(1250.0, 0.0), Vec2::new(1310.0, 40.0)), vec![62, 63, 64, 65]);
         assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(2000.0, 2000.0)).len(), 100);
-        let mut near = Vec::new();
-        g.for_each_near_cell(g.cell_of(63), |b| near.push(b));
-        near.sort();
-        assert_eq!(near, vec![62, 63, 64]);
+    }
+
+    /// Many bodies carried across many cells in both directions stay
+    /// findable exactly where they are, and every slot stays consistent.
+    #[test]
+    fn long_moves_keep_every_cell_exact() {
+        let n = 60;
+        let mut pts: Vec<Vec2> = (0..n).map(|i| Vec2::new((i * 37 % 100) as f64, (i * 53 % 100) as f64)).collect();
+        let mut g = grid(100.0, 10.0, &pts);
+        for step in 0..500 {
+            let i = step * 7 % n;
+            pts[i] = Vec2::new(((step * 31 + 11) % 100) as f64 + 0.5, ((step * 17 + 3) % 100) as f64 + 0.5);
+            g.moved(i, pts[i]);
+            for (c, w) in g.start.windows(2).enumerate() {
+                for s in w[0]..w[1] {
+                    let nb = g.slots[s as usize];
+                    assert_eq!(g.slot_of[nb.body as usize], s);
+                    assert_eq!(g.cell_of[nb.body as usize] as usize, c);
+                    assert_eq!(g.cell(pts[nb.body as usize]) as usize, c);
+                    assert_eq!(nb.pos, pts[nb.body as usize]);
+                }
+            }
+        }
+        for (i, p) in pts.iter().enumerate() {
+            assert!(found(&g, *p, *p).contains(&(i as u32)));
+        }
     }
 }

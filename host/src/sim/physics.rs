@@ -260,7 +260,7 @@ impl StepContext<'_> {
     fn resolve_circles(&mut self, i: usize) {
         let margin = CANDIDATE_MARGIN * self.max_radius;
         let mut candidates = std::mem::take(&mut self.scratch.candidates);
-        self.index.contact_candidates(self.bodies, i, None, margin, &mut candidates);
+        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, &mut candidates);
         let mut anchor = self.bodies[i].pos;
         let mut k = 0;
         while k < candidates.len() {
@@ -268,7 +268,7 @@ impl StepContext<'_> {
             k += 1;
             if self.separate(i, j) && (self.bodies[i].pos - anchor).length_squared() > margin * margin {
                 anchor = self.bodies[i].pos;
-                self.index.contact_candidates(self.bodies, i, Some(j), margin, &mut candidates);
+                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, &mut candidates);
                 k = 0;
             }
         }

@@ -270,7 +270,8 @@ impl PixyCamera {
 
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
-        world.any_body_near(lens, self.max_range, |j, b| {
+        world.any_body_near(lens, self.max_range, |b| {
+            let j = b.body as usize;
             if j == robot {
                 return false;
             }

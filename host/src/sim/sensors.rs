@@ -198,23 +198,20 @@ impl DiscSensors {
 impl SensorModel for DiscSensors {
     fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
         let size = world.config().arena_size;
-        let pucks = world.puck_range();
         let obstacles = match self.targets {
-            ObstacleTargets::Robots => 0..world.robots().len(),
-            ObstacleTargets::AnyBody => 0..world.bodies().len(),
-        };
+            ObstacleTargets::Robots => world.robots().len(),
+            ObstacleTargets::AnyBody => world.bodies().len(),
+        } as u32;
         for (i, (robot, reading)) in world.robots().iter().zip(out.iter_mut()).enumerate() {
             let pos = world.bodies()[i].pos;
             let at = |local: Vec2| pos + local.rotated(robot.direction);
             let [left, right] = self.puck_discs(robot.kind);
-            let any_puck = |discs: &[LocalDisc]| {
-                discs.iter().any(|d| world.any_body_in_disc(at(d.offset), d.radius, pucks.clone(), i))
-            };
+            let any_puck = |discs: &[LocalDisc]| discs.iter().any(|d| world.any_puck_in_disc(at(d.offset), d.radius));
             // Both obstacle discs hug the robot: one neighbour query serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
             let (mut seen_left, mut seen_right) = (false, false);
-            world.any_body_near(pos, self.obstacle_reach, |j, b| {
-                if j != i && obstacles.contains(&j) {
+            world.any_body_near(pos, self.obstacle_reach, |b| {
+                if b.body as usize != i && b.body < obstacles {
                     let overlaps = |(c, r): (Vec2, f64)| (b.pos - c).length_squared() < (r + b.radius) * (r + b.radius);
                     seen_left |= overlaps(obstacle_left);
                     seen_right |= overlaps(obstacle_right);

@@ -7,6 +7,7 @@
 
 use super::body::{Body, Robot, RobotKind};
 use super::broadphase::NeighbourIndex;
+use super::grid::Neighbour;
 use super::config::{ConfigError, PhysicsConfig, SimConfig, WorldConfig};
 use super::physics::{candidate_reach, PhysicsScratch, StepContext};
 use super::vec2::Vec2;
@@ -171,23 +172,25 @@ impl World {
         self.scratch.contacts()
     }
 
-    /// Whether any body with an index in `candidates`, other than `except`,
-    /// overlaps the disc at `centre` of `radius` (strictly: touching is not
-    /// overlapping).
-    pub fn any_body_in_disc(&self, centre: Vec2, radius: f64, candidates: Range<usize>, except: usize) -> bool {
-        self.any_body_near(centre, radius, |j, b| {
-            let r = radius + b.radius;
-            candidates.contains(&j) && j != except && (b.pos - centre).length_squared() < r * r
+    /// Whether any puck overlaps the disc at `centre` of `radius`
+    /// (strictly: touching is not overlapping).
+    pub fn any_puck_in_disc(&self, centre: Vec2, radius: f64) -> bool {
+        let robots = self.state.robots.len() as u32;
+        let half = radius + self.state.config.puck_radius;
+        let (min, max) = (centre - Vec2::new(half, half), centre + Vec2::new(half, half));
+        self.index.any_in_box(&self.state.bodies, min, max, |n| {
+            let r = radius + n.radius;
+            n.body >= robots && (n.pos - centre).length_squared() < r * r
         })
     }
 
-    /// Whether `pred(index, body)` holds for some body; `pred` sees at
-    /// least every body whose circle reaches within `reach` of `centre`
-    /// (and maybe others), and no more after it returns true.
-    pub fn any_body_near(&self, centre: Vec2, reach: f64, mut pred: impl FnMut(usize, &Body) -> bool) -> bool {
+    /// Whether `pred` holds for some body; `pred` sees at least every body
+    /// whose circle reaches within `reach` of `centre` (and maybe others),
+    /// and no more after it returns true.
+    pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&Neighbour) -> bool) -> bool {
         let r = reach + self.state.config.max_radius();
         let (min, max) = (centre - Vec2::new(r, r), centre + Vec2::new(r, r));
-        self.index.any_in_box(min, max, |j| pred(j, &self.state.bodies[j]))
+        self.index.any_in_box(&self.state.bodies, min, max, pred)
     }
 }
 
@@ -197,7 +200,7 @@ fn index_of(state: &WorldState) -> NeighbourIndex {
         state.config.broad_phase,
         state.config.arena_size,
         candidate_reach(state.config.max_radius()),
-        state.bodies.iter().map(|b| b.pos),
+        &state.bodies,
     )
 }
 
