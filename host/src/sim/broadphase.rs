@@ -1,8 +1,10 @@
-//! Neighbour search behind one interface: the spatial grid or all pairs.
+//! Neighbour search: which bodies a contact check or a sensor must test.
 //!
-//! Both answer with supersets of the exact answer and the callers apply the
-//! exact test afterwards, in a canonical order, so the choice never changes
-//! a result.
+//! Both modes are a [`SpatialGrid`]: the grid mode with cells the size of
+//! the largest contact reach, the all-pairs mode (`--naive`) with a single
+//! cell, so that every query sees every body. Queries answer with
+//! supersets of the exact answer and the callers apply the exact test
+//! afterwards, in a canonical order, so the mode never changes a result.
 
 use super::body::Body;
 use super::config::BroadPhase;
@@ -11,29 +13,46 @@ use super::vec2::Vec2;
 
 /// The neighbour index of a world.
 #[derive(Clone, Debug)]
-pub enum NeighbourIndex {
-    /// Bodies binned in a [`SpatialGrid`].
-    Grid(SpatialGrid),
-    /// No index: every body is a candidate.
-    Naive,
+pub struct NeighbourIndex {
+    grid: SpatialGrid,
+}
+
+/// Contact candidates of one body, ascending by index (a reused buffer).
+#[derive(Clone, Debug, Default)]
+pub struct Candidates {
+    /// One slot per body, so that gathering can write before it decides.
+    slots: Vec<u32>,
+    len: usize,
+}
+
+impl Candidates {
+    /// A buffer for a world of `bodies` bodies.
+    pub fn new(bodies: usize) -> Candidates {
+        Candidates { slots: vec![0; bodies.max(1)], len: 0 }
+    }
+
+    /// The candidates, ascending.
+    #[inline]
+    pub fn as_slice(&self) -> &[u32] {
+        &self.slots[..self.len]
+    }
 }
 
 impl NeighbourIndex {
     /// An index of the given kind over `bodies` in a `size` x `size`
-    /// arena, with grid cells of at least `cell` units.
+    /// arena; grid cells are at least `cell` units wide.
     pub fn new(kind: BroadPhase, size: f64, cell: f64, bodies: &[Body]) -> NeighbourIndex {
-        match kind {
-            BroadPhase::Grid => NeighbourIndex::Grid(SpatialGrid::new(size, cell, cell, bodies.iter().map(|b| (b.pos, b.radius)))),
-            BroadPhase::Naive => NeighbourIndex::Naive,
-        }
+        let cell = match kind {
+            BroadPhase::Grid => cell,
+            BroadPhase::Naive => size,
+        };
+        NeighbourIndex { grid: SpatialGrid::new(size, cell, bodies.iter().map(|b| (b.pos, b.radius))) }
     }
 
     /// Records a body's new position.
     #[inline]
     pub fn moved(&mut self, body: usize, p: Vec2) {
-        if let NeighbourIndex::Grid(g) = self {
-            g.moved(body, p);
-        }
+        self.grid.moved(body, p);
     }
 
     /// Fills `out` with every body `j` (other than `body`, with an index
@@ -47,40 +66,43 @@ impl NeighbourIndex {
         after: Option<usize>,
         max_radius: f64,
         margin: f64,
-        out: &mut Vec<u32>,
+        out: &mut Candidates,
     ) {
-        out.clear();
         let first = after.map_or(0, |a| a as u32 + 1);
         let (pos, radius) = (bodies[body].pos, bodies[body].radius);
         let half = radius + max_radius + margin;
-        self.any_in_box(bodies, pos - Vec2::new(half, half), pos + Vec2::new(half, half), |n| {
-            let j = n.body;
-            let reach = radius + n.radius + margin;
-            if j as usize == body || j < first || (n.pos - pos).length_squared() >= reach * reach {
-                return false;
+        let mut len = 0;
+        // Every body is written to the next free slot and kept only if it
+        // qualifies: no branch to mispredict. A query visits each body at
+        // most once, so there is always a free slot.
+        self.grid.any_in_box(pos - Vec2::new(half, half), pos + Vec2::new(half, half), |row| {
+            for n in row {
+                let reach = radius + n.radius + margin;
+                let near = (n.pos - pos).length_squared() < reach * reach;
+                out.slots[len] = n.body;
+                len += usize::from(near & (n.body as usize != body) & (n.body >= first));
             }
-            // Insertion keeps the short list sorted without a sort call.
-            out.push(j);
-            let mut k = out.len() - 1;
-            while k > 0 && out[k - 1] > j {
-                out[k] = out[k - 1];
-                k -= 1;
-            }
-            out[k] = j;
             false
         });
+        // Insertion sort: the list is short.
+        let found = &mut out.slots[..len];
+        for k in 1..found.len() {
+            let j = found[k];
+            let mut at = k;
+            while at > 0 && found[at - 1] > j {
+                found[at] = found[at - 1];
+                at -= 1;
+            }
+            found[at] = j;
+        }
+        out.len = len;
     }
 
-    /// Whether `pred` holds for some body of a superset of those whose
-    /// centres lie in the box `min ..= max`; stops at the first.
+    /// Whether `pred` holds for some run of bodies among those visited:
+    /// runs that together hold a superset of the bodies whose centres lie
+    /// in the box `min ..= max`. Stops at the first run for which it holds.
     #[inline]
-    pub fn any_in_box(&self, bodies: &[Body], min: Vec2, max: Vec2, mut pred: impl FnMut(&Neighbour) -> bool) -> bool {
-        match self {
-            NeighbourIndex::Grid(g) => g.any_in_box(min, max, pred),
-            NeighbourIndex::Naive => bodies
-                .iter()
-                .enumerate()
-                .any(|(j, b)| pred(&Neighbour { pos: b.pos, radius: b.radius, body: j as u32 })),
-        }
+    pub fn any_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+        self.grid.any_in_box(min, max, pred)
     }
 }

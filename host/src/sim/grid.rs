@@ -26,10 +26,8 @@ pub struct Neighbour {
 /// bodies it must find.
 #[derive(Clone, Debug)]
 pub struct SpatialGrid {
-    cols_per_unit: f64,
-    rows_per_unit: f64,
+    cells_per_unit: f64,
     cols: usize,
-    rows: usize,
     /// Cell `c` holds the slots `start[c] .. start[c + 1]`.
     start: Vec<u32>,
     slots: Vec<Neighbour>,
@@ -42,15 +40,12 @@ pub struct SpatialGrid {
 impl SpatialGrid {
     /// A grid over a `size` x `size` arena with cells of at least
     /// `min_cell` units, holding bodies of the given centres and radii.
-    pub fn new(size: f64, cell_width: f64, cell_height: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
-        let count = |side: f64| ((size / side).floor() as usize).clamp(1, u16::MAX as usize);
-        let (cols, rows) = (count(cell_width), count(cell_height));
+    pub fn new(size: f64, min_cell: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
+        let cols = ((size / min_cell).floor() as usize).clamp(1, u16::MAX as usize);
         let mut grid = SpatialGrid {
-            cols_per_unit: cols as f64 / size,
-            rows_per_unit: rows as f64 / size,
+            cells_per_unit: cols as f64 / size,
             cols,
-            rows,
-            start: vec![0; cols * rows + 1],
+            start: vec![0; cols * cols + 1],
             slots: bodies.enumerate().map(|(body, (pos, radius))| Neighbour { pos, radius, body: body as u32 }).collect(),
             slot_of: Vec::new(),
             cell_of: Vec::new(),
@@ -75,24 +70,18 @@ impl SpatialGrid {
         grid
     }
 
-    /// Column index of a coordinate, clamped to the grid. (`as`
+    /// Column or row index of a coordinate, clamped to the grid. (`as`
     /// truncates, which is the floor for the non-negative values it sees;
     /// `floor` would be a libm call on baseline x86-64, and a cast to `u32`
     /// is cheaper than one to `usize`.)
     #[inline]
-    fn col(&self, x: f64) -> usize {
-        ((x * self.cols_per_unit) as u32 as usize).min(self.cols - 1)
-    }
-
-    /// Row index of a coordinate, like [`SpatialGrid::col`].
-    #[inline]
-    fn row(&self, y: f64) -> usize {
-        ((y * self.rows_per_unit) as u32 as usize).min(self.rows - 1)
+    fn axis(&self, v: f64) -> usize {
+        ((v * self.cells_per_unit) as u32 as usize).min(self.cols - 1)
     }
 
     #[inline]
     fn cell(&self, p: Vec2) -> u32 {
-        (self.row(p.y) * self.cols + self.col(p.x)) as u32
+        (self.axis(p.y) * self.cols + self.axis(p.x)) as u32
     }
 
     /// Records that `body` is now at `p`.
@@ -139,28 +128,20 @@ impl SpatialGrid {
         }
     }
 
-    /// Calls `visit` for every body in the cells of rows `rows` and columns
-    /// `cols` (inclusive ranges) until it returns true; returns whether it did.
+    /// Calls `pred` with the bodies of each row of the cells that overlap
+    /// the box `min ..= max` (a superset of the bodies inside the box),
+    /// until it returns true; returns whether it did.
     #[inline]
-    fn visit(&self, rows: (usize, usize), cols: (usize, usize), mut visit: impl FnMut(&Neighbour) -> bool) -> bool {
-        for row in rows.0..=rows.1 {
+    pub fn any_in_box(&self, min: Vec2, max: Vec2, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+        let (first_col, last_col) = (self.axis(min.x), self.axis(max.x));
+        for row in self.axis(min.y)..=self.axis(max.y) {
             let base = row * self.cols;
-            let (from, to) = (self.start[base + cols.0], self.start[base + cols.1 + 1]);
-            for n in &self.slots[from as usize..to as usize] {
-                if visit(n) {
-                    return true;
-                }
+            let (from, to) = (self.start[base + first_col], self.start[base + last_col + 1]);
+            if pred(&self.slots[from as usize..to as usize]) {
+                return true;
             }
         }
         false
-    }
-
-    /// Whether `pred` holds for some body whose centre lies in a cell that
-    /// overlaps the box `min ..= max` (a superset of the bodies inside the
-    /// box); stops at the first.
-    #[inline]
-    pub fn any_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&Neighbour) -> bool) -> bool {
-        self.visit((self.row(min.y), self.row(max.y)), (self.col(min.x), self.col(max.x)), pred)
     }
 }
 
@@ -169,13 +150,13 @@ mod tests {
     use super::*;
 
     fn grid(size: f64, cell: f64, pts: &[Vec2]) -> SpatialGrid {
-        SpatialGrid::new(size, cell, cell, pts.iter().map(|&p| (p, 1.0)))
+        SpatialGrid::new(size, cell, pts.iter().map(|&p| (p, 1.0)))
     }
 
     fn found(g: &SpatialGrid, min: Vec2, max: Vec2) -> Vec<u32> {
         let mut v = Vec::new();
-        g.any_in_box(min, max, |n| {
-            v.push(n.body);
+        g.any_in_box(min, max, |row| {
+            v.extend(row.iter().map(|n| n.body));
             false
         });
         v.sort();
@@ -193,8 +174,8 @@ mod tests {
         assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), Vec::<u32>::new());
         assert_eq!(found(&g, Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0)), vec![0, 1]);
         let mut seen = Vec::new();
-        g.any_in_box(Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0), |n| {
-            seen.push((n.body, n.pos));
+        g.any_in_box(Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0), |row| {
+            seen.extend(row.iter().map(|n| (n.body, n.pos)));
             false
         });
         seen.sort_by_key(|s| s.0);

@@ -13,7 +13,7 @@
 
 use super::bitset::BitSet;
 use super::body::{Body, Robot};
-use super::broadphase::NeighbourIndex;
+use super::broadphase::{Candidates, NeighbourIndex};
 use super::config::PhysicsConfig;
 use super::vec2::Vec2;
 use super::SimRng;
@@ -53,7 +53,7 @@ pub struct PhysicsScratch {
     /// last emptied the set (for incremental Eval).
     moved: BitSet,
     contacts: Vec<Contact>,
-    candidates: Vec<u32>,
+    candidates: Candidates,
     robot_pairs: Vec<(u32, u32)>,
 }
 
@@ -74,7 +74,7 @@ impl PhysicsScratch {
             pending: BitSet::new(n),
             moved: BitSet::new(n),
             contacts: Vec::with_capacity(8 * n + 64),
-            candidates: Vec::with_capacity(n),
+            candidates: Candidates::new(n),
             robot_pairs: Vec::with_capacity(robots * robots / 2 + 1),
         }
     }
@@ -263,8 +263,8 @@ impl StepContext<'_> {
         self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, &mut candidates);
         let mut anchor = self.bodies[i].pos;
         let mut k = 0;
-        while k < candidates.len() {
-            let j = candidates[k] as usize;
+        while let Some(&j) = candidates.as_slice().get(k) {
+            let j = j as usize;
             k += 1;
             if self.separate(i, j) && (self.bodies[i].pos - anchor).length_squared() > margin * margin {
                 anchor = self.bodies[i].pos;

@@ -270,34 +270,36 @@ impl PixyCamera {
 
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
-        world.any_body_near(lens, self.max_range, |b| {
-            let j = b.body as usize;
-            if j == robot {
-                return false;
-            }
-            let rel = b.pos - lens;
-            let f = rel.dot(dir);
-            // Cheap culls before projecting: behind the lens, far outside the
-            // horizontal field of view, or out of range.
-            if f + b.radius < 0.0 {
-                return false;
-            }
-            let (height, signature) = if j < robots {
-                (self.robot_height, self.classify.robot_signature)
-            } else {
-                (self.puck_height, self.classify.puck_signature)
-            };
-            let s = rel.dot(right);
-            if s.abs() > (f + b.radius + self.height + height) * self.tan_half_h + b.radius {
-                return false;
-            }
-            let reach = self.max_range + b.radius;
-            let distance_squared = f * f + s * s;
-            if distance_squared > reach * reach {
-                return false;
-            }
-            if let Some(rect) = self.silhouette(f, s, b.radius, height) {
-                in_view.push(InView { distance: distance_squared.sqrt(), index: j, signature, rect });
+        world.any_body_near(lens, self.max_range, |row| {
+            for b in row {
+                let j = b.body as usize;
+                if j == robot {
+                    continue;
+                }
+                let rel = b.pos - lens;
+                let f = rel.dot(dir);
+                // Cheap culls before projecting: behind the lens, far outside the
+                // horizontal field of view, or out of range.
+                if f + b.radius < 0.0 {
+                    continue;
+                }
+                let (height, signature) = if j < robots {
+                    (self.robot_height, self.classify.robot_signature)
+                } else {
+                    (self.puck_height, self.classify.puck_signature)
+                };
+                let s = rel.dot(right);
+                if s.abs() > (f + b.radius + self.height + height) * self.tan_half_h + b.radius {
+                    continue;
+                }
+                let reach = self.max_range + b.radius;
+                let distance_squared = f * f + s * s;
+                if distance_squared > reach * reach {
+                    continue;
+                }
+                if let Some(rect) = self.silhouette(f, s, b.radius, height) {
+                    in_view.push(InView { distance: distance_squared.sqrt(), index: j, signature, rect });
+                }
             }
             false
         });

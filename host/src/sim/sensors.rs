@@ -210,11 +210,12 @@ impl SensorModel for DiscSensors {
             // Both obstacle discs hug the robot: one neighbour query serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
             let (mut seen_left, mut seen_right) = (false, false);
-            world.any_body_near(pos, self.obstacle_reach, |b| {
-                if b.body as usize != i && b.body < obstacles {
+            world.any_body_near(pos, self.obstacle_reach, |row| {
+                for b in row {
+                    let counts = (b.body as usize != i) & (b.body < obstacles);
                     let overlaps = |(c, r): (Vec2, f64)| (b.pos - c).length_squared() < (r + b.radius) * (r + b.radius);
-                    seen_left |= overlaps(obstacle_left);
-                    seen_right |= overlaps(obstacle_right);
+                    seen_left |= counts & overlaps(obstacle_left);
+                    seen_right |= counts & overlaps(obstacle_right);
                 }
                 seen_left && seen_right
             });

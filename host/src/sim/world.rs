@@ -178,19 +178,21 @@ impl World {
         let robots = self.state.robots.len() as u32;
         let half = radius + self.state.config.puck_radius;
         let (min, max) = (centre - Vec2::new(half, half), centre + Vec2::new(half, half));
-        self.index.any_in_box(&self.state.bodies, min, max, |n| {
-            let r = radius + n.radius;
-            n.body >= robots && (n.pos - centre).length_squared() < r * r
+        self.index.any_in_box(min, max, |row| {
+            row.iter().fold(false, |hit, n| {
+                let r = radius + n.radius;
+                hit | ((n.body >= robots) & ((n.pos - centre).length_squared() < r * r))
+            })
         })
     }
 
-    /// Whether `pred` holds for some body; `pred` sees at least every body
-    /// whose circle reaches within `reach` of `centre` (and maybe others),
-    /// and no more after it returns true.
-    pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&Neighbour) -> bool) -> bool {
+    /// Whether `pred` holds for some run of bodies; the runs together hold
+    /// at least every body whose circle reaches within `reach` of `centre`
+    /// (and maybe others), and none are passed after `pred` returns true.
+    pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let r = reach + self.state.config.max_radius();
         let (min, max) = (centre - Vec2::new(r, r), centre + Vec2::new(r, r));
-        self.index.any_in_box(&self.state.bodies, min, max, pred)
+        self.index.any_in_box(min, max, pred)
     }
 }
 
