@@ -134,7 +134,7 @@ impl SpatialGrid {
     #[inline]
     pub fn any_in_box(&self, min: Vec2, max: Vec2, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let (first_col, last_col) = (self.axis(min.x), self.axis(max.x));
-        for row in self.axis(min.y)..=self.axis(max.y) {
+        for row in self.axis(min.y)..self.axis(max.y) + 1 {
             let base = row * self.cols;
             let (from, to) = (self.start[base + first_col], self.start[base + last_col + 1]);
             if pred(&self.slots[from as usize..to as usize]) {

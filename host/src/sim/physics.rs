@@ -41,8 +41,9 @@ pub enum Contact {
 #[derive(Clone, Debug, Default)]
 pub struct PhysicsScratch {
     /// Bodies that may move or touch something: robots, bodies with a
-    /// velocity, bodies in contact last step. Everything else is at rest
-    /// and costs nothing.
+    /// velocity, bodies in contact last step (and, until the next step
+    /// drops them, pucks that came to rest in the last one). Everything
+    /// else is at rest and costs nothing.
     live: BitSet,
     /// Bodies checked against other bodies this step.
     awake: BitSet,
@@ -129,12 +130,12 @@ impl StepContext<'_> {
         self.integrate();
         self.resolve_overlaps();
         self.apply_impulses();
-        self.retire_resting();
     }
 
     /// Velocity from heading for robots; rest below the stop speed; then
     /// `p += v`, `v -= k v`. Marks which bodies are awake. Only live bodies
-    /// can move, so only they are visited.
+    /// can move, so only they are visited; a puck that is neither moving
+    /// nor in contact leaves the live set until a contact wakes it.
     fn integrate(&mut self) {
         let stop2 = self.config.stop_speed * self.config.stop_speed;
         let keep = 1.0 - self.config.deceleration;
@@ -148,7 +149,7 @@ impl StepContext<'_> {
             if i < robots {
                 b.vel = self.robots[i].direction * self.forward_speed;
             }
-            let moving = b.vel.length_squared() >= stop2 && b.vel != Vec2::ZERO;
+            let moving = (b.vel.length_squared() >= stop2) & (b.vel != Vec2::ZERO);
             if moving {
                 b.pos += b.vel;
                 b.vel = b.vel * keep;
@@ -159,6 +160,8 @@ impl StepContext<'_> {
             }
             if moving || b.in_contact {
                 sc.awake.insert(i);
+            } else if i >= robots {
+                sc.live.remove(i);
             }
             b.in_contact = false;
         }
@@ -176,20 +179,6 @@ impl StepContext<'_> {
                 self.resolve_circles(i);
             }
             self.clamp(i);
-        }
-    }
-
-    /// Drops from the live set the pucks that have come to rest out of contact.
-    fn retire_resting(&mut self) {
-        let robots = self.robots.len();
-        let live = &mut self.scratch.live;
-        let mut next = live.next_from(robots);
-        while let Some(i) = next {
-            next = live.next_from(i + 1);
-            let b = &self.bodies[i];
-            if b.vel == Vec2::ZERO && !b.in_contact {
-                live.remove(i);
-            }
         }
     }
 
@@ -222,7 +211,7 @@ impl StepContext<'_> {
         let s = self.arena_size;
         let reach = self.bodies[i].radius + self.config.wall_radius - self.config.overlap_threshold;
         let p = self.bodies[i].pos;
-        if p.x >= reach && p.x <= s - reach && p.y >= reach && p.y <= s - reach {
+        if (p.x >= reach) & (p.x <= s - reach) & (p.y >= reach) & (p.y <= s - reach) {
             return; // farther than `reach` from every wall: no contact possible
         }
         // (axis is x?, wall coordinate, inward normal)
@@ -283,7 +272,7 @@ impl StepContext<'_> {
         let reach = ri + rj - self.config.overlap_threshold;
         let mut delta = self.bodies[j].pos - self.bodies[i].pos;
         let mut d2 = delta.length_squared();
-        if reach <= 0.0 || d2 >= reach * reach {
+        if (reach <= 0.0) | (d2 >= reach * reach) {
             return false;
         }
         if d2 == 0.0 {
