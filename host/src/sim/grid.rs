@@ -30,6 +30,7 @@ pub struct SpatialGrid {
     cols: usize,
     /// Cell `c` holds the slots `start[c] .. start[c + 1]`.
     start: Vec<u32>,
+    /// The bodies, cell by cell.
     slots: Vec<Neighbour>,
     /// Each body's slot.
     slot_of: Vec<u32>,
