@@ -68,7 +68,6 @@ impl NeighbourIndex {
         margin: f64,
         out: &mut Candidates,
     ) {
-        let first = after.map_or(0, |a| a as u32 + 1);
         let (pos, radius) = (bodies[body].pos, bodies[body].radius);
         let half = radius + max_radius + margin;
         let mut len = 0;
@@ -80,7 +79,7 @@ impl NeighbourIndex {
                 let reach = radius + n.radius + margin;
                 let near = (n.pos - pos).length_squared() < reach * reach;
                 out.slots[len] = n.body;
-                len += usize::from(near & (n.body as usize != body) & (n.body >= first));
+                len += usize::from(near & (n.body as usize != body));
             }
             false
         });
@@ -95,7 +94,11 @@ impl NeighbourIndex {
             }
             found[at] = j;
         }
-        out.len = len;
+        // Only a re-gather in the middle of a turn passes `after`: drop
+        // what it has already handled.
+        let done = after.map_or(0, |a| found.partition_point(|&j| j as usize <= a));
+        found.copy_within(done.., 0);
+        out.len = len - done;
     }
 
     /// Whether `pred` holds for some run of bodies among those visited:

@@ -166,10 +166,8 @@ pub struct DiscSensors {
     field: [Vec2; 3],
     /// Left discs then right discs, per kind: `[outie, innie]`.
     pucks: [[Vec<LocalDisc>; 2]; 2],
-    /// Left and right obstacle discs.
+    /// Left and right obstacle discs (mirror images: the same radius).
     obstacle: [LocalDisc; 2],
-    /// How far from the robot's centre the obstacle discs reach.
-    obstacle_reach: f64,
     targets: ObstacleTargets,
 }
 
@@ -185,7 +183,6 @@ impl DiscSensors {
             field: [Vec2::new(side.x, -side.y), Vec2::new(config.field_distance * robot_radius, 0.0), side],
             pucks: [pucks(&config.outie_pucks), pucks(&config.innie_pucks)],
             obstacle: LocalDisc::pair(&config.obstacle, robot_radius),
-            obstacle_reach: (config.obstacle.distance + config.obstacle.radius) * robot_radius,
             targets: config.obstacle_targets,
         }
     }
@@ -207,10 +204,14 @@ impl SensorModel for DiscSensors {
             let at = |local: Vec2| pos + local.rotated(robot.direction);
             let [left, right] = self.puck_discs(robot.kind);
             let any_puck = |discs: &[LocalDisc]| discs.iter().any(|d| world.any_puck_in_disc(at(d.offset), d.radius));
-            // Both obstacle discs hug the robot: one neighbour query serves both.
+            // Both obstacle discs hug the robot: one neighbour query, over
+            // the box around both, serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
+            let reach = self.obstacle[0].radius + world.config().max_radius();
+            let min = Vec2::new(obstacle_left.0.x.min(obstacle_right.0.x), obstacle_left.0.y.min(obstacle_right.0.y));
+            let max = Vec2::new(obstacle_left.0.x.max(obstacle_right.0.x), obstacle_left.0.y.max(obstacle_right.0.y));
             let (mut seen_left, mut seen_right) = (false, false);
-            world.any_body_near(pos, self.obstacle_reach, |row| {
+            world.any_body_in_box(min - Vec2::new(reach, reach), max + Vec2::new(reach, reach), |row| {
                 for b in row {
                     let counts = (b.body as usize != i) & (b.body < obstacles);
                     let overlaps = |(c, r): (Vec2, f64)| (b.pos - c).length_squared() < (r + b.radius) * (r + b.radius);

@@ -191,7 +191,13 @@ impl World {
     /// (and maybe others), and none are passed after `pred` returns true.
     pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let r = reach + self.state.config.max_radius();
-        let (min, max) = (centre - Vec2::new(r, r), centre + Vec2::new(r, r));
+        self.any_body_in_box(centre - Vec2::new(r, r), centre + Vec2::new(r, r), pred)
+    }
+
+    /// Whether `pred` holds for some run of bodies; the runs together hold
+    /// at least every body whose centre lies in the box `min ..= max` (and
+    /// maybe others), and none are passed after `pred` returns true.
+    pub fn any_body_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         self.index.any_in_box(min, max, pred)
     }
 }
