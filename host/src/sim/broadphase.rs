@@ -97,7 +97,9 @@ impl NeighbourIndex {
         // Only a re-gather in the middle of a turn passes `after`: drop
         // what it has already handled.
         let done = after.map_or(0, |a| found.partition_point(|&j| j as usize <= a));
-        found.copy_within(done.., 0);
+        if done > 0 {
+            found.copy_within(done.., 0);
+        }
         out.len = len - done;
     }
 
