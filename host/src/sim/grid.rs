@@ -121,6 +121,7 @@ impl SpatialGrid {
         self.cell_of[body] = to;
     }
 
+    #[inline]
     fn swap_slots(&mut self, a: u32, b: u32) {
         if a != b {
             self.slots.swap(a as usize, b as usize);
