@@ -4,8 +4,8 @@
 //!
 //! Each slot holds a copy of a body's centre and radius: a query reads
 //! nothing else. The grid is updated whenever a body moves, so it always
-//! matches the current positions; a body that changes cell is carried
-//! there by swaps along the cells in between. Updates and queries
+//! matches the current positions; when a body changes cell, the slots
+//! between its old and new place shift by one. Updates and queries
 //! allocate nothing.
 
 use super::vec2::Vec2;
@@ -97,37 +97,28 @@ impl SpatialGrid {
     }
 
     /// Carries a body from cell `from` to cell `to` (the rare case of
-    /// [`SpatialGrid::moved`]): at each cell boundary on the way it swaps
-    /// places with the cell's end slot and the boundary moves past it.
+    /// [`SpatialGrid::moved`]): the slots in between shift by one towards
+    /// the body's old slot, keeping their cells, and every cell boundary in
+    /// between moves by one.
     #[cold]
     #[inline(never)]
     fn relink(&mut self, body: usize, from: u32, to: u32) {
-        let mut slot = self.slot_of[body];
-        if from < to {
-            for boundary in from as usize + 1..=to as usize {
-                let last = self.start[boundary] - 1;
-                self.swap_slots(slot, last);
-                slot = last;
-                self.start[boundary] = last;
-            }
+        let (from, to, slot) = (from as usize, to as usize, self.slot_of[body] as usize);
+        let target = if from < to {
+            let target = self.start[to] as usize - 1;
+            self.slots[slot..=target].rotate_left(1);
+            self.start[from + 1..=to].iter_mut().for_each(|b| *b -= 1);
+            target
         } else {
-            for boundary in (to as usize + 1..=from as usize).rev() {
-                let first = self.start[boundary];
-                self.swap_slots(slot, first);
-                slot = first;
-                self.start[boundary] = first + 1;
-            }
+            let target = self.start[to + 1] as usize;
+            self.slots[target..=slot].rotate_right(1);
+            self.start[to + 1..=from].iter_mut().for_each(|b| *b += 1);
+            target
+        };
+        for k in slot.min(target)..=slot.max(target) {
+            self.slot_of[self.slots[k].body as usize] = k as u32;
         }
-        self.cell_of[body] = to;
-    }
-
-    #[inline]
-    fn swap_slots(&mut self, a: u32, b: u32) {
-        if a != b {
-            self.slots.swap(a as usize, b as usize);
-            self.slot_of[self.slots[a as usize].body as usize] = a;
-            self.slot_of[self.slots[b as usize].body as usize] = b;
-        }
+        self.cell_of[body] = to as u32;
     }
 
     /// Calls `pred` with the bodies of each row of the cells that overlap
