@@ -28,7 +28,7 @@ pub struct Candidates {
 impl Candidates {
     /// A buffer for a world of `bodies` bodies.
     pub fn new(bodies: usize) -> Candidates {
-        Candidates { slots: vec![0; bodies.max(1)], len: 0 }
+        Candidates { slots: vec![0; bodies], len: 0 }
     }
 
     /// The candidates, ascending.

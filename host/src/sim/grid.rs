@@ -51,22 +51,19 @@ impl SpatialGrid {
             slot_of: Vec::new(),
             cell_of: Vec::new(),
         };
-        // A counting sort: bodies per cell, their running sum, placement.
+        // Slots in cell order (a stable sort: by body within a cell); each
+        // cell starts where the counts of the cells before it end.
         grid.cell_of = grid.slots.iter().map(|n| grid.cell(n.pos)).collect();
+        grid.slots.sort_by_key(|n| grid.cell_of[n.body as usize]);
+        grid.slot_of = vec![0; grid.slots.len()];
+        for (slot, n) in grid.slots.iter().enumerate() {
+            grid.slot_of[n.body as usize] = slot as u32;
+        }
         for &cell in &grid.cell_of {
             grid.start[cell as usize + 1] += 1;
         }
         for c in 1..grid.start.len() {
             grid.start[c] += grid.start[c - 1];
-        }
-        let mut next = grid.start.clone();
-        grid.slot_of = grid.cell_of.iter().map(|&cell| {
-            next[cell as usize] += 1;
-            next[cell as usize] - 1
-        }).collect();
-        let unsorted = grid.slots.clone();
-        for n in unsorted {
-            grid.slots[grid.slot_of[n.body as usize] as usize] = n;
         }
         grid
     }

@@ -177,8 +177,7 @@ impl World {
     pub fn any_puck_in_disc(&self, centre: Vec2, radius: f64) -> bool {
         let robots = self.state.robots.len() as u32;
         let half = radius + self.state.config.puck_radius;
-        let (min, max) = (centre - Vec2::new(half, half), centre + Vec2::new(half, half));
-        self.index.any_in_box(min, max, |row| {
+        self.any_body_in_box(centre - Vec2::new(half, half), centre + Vec2::new(half, half), |row| {
             row.iter().fold(false, |hit, n| {
                 let r = radius + n.radius;
                 hit | ((n.body >= robots) & ((n.pos - centre).length_squared() < r * r))
