@@ -87,3 +87,36 @@ fn field_sensors_read_the_rounded_cells_and_zero_past_the_edge() {
     assert_eq!(world_at(773.75).mid, FieldValue::ZERO);
     assert_eq!(world_at(785.0).mid, FieldValue::ZERO);
 }
+
+/// The sensors remember which puck set each puck bit, to test it first
+/// next time. That is only a shortcut: readings along an orbital
+/// construction run, also after sensing another world in between, equal
+/// those of sensors that start afresh every step.
+#[test]
+fn readings_do_not_depend_on_what_the_sensors_saw_before() {
+    use host::controller::{OrbitalConfig, OrbitalConstruction};
+    use host::sim::{Simulation, Thresholds};
+    use std::sync::Arc;
+    let config = SimConfig::default();
+    let field = Arc::new(ScalarField::annulus());
+    let mut sim = Simulation::new(config.clone(), field.clone(), 3).expect("valid config");
+    let mut oc = OrbitalConstruction::new(OrbitalConfig::default(), &Thresholds::default());
+    let mut remembering = DiscSensors::new(&config.sensors, R);
+    let mut out = vec![SensorReading::default(); config.world.robots];
+    let mut fresh_out = out.clone();
+    let mut hits = 0;
+    for step in 0..3000 {
+        sim.step(&mut oc);
+        if step == 1500 {
+            // another world, with other pucks at the remembered indices
+            remembering.sense(&World::new(&config, 99).expect("valid config"), &field, &mut out);
+        }
+        let world = sim.world();
+        remembering.sense(world, &field, &mut out);
+        DiscSensors::new(&config.sensors, R).sense(world, &field, &mut fresh_out);
+        assert_eq!(out, fresh_out, "step {step}");
+        assert_eq!(out, sim.readings(), "step {step}");
+        hits += out.iter().filter(|r| r.puck_left || r.puck_right).count();
+    }
+    assert!(hits > 3000, "the run must exercise the puck sensors ({hits} readings with a puck)");
+}

@@ -160,7 +160,7 @@ impl LocalDisc {
 }
 
 /// The reference model's disc sensors, with the geometry converted to units.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct DiscSensors {
     /// Left, mid, right sample points.
     field: [Vec2; 3],
@@ -169,6 +169,11 @@ pub struct DiscSensors {
     /// Left and right obstacle discs (mirror images: the same radius).
     obstacle: [LocalDisc; 2],
     targets: ObstacleTargets,
+    /// Per robot, left and right: the puck that set the puck bit last
+    /// time. A puck usually stays in a disc for several steps, so it is
+    /// tested first and spares the neighbour queries. Only a hint: it is
+    /// tested exactly like any other puck, so readings never depend on it.
+    witnesses: Vec<[usize; 2]>,
 }
 
 impl DiscSensors {
@@ -184,6 +189,7 @@ impl DiscSensors {
             pucks: [pucks(&config.outie_pucks), pucks(&config.innie_pucks)],
             obstacle: LocalDisc::pair(&config.obstacle, robot_radius),
             targets: config.obstacle_targets,
+            witnesses: Vec::new(),
         }
     }
 
@@ -199,11 +205,16 @@ impl SensorModel for DiscSensors {
             ObstacleTargets::Robots => world.robots().len(),
             ObstacleTargets::AnyBody => world.bodies().len(),
         } as u32;
-        for (i, (robot, reading)) in world.robots().iter().zip(out.iter_mut()).enumerate() {
+        let mut witnesses = std::mem::take(&mut self.witnesses);
+        witnesses.resize(world.robots().len(), [usize::MAX; 2]);
+        for (i, ((robot, reading), witness)) in world.robots().iter().zip(out.iter_mut()).zip(&mut witnesses).enumerate() {
             let pos = world.bodies()[i].pos;
             let at = |local: Vec2| pos + local.rotated(robot.direction);
             let [left, right] = self.puck_discs(robot.kind);
-            let any_puck = |discs: &[LocalDisc]| discs.iter().any(|d| world.any_puck_in_disc(at(d.offset), d.radius));
+            let any_puck = |discs: &[LocalDisc], witness: &mut usize| {
+                discs.iter().any(|d| world.puck_overlaps_disc(*witness, at(d.offset), d.radius))
+                    || discs.iter().find_map(|d| world.puck_in_disc(at(d.offset), d.radius)).map(|puck| *witness = puck).is_some()
+            };
             // Both obstacle discs hug the robot: one neighbour query, over
             // the box around both, serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
@@ -224,12 +235,13 @@ impl SensorModel for DiscSensors {
                 left: field.sense(at(self.field[0]), size),
                 mid: field.sense(at(self.field[1]), size),
                 right: field.sense(at(self.field[2]), size),
-                puck_left: any_puck(left),
-                puck_right: any_puck(right),
+                puck_left: any_puck(left, &mut witness[0]),
+                puck_right: any_puck(right, &mut witness[1]),
                 obstacle_left: seen_left,
                 obstacle_right: seen_right,
             };
         }
+        self.witnesses = witnesses;
     }
 
     fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {

@@ -172,17 +172,34 @@ impl World {
         self.scratch.contacts()
     }
 
-    /// Whether any puck overlaps the disc at `centre` of `radius`
-    /// (strictly: touching is not overlapping).
-    pub fn any_puck_in_disc(&self, centre: Vec2, radius: f64) -> bool {
+    /// A puck that overlaps the disc at `centre` of `radius` (strictly:
+    /// touching is not overlapping), if there is one.
+    pub fn puck_in_disc(&self, centre: Vec2, radius: f64) -> Option<usize> {
+        const NONE: u32 = u32::MAX;
         let robots = self.state.robots.len() as u32;
         let half = radius + self.state.config.puck_radius;
+        let mut found = NONE;
         self.any_body_in_box(centre - Vec2::new(half, half), centre + Vec2::new(half, half), |row| {
-            row.iter().fold(false, |hit, n| {
+            for n in row {
                 let r = radius + n.radius;
-                hit | ((n.body >= robots) & ((n.pos - centre).length_squared() < r * r))
-            })
-        })
+                let hit = (n.body >= robots) & ((n.pos - centre).length_squared() < r * r);
+                found = if hit { n.body } else { found };
+            }
+            found != NONE
+        });
+        (found != NONE).then_some(found as usize)
+    }
+
+    /// Whether body `body` is a puck that overlaps the disc at `centre` of
+    /// `radius`: the test of [`World::puck_in_disc`] for one body.
+    pub fn puck_overlaps_disc(&self, body: usize, centre: Vec2, radius: f64) -> bool {
+        match self.state.bodies.get(body) {
+            Some(b) if body >= self.state.robots.len() => {
+                let r = radius + b.radius;
+                (b.pos - centre).length_squared() < r * r
+            }
+            _ => false,
+        }
     }
 
     /// Whether `pred` holds for some run of bodies; the runs together hold
