@@ -74,15 +74,23 @@ impl NeighbourIndex {
         // Every body is written to the next free slot and kept only if it
         // qualifies: no branch to mispredict. A query visits each body at
         // most once, so there is always a free slot.
-        self.grid.any_in_box(pos - Vec2::new(half, half), pos + Vec2::new(half, half), |row| {
+        let mut gather = |row: &[Neighbour]| {
             for n in row {
                 let reach = radius + n.radius + margin;
                 let near = (n.pos - pos).length_squared() < reach * reach;
                 out.slots[len] = n.body;
                 len += usize::from(near & (n.body as usize != body));
             }
-            false
-        });
+        };
+        if half <= self.grid.cell_width() {
+            // Everything within reach is in the body's cell or next to it.
+            self.grid.visit_around(body, gather);
+        } else {
+            self.grid.any_in_box(pos - Vec2::new(half, half), pos + Vec2::new(half, half), |row| {
+                gather(row);
+                false
+            });
+        }
         // Insertion sort: the list is short.
         let found = &mut out.slots[..len];
         for k in 1..found.len() {

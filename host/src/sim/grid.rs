@@ -22,19 +22,27 @@ pub struct Neighbour {
 }
 
 /// Bodies binned by the cell of their centre. Positions outside the arena
-/// fall in the border cells, which keeps every query a superset of the
-/// bodies it must find.
+/// fall in the outermost cells of the arena, which keeps every query a
+/// superset of the bodies it must find.
+///
+/// A ring of cells that stay empty surrounds the arena's `cols` x `cols`
+/// cells, so that the eight cells around any body's cell exist: the
+/// neighbourhood of a body is three runs of three cells, found from its
+/// cell index alone ([`SpatialGrid::visit_around`]).
 #[derive(Clone, Debug)]
 pub struct SpatialGrid {
     cells_per_unit: f64,
+    /// Cells across the arena.
     cols: usize,
+    /// Cells across the arena and its empty ring: `cols + 2`.
+    stride: usize,
     /// Cell `c` holds the slots `start[c] .. start[c + 1]`.
     start: Vec<u32>,
     /// The bodies, cell by cell.
     slots: Vec<Neighbour>,
     /// Each body's slot.
     slot_of: Vec<u32>,
-    /// Each body's cell, `row * cols + col`.
+    /// Each body's cell, `row * stride + col` (the ring counted).
     cell_of: Vec<u32>,
 }
 
@@ -46,7 +54,8 @@ impl SpatialGrid {
         let mut grid = SpatialGrid {
             cells_per_unit: cols as f64 / size,
             cols,
-            start: vec![0; cols * cols + 1],
+            stride: cols + 2,
+            start: vec![0; (cols + 2) * (cols + 2) + 1],
             slots: bodies.enumerate().map(|(body, (pos, radius))| Neighbour { pos, radius, body: body as u32 }).collect(),
             slot_of: Vec::new(),
             cell_of: Vec::new(),
@@ -68,18 +77,19 @@ impl SpatialGrid {
         grid
     }
 
-    /// Column or row index of a coordinate, clamped to the grid. (`as`
+    /// Column or row index of a coordinate, clamped to the arena's cells
+    /// (the empty ring excluded: from 1 to `cols`). (`as`
     /// truncates, which is the floor for the non-negative values it sees;
     /// `floor` would be a libm call on baseline x86-64, and a cast to `u32`
     /// is cheaper than one to `usize`.)
     #[inline]
     fn axis(&self, v: f64) -> usize {
-        ((v * self.cells_per_unit) as u32 as usize).min(self.cols - 1)
+        ((v * self.cells_per_unit) as u32 as usize).min(self.cols - 1) + 1
     }
 
     #[inline]
     fn cell(&self, p: Vec2) -> u32 {
-        (self.axis(p.y) * self.cols + self.axis(p.x)) as u32
+        (self.axis(p.y) * self.stride + self.axis(p.x)) as u32
     }
 
     /// Records that `body` is now at `p`.
@@ -125,13 +135,30 @@ impl SpatialGrid {
     pub fn any_in_box(&self, min: Vec2, max: Vec2, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let (first_col, last_col) = (self.axis(min.x), self.axis(max.x));
         for row in self.axis(min.y)..self.axis(max.y) + 1 {
-            let base = row * self.cols;
+            let base = row * self.stride;
             let (from, to) = (self.start[base + first_col], self.start[base + last_col + 1]);
             if pred(&self.slots[from as usize..to as usize]) {
                 return true;
             }
         }
         false
+    }
+
+    /// Calls `visit` with the bodies of body `body`'s cell and the eight
+    /// around it, one row of three cells at a time: every body whose centre
+    /// is less than a cell's width away from `body`'s (and others).
+    #[inline]
+    pub fn visit_around(&self, body: usize, mut visit: impl FnMut(&[Neighbour])) {
+        let cell = self.cell_of[body] as usize;
+        for mid in [cell - self.stride, cell, cell + self.stride] {
+            let (from, to) = (self.start[mid - 1], self.start[mid + 2]);
+            visit(&self.slots[from as usize..to as usize]);
+        }
+    }
+
+    /// The width of a cell.
+    pub fn cell_width(&self) -> f64 {
+        1.0 / self.cells_per_unit
     }
 }
 
@@ -178,6 +205,28 @@ mod tests {
         let g = grid(2000.0, 20.0, &pts);
         assert_eq!(found(&g, Vec2::new(1250.0, 0.0), Vec2::new(1310.0, 40.0)), vec![62, 63, 64, 65]);
         assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(2000.0, 2000.0)).len(), 100);
+    }
+
+    /// A body's neighbourhood holds every body less than a cell's width
+    /// away, also at the arena's edges and for bodies outside it.
+    #[test]
+    fn the_cells_around_a_body_hold_everything_within_a_cell_width() {
+        let pts: Vec<Vec2> = (0..400).map(|i| Vec2::new((i * 37 % 113) as f64 - 6.5, (i * 53 % 109) as f64 - 4.5)).collect();
+        let g = grid(100.0, 10.0, &pts);
+        assert_eq!(g.cell_width(), 10.0);
+        for (b, p) in pts.iter().enumerate() {
+            let mut seen = Vec::new();
+            g.visit_around(b, |row| seen.extend(row.iter().map(|n| n.body)));
+            let mut unique = seen.clone();
+            unique.sort();
+            unique.dedup();
+            assert_eq!(unique.len(), seen.len(), "no body twice");
+            for (j, q) in pts.iter().enumerate() {
+                if (*q - *p).length() < 10.0 {
+                    assert!(seen.contains(&(j as u32)), "body {j} near body {b}");
+                }
+            }
+        }
     }
 
     /// Many bodies carried across many cells in both directions stay
