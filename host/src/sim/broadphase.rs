@@ -74,23 +74,16 @@ impl NeighbourIndex {
         // Every body is written to the next free slot and kept only if it
         // qualifies: no branch to mispredict. A query visits each body at
         // most once, so there is always a free slot.
-        let mut gather = |row: &[Neighbour]| {
+        let gather = |row: &[Neighbour]| {
             for n in row {
                 let reach = radius + n.radius + margin;
                 let near = (n.pos - pos).length_squared() < reach * reach;
                 out.slots[len] = n.body;
                 len += usize::from(near & (n.body as usize != body));
             }
+            false
         };
-        if half <= self.grid.cell_width() {
-            // Everything within reach is in the body's cell or next to it.
-            self.grid.visit_around(body, gather);
-        } else {
-            self.grid.any_in_box(pos - Vec2::new(half, half), pos + Vec2::new(half, half), |row| {
-                gather(row);
-                false
-            });
-        }
+        self.any_around(bodies, body, half, gather);
         // Insertion sort: the list is short.
         let found = &mut out.slots[..len];
         for k in 1..found.len() {
@@ -109,6 +102,21 @@ impl NeighbourIndex {
             found.copy_within(done.., 0);
         }
         out.len = len - done;
+    }
+
+    /// Whether `pred` holds for some run of bodies among those visited:
+    /// runs that together hold a superset of the bodies whose centres are
+    /// closer than `reach` to body `body`'s. Stops at the first run for
+    /// which it holds. Within a cell's width, the body's cell and the
+    /// eight around it are searched, with no box to convert to cells.
+    #[inline]
+    pub fn any_around(&self, bodies: &[Body], body: usize, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+        if reach <= self.grid.cell_width() {
+            self.grid.any_around(body, pred)
+        } else {
+            let pos = bodies[body].pos;
+            self.grid.any_in_box(pos - Vec2::new(reach, reach), pos + Vec2::new(reach, reach), pred)
+        }
     }
 
     /// Whether `pred` holds for some run of bodies among those visited:

@@ -28,7 +28,7 @@ pub struct Neighbour {
 /// A ring of cells that stay empty surrounds the arena's `cols` x `cols`
 /// cells, so that the eight cells around any body's cell exist: the
 /// neighbourhood of a body is three runs of three cells, found from its
-/// cell index alone ([`SpatialGrid::visit_around`]).
+/// cell index alone ([`SpatialGrid::any_around`]).
 #[derive(Clone, Debug)]
 pub struct SpatialGrid {
     cells_per_unit: f64,
@@ -144,16 +144,17 @@ impl SpatialGrid {
         false
     }
 
-    /// Calls `visit` with the bodies of body `body`'s cell and the eight
-    /// around it, one row of three cells at a time: every body whose centre
-    /// is less than a cell's width away from `body`'s (and others).
+    /// Calls `pred` with the bodies of body `body`'s cell and the eight
+    /// around it, one row of three cells at a time (every body whose
+    /// centre is less than a cell's width away from `body`'s, and others),
+    /// until it returns true; returns whether it did.
     #[inline]
-    pub fn visit_around(&self, body: usize, mut visit: impl FnMut(&[Neighbour])) {
+    pub fn any_around(&self, body: usize, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let cell = self.cell_of[body] as usize;
-        for mid in [cell - self.stride, cell, cell + self.stride] {
+        [cell - self.stride, cell, cell + self.stride].into_iter().any(|mid| {
             let (from, to) = (self.start[mid - 1], self.start[mid + 2]);
-            visit(&self.slots[from as usize..to as usize]);
-        }
+            pred(&self.slots[from as usize..to as usize])
+        })
     }
 
     /// The width of a cell.
@@ -216,7 +217,10 @@ mod tests {
         assert_eq!(g.cell_width(), 10.0);
         for (b, p) in pts.iter().enumerate() {
             let mut seen = Vec::new();
-            g.visit_around(b, |row| seen.extend(row.iter().map(|n| n.body)));
+            g.any_around(b, |row| {
+                seen.extend(row.iter().map(|n| n.body));
+                false
+            });
             let mut unique = seen.clone();
             unique.sort();
             unique.dedup();

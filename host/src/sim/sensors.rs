@@ -168,6 +168,8 @@ pub struct DiscSensors {
     pucks: [[Vec<LocalDisc>; 2]; 2],
     /// Left and right obstacle discs (mirror images: the same radius).
     obstacle: [LocalDisc; 2],
+    /// How far from the robot's centre the obstacle discs reach.
+    obstacle_reach: f64,
     targets: ObstacleTargets,
     /// Per robot, left and right: the puck that set the puck bit last
     /// time. A puck usually stays in a disc for several steps, so it is
@@ -188,6 +190,7 @@ impl DiscSensors {
             field: [Vec2::new(side.x, -side.y), Vec2::new(config.field_distance * robot_radius, 0.0), side],
             pucks: [pucks(&config.outie_pucks), pucks(&config.innie_pucks)],
             obstacle: LocalDisc::pair(&config.obstacle, robot_radius),
+            obstacle_reach: (config.obstacle.distance + config.obstacle.radius) * robot_radius,
             targets: config.obstacle_targets,
             witnesses: Vec::new(),
         }
@@ -215,14 +218,11 @@ impl SensorModel for DiscSensors {
                 discs.iter().any(|d| world.puck_overlaps_disc(*witness, at(d.offset), d.radius))
                     || discs.iter().find_map(|d| world.puck_in_disc(at(d.offset), d.radius)).map(|puck| *witness = puck).is_some()
             };
-            // Both obstacle discs hug the robot: one neighbour query, over
-            // the box around both, serves both.
+            // Both obstacle discs hug the robot: one neighbour query around
+            // the robot serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
-            let reach = self.obstacle[0].radius + world.config().max_radius();
-            let min = Vec2::new(obstacle_left.0.x.min(obstacle_right.0.x), obstacle_left.0.y.min(obstacle_right.0.y));
-            let max = Vec2::new(obstacle_left.0.x.max(obstacle_right.0.x), obstacle_left.0.y.max(obstacle_right.0.y));
             let (mut seen_left, mut seen_right) = (false, false);
-            world.any_body_in_box(min - Vec2::new(reach, reach), max + Vec2::new(reach, reach), |row| {
+            world.any_body_around(i, self.obstacle_reach + world.config().max_radius(), |row| {
                 for b in row {
                     let counts = (b.body as usize != i) & (b.body < obstacles);
                     let overlaps = |(c, r): (Vec2, f64)| (b.pos - c).length_squared() < (r + b.radius) * (r + b.radius);

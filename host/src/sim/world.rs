@@ -203,6 +203,14 @@ impl World {
     }
 
     /// Whether `pred` holds for some run of bodies; the runs together hold
+    /// at least every body whose centre is closer than `reach` to body
+    /// `body`'s (and maybe others), and none are passed after `pred`
+    /// returns true.
+    pub fn any_body_around(&self, body: usize, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+        self.index.any_around(&self.state.bodies, body, reach, pred)
+    }
+
+    /// Whether `pred` holds for some run of bodies; the runs together hold
     /// at least every body whose circle reaches within `reach` of `centre`
     /// (and maybe others), and none are passed after `pred` returns true.
     pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
