@@ -13,9 +13,11 @@ use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// Version of [`TrialResult`]'s layout and meaning; part of the config
-/// hash, so results of another version are re-run, not mixed in.
-pub const RESULT_FORMAT: u32 = 1;
+/// Version of [`TrialResult`]'s layout and meaning, and of the
+/// simulator's results; part of the config hash, so results of another
+/// version are re-run, not mixed in. 2: headings turn through our own
+/// `sin_cos` (`sim::trig`) instead of the platform's.
+pub const RESULT_FORMAT: u32 = 2;
 
 /// Steps per collision block (the thesis' chapter 6 metric).
 pub const BLOCK_STEPS: u64 = 1000;

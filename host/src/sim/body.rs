@@ -1,6 +1,7 @@
 //! Circle bodies and the robots that drive some of them.
 
 use super::vec2::Vec2;
+use std::f64::consts::{PI, TAU};
 use serde::{Deserialize, Serialize};
 
 /// A circle in the arena: a robot or a puck.
@@ -59,10 +60,13 @@ impl Robot {
         Robot { heading, direction: Vec2::from_angle(heading), kind }
     }
 
-    /// Turns by `angle` radians (positive = right).
+    /// Turns by `angle` radians (positive = right). The heading is kept
+    /// within [-pi, pi] (whole turns are dropped), where its sine and
+    /// cosine are most accurate.
     pub fn turn(&mut self, angle: f64) {
         if angle != 0.0 {
-            self.heading += angle;
+            let heading = self.heading + angle;
+            self.heading = if heading.abs() > PI { heading - TAU * (heading / TAU).round() } else { heading };
             self.direction = Vec2::from_angle(self.heading);
         }
     }

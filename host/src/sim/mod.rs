@@ -21,6 +21,7 @@ pub mod pixy_camera;
 pub mod robot_sensors;
 pub mod sensors;
 pub mod simulation;
+pub mod trig;
 pub mod vec2;
 pub mod world;
 

@@ -21,9 +21,10 @@ impl Vec2 {
         Vec2 { x, y }
     }
 
-    /// The unit vector at `angle` radians (0 = +x, growing clockwise on screen).
+    /// The unit vector at `angle` radians (0 = +x, growing clockwise on
+    /// screen), the same on every machine ([`super::trig`]).
     pub fn from_angle(angle: f64) -> Vec2 {
-        let (s, c) = angle.sin_cos();
+        let (s, c) = super::trig::sin_cos(angle);
         Vec2 { x: c, y: s }
     }
 
