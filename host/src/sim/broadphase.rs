@@ -107,11 +107,12 @@ impl NeighbourIndex {
     /// Whether `pred` holds for some run of bodies among those visited:
     /// runs that together hold a superset of the bodies whose centres are
     /// closer than `reach` to body `body`'s. Stops at the first run for
-    /// which it holds. Within a cell's width, the body's cell and the
+    /// which it holds. Within a cell's width (less a hair, so that the
+    /// rounding of cell indices cannot matter), the body's cell and the
     /// eight around it are searched, with no box to convert to cells.
     #[inline]
     pub fn any_around(&self, bodies: &[Body], body: usize, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
-        if reach <= self.grid.cell_width() {
+        if reach <= self.grid.cell_width() * (1.0 - 1e-9) {
             self.grid.any_around(body, pred)
         } else {
             let pos = bodies[body].pos;
