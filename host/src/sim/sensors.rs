@@ -11,7 +11,7 @@ use super::body::RobotKind;
 use super::config::{check, positive, ConfigError};
 use super::field::ScalarField;
 use super::vec2::Vec2;
-use super::world::World;
+use super::world::{disc_overlaps, World};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 
@@ -225,7 +225,7 @@ impl SensorModel for DiscSensors {
             world.any_body_around(i, self.obstacle_reach + world.config().max_radius(), |row| {
                 for b in row {
                     let counts = (b.body as usize != i) & (b.body < obstacles);
-                    let overlaps = |(c, r): (Vec2, f64)| (b.pos - c).length_squared() < (r + b.radius) * (r + b.radius);
+                    let overlaps = |(c, r): (Vec2, f64)| disc_overlaps(c, r, b.pos, b.radius);
                     seen_left |= counts & overlaps(obstacle_left);
                     seen_right |= counts & overlaps(obstacle_right);
                 }

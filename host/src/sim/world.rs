@@ -181,8 +181,7 @@ impl World {
         let mut found = NONE;
         self.any_body_in_box(centre - Vec2::new(half, half), centre + Vec2::new(half, half), |row| {
             for n in row {
-                let r = radius + n.radius;
-                let hit = (n.body >= robots) & ((n.pos - centre).length_squared() < r * r);
+                let hit = (n.body >= robots) & disc_overlaps(centre, radius, n.pos, n.radius);
                 found = if hit { n.body } else { found };
             }
             found != NONE
@@ -194,10 +193,7 @@ impl World {
     /// `radius`: the test of [`World::puck_in_disc`] for one body.
     pub fn puck_overlaps_disc(&self, body: usize, centre: Vec2, radius: f64) -> bool {
         match self.state.bodies.get(body) {
-            Some(b) if body >= self.state.robots.len() => {
-                let r = radius + b.radius;
-                (b.pos - centre).length_squared() < r * r
-            }
+            Some(b) if body >= self.state.robots.len() => disc_overlaps(centre, radius, b.pos, b.radius),
             _ => false,
         }
     }
@@ -224,6 +220,15 @@ impl World {
     pub fn any_body_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         self.index.any_in_box(min, max, pred)
     }
+}
+
+/// Whether the disc at `centre` of `radius` and a circle at `pos` of
+/// `circle_radius` overlap (strictly: touching is not overlapping): the
+/// one test every disc sensor applies.
+#[inline]
+pub fn disc_overlaps(centre: Vec2, radius: f64, pos: Vec2, circle_radius: f64) -> bool {
+    let r = radius + circle_radius;
+    (pos - centre).length_squared() < r * r
 }
 
 /// A fresh neighbour index of a state's bodies.
