@@ -1,6 +1,7 @@
 //! Embeds the policy: decodes the blob with `shared`'s decoder, checks its
 //! hasher, and generates `policy.rs` (the packed table and each action's
-//! motor outputs, computed here on the host so the AVR needs no floats).
+//! motor outputs, `shared::RobotProfile::action_motors` computed here on
+//! the host so the AVR needs no floats).
 //!
 //! - `FIRMWARE_POLICY`: the blob (default `policies/oc-heuristic.policy`;
 //!   a relative path is taken from the workspace root).
@@ -8,7 +9,7 @@
 //!   count as in `docs/state-hash.md`; default `original`). A blob of
 //!   another hasher fails the build.
 
-use shared::{MotorCommand, PolicyBlob, RobotProfile, StateHasher};
+use shared::{PolicyBlob, RobotProfile, StateHasher};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::{env, fs};
@@ -33,7 +34,7 @@ fn main() {
     let blob = PolicyBlob::decode(&bytes).unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
     let hasher_name = env::var("FIRMWARE_HASHER").unwrap_or_else(|_| DEFAULT_HASHER.into());
     let expected = StateHasher::from_name(&hasher_name)
-        .unwrap_or_else(|| fail(&format!("FIRMWARE_HASHER={hasher_name} is not a hasher (original, original-obstacle, bits7, bits9)")));
+        .unwrap_or_else(|| fail(&format!("FIRMWARE_HASHER={hasher_name} is not a hasher ({})", StateHasher::NAMES)));
     if blob.hasher() != expected {
         fail(&format!(
             "policy file {}: its hasher is {} but the firmware is built for {expected}; \
@@ -44,11 +45,7 @@ fn main() {
         ));
     }
 
-    let profile = RobotProfile::ZUMO;
-    let mut commands = [MotorCommand::default(); 4];
-    for (command, w) in commands.iter_mut().zip(blob.actions().angular_speeds()) {
-        *command = profile.mix(blob.actions().forward_speed(), *w);
-    }
+    let motors = RobotProfile::ZUMO.action_motors(blob.actions());
     let mut out = String::new();
     let hasher = format!("{:?}", blob.hasher());
     let packed = blob.table().packed();
@@ -60,15 +57,14 @@ fn main() {
     writeln!(out, "pub const HASHER: shared::StateHasher = shared::StateHasher::{hasher};").unwrap();
     writeln!(out, "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout).").unwrap();
     writeln!(out, "pub const POLICY: [u8; {}] = {:?};", packed.len(), packed).unwrap();
-    writeln!(out, "/// Each action's motor commands and outputs, mixed with `shared::RobotProfile::ZUMO`.").unwrap();
-    writeln!(out, "pub const MOTORS: crate::decision::ActionMotors = crate::decision::ActionMotors {{").unwrap();
+    writeln!(out, "/// Each action's motor commands and outputs (`shared::RobotProfile::ZUMO.action_motors`).").unwrap();
+    writeln!(out, "pub const MOTORS: shared::ActionMotors = shared::ActionMotors {{").unwrap();
     write!(out, "    commands: [").unwrap();
-    for c in commands {
+    for c in motors.commands {
         write!(out, "shared::MotorCommand {{ left: {}, right: {} }}, ", c.left, c.right).unwrap();
     }
     writeln!(out, "],\n    outputs: [").unwrap();
-    for c in commands {
-        let o = profile.outputs(c);
+    for o in motors.outputs {
         writeln!(
             out,
             "        shared::DriveOutputs {{ left: shared::MotorOutput {{ duty: {}, dir_high: {} }}, right: shared::MotorOutput {{ duty: {}, dir_high: {} }} }},",

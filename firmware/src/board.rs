@@ -1,6 +1,7 @@
 //! Register access for the Zumo 32U4 (ATmega32U4, 16 MHz): the only
-//! module with `unsafe` and `avr-device`. Pins and timers follow
-//! `../shared/docs/hardware.md`; everything else is in the library.
+//! module with `unsafe` and `avr-device`. Pins come from `firmware::pins`;
+//! the timers are set up as Pololu's Zumo 32U4 library sets them (motors)
+//! or as this table says; everything else is in the library.
 //!
 //! | what                | where                                      |
 //! |---------------------|--------------------------------------------|
@@ -18,6 +19,7 @@ use core::arch::asm;
 use firmware::camera::{BusError, WordSource};
 use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, RC_TIMEOUT_TICKS, TICK_US, TWI_TIMEOUT_TICKS};
 use firmware::embedded;
+use firmware::pins;
 use firmware::rc::Discharge;
 use firmware::supervisor::{Buttons, Leds};
 use shared::DriveOutputs;
@@ -40,25 +42,26 @@ impl firmware::decision::PolicyBytes for FlashPolicy {
     }
 }
 
-// Bits of the registers used below (ATmega32U4 datasheet).
-const PB0: u8 = 1 << 0; // red LED (low = on)
-const PB1: u8 = 1 << 1; // right DIR
-const PB2: u8 = 1 << 2; // left DIR
-const PB3: u8 = 1 << 3; // button A
-const PB5: u8 = 1 << 5; // OC1A right PWM
-const PB6: u8 = 1 << 6; // OC1B left PWM
-const PB7: u8 = 1 << 7; // LEDON (emitters)
-const PC7: u8 = 1 << 7; // yellow LED
-const PD5: u8 = 1 << 5; // button B / green LED (low = on)
-const PD6: u8 = 1 << 6; // right field sensor
-const PF4: u8 = 1 << 4; // mid field sensor
-const PF7: u8 = 1 << 7; // left field sensor
+// Pin bits (the Zumo's pin map, `firmware::pins`).
+const LED_RED: u8 = pins::LED_RED.mask();
+const DIR_RIGHT: u8 = pins::DIR_RIGHT.mask();
+const DIR_LEFT: u8 = pins::DIR_LEFT.mask();
+const BUTTON_A: u8 = pins::BUTTON_A.mask();
+const PWM_RIGHT: u8 = pins::PWM_RIGHT.mask();
+const PWM_LEFT: u8 = pins::PWM_LEFT.mask();
+const EMITTERS: u8 = pins::EMITTERS.mask();
+const LED_YELLOW: u8 = pins::LED_YELLOW.mask();
+const BUTTON_B: u8 = pins::BUTTON_B_LED_GREEN.mask();
+const SENSOR_LEFT: u8 = pins::FIELD_SENSORS[0].mask(); // on PORTF
+const SENSOR_MID: u8 = pins::FIELD_SENSORS[1].mask(); // on PORTF
+const SENSOR_RIGHT: u8 = pins::FIELD_SENSORS[2].mask(); // on PORTD
+// Register bits (ATmega32U4 datasheet).
 const TWINT: u8 = 1 << 7;
 const TWEA: u8 = 1 << 6;
 const TWSTA: u8 = 1 << 5;
 const TWSTO: u8 = 1 << 4;
 const TWEN: u8 = 1 << 2;
-const PIXY_READ: u8 = (0x54 << 1) | 1;
+const PIXY_READ: u8 = (pins::PIXY_ADDRESS << 1) | 1;
 const WDE: u8 = 1 << 3;
 const WDCE: u8 = 1 << 4;
 const WDP2: u8 = 1 << 2; // with WDP1..0 = 0: 250 ms
@@ -103,17 +106,17 @@ impl Board {
         dp.TC3.tccr3b().write(|w| unsafe { w.bits(0b011) });
         // Motors: outputs low; Timer1 mode 8 (phase and frequency correct,
         // TOP = ICR1 = 400), non-inverting OC1A/OC1B, clk/1: 20 kHz.
-        dp.PORTB.portb().write(|w| unsafe { w.bits(PB3 | PB0) }); // A pull-up, red LED off, LEDON low
-        dp.PORTB.ddrb().write(|w| unsafe { w.bits(PB0 | PB1 | PB2 | PB5 | PB6 | PB7) });
+        dp.PORTB.portb().write(|w| unsafe { w.bits(BUTTON_A | LED_RED) }); // A pull-up, red LED off, LEDON low
+        dp.PORTB.ddrb().write(|w| unsafe { w.bits(LED_RED | DIR_RIGHT | DIR_LEFT | PWM_RIGHT | PWM_LEFT | EMITTERS) });
         dp.TC1.tccr1a().write(|w| unsafe { w.bits(0b1010_0000) });
         dp.TC1.tccr1b().write(|w| unsafe { w.bits(0b0001_0001) });
         dp.TC1.icr1().write(|w| w.set(400));
         dp.TC1.ocr1a().write(|w| w.set(0));
         dp.TC1.ocr1b().write(|w| w.set(0));
-        // LEDs: yellow off, green off (PD5 high).
-        dp.PORTC.ddrc().write(|w| unsafe { w.bits(PC7) });
-        dp.PORTD.portd().write(|w| unsafe { w.bits(PD5) });
-        dp.PORTD.ddrd().write(|w| unsafe { w.bits(PD5) });
+        // LEDs: yellow off, green off (its pin high).
+        dp.PORTC.ddrc().write(|w| unsafe { w.bits(LED_YELLOW) });
+        dp.PORTD.portd().write(|w| unsafe { w.bits(BUTTON_B) });
+        dp.PORTD.ddrd().write(|w| unsafe { w.bits(BUTTON_B) });
         // TWI: 100 kHz = 16 MHz / (16 + 2 x 72), prescaler 1.
         dp.TWI.twsr().write(|w| unsafe { w.bits(0) });
         dp.TWI.twbr().write(|w| unsafe { w.bits(72) });
@@ -169,17 +172,17 @@ impl Board {
         avr_device::asm::wdr();
     }
 
-    /// Reads both buttons. B shares PD5 with the green LED: the pin becomes
+    /// Reads both buttons. B shares its pin with the green LED: the pin becomes
     /// a pulled-up input for a few microseconds, then is restored.
     pub fn buttons(&self) -> Buttons {
         let d = &self.dp.PORTD;
-        let a = self.dp.PORTB.pinb().read().bits() & PB3 == 0;
+        let a = self.dp.PORTB.pinb().read().bits() & BUTTON_A == 0;
         let (ddr, port) = (d.ddrd().read().bits(), d.portd().read().bits());
-        d.ddrd().write(|w| unsafe { w.bits(ddr & !PD5) });
-        d.portd().write(|w| unsafe { w.bits(port | PD5) });
+        d.ddrd().write(|w| unsafe { w.bits(ddr & !BUTTON_B) });
+        d.portd().write(|w| unsafe { w.bits(port | BUTTON_B) });
         let t = self.now();
         self.wait_until(t, 2);
-        let b = d.pind().read().bits() & PD5 == 0;
+        let b = d.pind().read().bits() & BUTTON_B == 0;
         d.portd().write(|w| unsafe { w.bits(port) });
         d.ddrd().write(|w| unsafe { w.bits(ddr) });
         Buttons { a, b }
@@ -196,16 +199,16 @@ impl Board {
     #[inline(never)]
     pub fn field_sensors(&self) -> [u16; 3] {
         let (f, d) = (&self.dp.PORTF, &self.dp.PORTD);
-        f.portf().modify(|r, w| unsafe { w.bits(r.bits() | PF7 | PF4) });
-        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() | PF7 | PF4) });
-        d.portd().modify(|r, w| unsafe { w.bits(r.bits() | PD6) });
-        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | PD6) });
+        f.portf().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
+        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
+        d.portd().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
         let t = self.now();
         self.wait_until(t, RC_CHARGE_US.div_ceil(TICK_US) + 1);
-        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() & !(PF7 | PF4)) });
-        f.portf().modify(|r, w| unsafe { w.bits(r.bits() & !(PF7 | PF4)) });
-        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !PD6) });
-        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !PD6) });
+        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+        f.portf().modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
         // Poll: only sample the pins and the timer, and note when the pins
         // change (at most once per sensor); the measurement is worked out
         // from those changes afterwards, so a slow update never delays the
@@ -217,7 +220,7 @@ impl Board {
         loop {
             let (pf, pd) = (f.pinf().read().bits(), d.pind().read().bits());
             let now = self.now();
-            let low = u8::from(pf & PF7 == 0) | u8::from(pf & PF4 == 0) << 1 | u8::from(pd & PD6 == 0) << 2;
+            let low = u8::from(pf & SENSOR_LEFT == 0) | u8::from(pf & SENSOR_MID == 0) << 1 | u8::from(pd & SENSOR_RIGHT == 0) << 2;
             if low != seen {
                 if let Some(change) = changes.get_mut(count) {
                     *change = (now, low);
@@ -236,17 +239,17 @@ impl Board {
         discharge.times()
     }
 
-    /// Applies motor outputs: OCR1A/PB1 right, OCR1B/PB2 left.
+    /// Applies motor outputs: OCR1A and DIR_RIGHT right, OCR1B and DIR_LEFT left.
     pub fn set_motors(&self, out: &DriveOutputs) {
         let b = &self.dp.PORTB;
         let mut dir = 0;
         if out.right.dir_high {
-            dir |= PB1;
+            dir |= DIR_RIGHT;
         }
         if out.left.dir_high {
-            dir |= PB2;
+            dir |= DIR_LEFT;
         }
-        b.portb().modify(|r, w| unsafe { w.bits((r.bits() & !(PB1 | PB2)) | dir) });
+        b.portb().modify(|r, w| unsafe { w.bits((r.bits() & !(DIR_RIGHT | DIR_LEFT)) | dir) });
         self.dp.TC1.ocr1a().write(|w| w.set(out.right.duty));
         self.dp.TC1.ocr1b().write(|w| w.set(out.left.duty));
     }
@@ -260,9 +263,9 @@ impl Board {
     /// Lights the LEDs.
     pub fn leds(&self, leds: Leds) {
         let (b, c, d) = (&self.dp.PORTB, &self.dp.PORTC, &self.dp.PORTD);
-        c.portc().modify(|r, w| unsafe { w.bits(if leds.yellow { r.bits() | PC7 } else { r.bits() & !PC7 }) });
-        b.portb().modify(|r, w| unsafe { w.bits(if leds.red { r.bits() & !PB0 } else { r.bits() | PB0 }) });
-        d.portd().modify(|r, w| unsafe { w.bits(if leds.green { r.bits() & !PD5 } else { r.bits() | PD5 }) });
+        c.portc().modify(|r, w| unsafe { w.bits(if leds.yellow { r.bits() | LED_YELLOW } else { r.bits() & !LED_YELLOW }) });
+        b.portb().modify(|r, w| unsafe { w.bits(if leds.red { r.bits() & !LED_RED } else { r.bits() | LED_RED }) });
+        d.portd().modify(|r, w| unsafe { w.bits(if leds.green { r.bits() & !BUTTON_B } else { r.bits() | BUTTON_B }) });
     }
 
     /// Sends bytes on USART1 (blocking).

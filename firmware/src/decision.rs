@@ -8,8 +8,8 @@
 //! its table.
 
 use shared::{
-    ActionId, BlobSummary, CameraConfig, DriveOutputs, FieldCalibration, FieldScales, FieldValue, MotorCommand,
-    PixyBlock, PolicyTable, SensorReading, State, StateHasher,
+    ActionId, ActionMotors, BlobSummary, CameraConfig, DriveOutputs, FieldCalibration, FieldScales, FieldValue,
+    MotorCommand, PixyBlock, PolicyTable, SensorReading, State, StateHasher,
 };
 
 /// Read access to the packed policy table (in flash on the robot).
@@ -22,15 +22,6 @@ impl PolicyBytes for [u8] {
     fn byte(&self, index: usize) -> u8 {
         self.get(index).copied().unwrap_or(0)
     }
-}
-
-/// The motor outputs of each action (up to four).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ActionMotors {
-    /// Signed commands, for the log.
-    pub commands: [MotorCommand; 4],
-    /// Pin-level outputs (duty, direction), for the board.
-    pub outputs: [DriveOutputs; 4],
 }
 
 /// Everything a decision computed.
@@ -86,8 +77,7 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
         let byte = self.policy.byte(PolicyTable::byte_index(masked));
         let action = PolicyTable::action_in_byte(byte, masked);
-        let i = action.index() & 3;
-        Decision { values, blobs, state, action, command: self.motors.commands[i], outputs: self.motors.outputs[i] }
+        Decision { values, blobs, state, action, command: self.motors.command(action), outputs: self.motors.outputs(action) }
     }
 }
 
@@ -100,12 +90,7 @@ mod tests {
     use shared::{PolicyBlob, RobotProfile, SensorRange};
 
     fn motors_of(blob: &PolicyBlob) -> ActionMotors {
-        let mut m = ActionMotors { commands: [MotorCommand::default(); 4], outputs: [DriveOutputs::STOP; 4] };
-        for (i, w) in blob.actions().angular_speeds().iter().enumerate() {
-            m.commands[i] = RobotProfile::ZUMO.mix(blob.actions().forward_speed(), *w);
-            m.outputs[i] = RobotProfile::ZUMO.outputs(m.commands[i]);
-        }
-        m
+        RobotProfile::ZUMO.action_motors(blob.actions())
     }
 
     #[test]

@@ -3,8 +3,9 @@
 //! A step is everything a run does per step: every robot's sensors, the
 //! controller, physics, and Eval at the default check interval.
 
-use crate::scenario::{run_timed, Scenario};
-use crate::sim::BroadPhase;
+use crate::run_summary::run_timed;
+use sim::scenario::Scenario;
+use sim::BroadPhase;
 use anyhow::Result;
 
 /// Which configuration to measure.

@@ -1,9 +1,10 @@
-//! The host side: simulator, trainer, and the tools around policy blobs.
+//! The host side over the simulator (`sim`): the Q-learning trainer, the
+//! thesis' experiments and their reports, the tools for real robots, and
+//! the tools around policy blobs.
 #![warn(missing_docs)]
 
 pub mod atomic;
 pub mod bench;
-pub mod controller;
 pub mod experiment;
 pub mod inspect;
 pub mod learn;
@@ -11,7 +12,6 @@ pub mod policy_file;
 pub mod render;
 pub mod report;
 pub mod robot;
-pub mod scenario;
+pub mod run_summary;
 pub mod sensor_choice;
-pub mod sim;
 pub mod train;

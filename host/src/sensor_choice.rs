@@ -1,33 +1,26 @@
-//! `--sensors`: which sensor model the simulated robots have.
-//!
-//! - `disc`: the disc sensors of the reference model (default; obstacle
-//!   discs as in the original code: radius r/4, any body);
-//! - `disc-thesis`: the same with the obstacle discs the thesis describes
-//!   (section 5.2: the size of a puck sensor, robots only);
-//! - `robot`: the Zumo's real senses ([`RobotSensors`]: photo-transistors
-//!   through the firmware's RC timing and calibration, the Pixy camera
-//!   through the firmware's blob classification), default settings;
-//! - `robot:FILE`: the same with the settings of a JSON [`RobotSensorConfig`]
-//!   file (every field optional; `docs/robot-sensors.md`).
+//! `--sensors` (and `sensors = "..."` in training and experiment files):
+//! a sensor model by name, `disc`, `disc-thesis` or `robot`
+//! ([`sim::sensor_setup`]), or `robot:FILE`, the robot sensor model with
+//! the settings of a JSON [`RobotSensorConfig`] file (every field
+//! optional; `docs/robot-sensors.md`).
 
-use crate::sim::{DiscSensorConfig, DiscSensors, Footprint, RobotSensorConfig, RobotSensors, ScalarField, SensorModel, SimConfig, World};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use shared::SensorReading;
+use sim::robot_sensors::RobotSensorConfig;
+use sim::config::SimConfig;
+use sim::sensor_setup::{SelectedSensors, SensorSetup};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// The `--sensors` choice (`sensors = "..."` in training and experiment
-/// files, with the same names).
+/// The `--sensors` choice.
 #[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum SensorChoice {
     /// The thesis' disc sensors of `SimConfig::sensors`.
     #[default]
     Disc,
-    /// The disc sensors with the thesis' obstacle discs
-    /// ([`DiscSensorConfig::thesis_obstacles`]).
+    /// The disc sensors with the thesis' obstacle discs.
     DiscThesis,
     /// The robot sensor model, with the settings of a JSON file if given.
     Robot(Option<PathBuf>),
@@ -43,7 +36,7 @@ impl FromStr for SensorChoice {
             "robot" => Ok(SensorChoice::Robot(None)),
             _ => match s.strip_prefix("robot:") {
                 Some(path) if !path.is_empty() => Ok(SensorChoice::Robot(Some(PathBuf::from(path)))),
-                _ => Err(format!("unknown sensor model {s:?}: expected disc, disc-thesis, robot or robot:CONFIG.json")),
+                _ => Err(format!("unknown sensor model {s:?}: expected {} or robot:CONFIG.json", SensorSetup::NAMES)),
             },
         }
     }
@@ -85,53 +78,19 @@ pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig> {
 }
 
 impl SensorChoice {
-    /// The sensor model for the robots of `config`.
-    pub fn build(&self, config: &SimConfig) -> Result<SelectedSensors> {
-        let radius = config.world.robot_radius;
+    /// The sensor model with its settings (a config file read and checked).
+    pub fn setup(&self) -> Result<SensorSetup> {
         Ok(match self {
-            SensorChoice::Disc => SelectedSensors::Disc(DiscSensors::new(&config.sensors, radius)),
-            SensorChoice::DiscThesis => {
-                let thesis = DiscSensorConfig::thesis_obstacles();
-                let discs = DiscSensorConfig {
-                    obstacle: thesis.obstacle,
-                    obstacle_targets: thesis.obstacle_targets,
-                    ..config.sensors.clone()
-                };
-                SelectedSensors::Disc(DiscSensors::new(&discs, radius))
-            }
-            SensorChoice::Robot(file) => {
-                let robot = match file {
-                    Some(path) => read_robot_config(path)?,
-                    None => RobotSensorConfig::default(),
-                };
-                SelectedSensors::Robot(Box::new(RobotSensors::new(&robot, radius)))
-            }
+            SensorChoice::Disc => SensorSetup::Disc,
+            SensorChoice::DiscThesis => SensorSetup::DiscThesis,
+            SensorChoice::Robot(None) => SensorSetup::Robot(Box::default()),
+            SensorChoice::Robot(Some(path)) => SensorSetup::Robot(Box::new(read_robot_config(path)?)),
         })
     }
-}
 
-/// The model a [`SensorChoice`] selected.
-#[derive(Clone, Debug)]
-pub enum SelectedSensors {
-    /// The thesis' discs.
-    Disc(DiscSensors),
-    /// The robot's photo-transistors and camera.
-    Robot(Box<RobotSensors>),
-}
-
-impl SensorModel for SelectedSensors {
-    fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
-        match self {
-            SelectedSensors::Disc(s) => s.sense(world, field, out),
-            SelectedSensors::Robot(s) => s.sense(world, field, out),
-        }
-    }
-
-    fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
-        match self {
-            SelectedSensors::Disc(s) => s.footprints(world, robot, out),
-            SelectedSensors::Robot(s) => s.footprints(world, robot, out),
-        }
+    /// The sensor model for the robots of `config`.
+    pub fn build(&self, config: &SimConfig) -> Result<SelectedSensors> {
+        Ok(self.setup()?.build(config))
     }
 }
 

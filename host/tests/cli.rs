@@ -74,3 +74,27 @@ fn bench_prints_steps_per_second() {
     let rate = line.trim().strip_suffix(" steps/s").expect("<N> steps/s");
     assert!(rate.parse::<f64>().unwrap() > 0.0);
 }
+
+#[test]
+fn host_run_takes_the_robot_sensor_model_and_names_a_bad_config() {
+    let out = host()
+        .args(["run", "--sensors", "robot", "--steps", "300", "--json"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v.get("mean_eval").is_some_and(|x| x.is_number()));
+
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("robot.json");
+    std::fs::write(&config, r#"{"camera": {"fov_h_deg": 200}}"#).unwrap();
+    let out = host()
+        .args(["run", "--sensors", &format!("robot:{}", config.display()), "--steps", "10"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success());
+    assert!(err.contains("robot.json") && err.contains("camera.fov_h_deg = 200"), "{err}");
+    let out = host().args(["run", "--sensors", "sonar"]).output().unwrap();
+    assert!(String::from_utf8(out.stderr).unwrap().contains("\"sonar\""));
+}

@@ -1,7 +1,7 @@
 //! The steady-state step loop allocates nothing, with or without learning.
 
-use host::controller::{OrbitalConfig, OrbitalConstruction};
-use host::sim::{ScalarField, SimConfig, Simulation};
+use sim::controllers::{OrbitalConfig, OrbitalConstruction};
+use sim::{ScalarField, SimConfig, Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::Arc;

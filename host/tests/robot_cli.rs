@@ -71,7 +71,7 @@ fn replay_reports_in_text_and_json_and_names_damaged_records() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!((v["frames"].as_u64(), v["damaged"].as_u64(), v["diverged"].as_u64()), (Some(4), Some(1), Some(0)));
     assert_eq!(v["first_damaged"][0]["offset"].as_u64(), Some(damaged_at));
-    assert_eq!(v["modes"][0].as_u64(), Some(4));
+    assert_eq!(v["modes"]["idle"].as_u64(), Some(4));
     assert_eq!(v["calibration_checked"].as_u64(), Some(4));
 }
 

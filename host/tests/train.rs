@@ -1,10 +1,11 @@
 //! Training: determinism, exact resume from checkpoints, torn writes, and
 //! the one-sensing-per-step contract a learner relies on.
 
-use host::controller::{Controller, Perception};
-use host::learn::{QLearner, Reward};
+use sim::{Controller, Perception};
+use host::learn::QLearner;
+use sim::Reward;
 use host::sensor_choice::SensorChoice;
-use host::sim::{EpisodeStart, SimRng, StepOutcome};
+use sim::{EpisodeStart, SimRng, StepOutcome};
 use host::train::checkpoint::{self, CheckpointError};
 use host::train::{TrainConfig, Trainer, TrainingState};
 use shared::SensorReading;
@@ -17,7 +18,7 @@ fn small(seed: u64) -> TrainConfig {
     TrainConfig { robots: 4, pucks: 60, seed, stuck_limit: Some(700), ..TrainConfig::default() }
 }
 
-fn trainer(config: TrainConfig) -> Trainer<host::sensor_choice::SelectedSensors> {
+fn trainer(config: TrainConfig) -> Trainer<sim::SelectedSensors> {
     let field = Arc::new(config.field.load().unwrap());
     let sensors = config.sensors.build(&config.sim_config()).unwrap();
     Trainer::new(config, field, sensors, None).unwrap()
@@ -71,7 +72,7 @@ fn train_then_resume_equals_one_long_run() {
 #[test]
 fn a_resume_refuses_a_changed_field() {
     let t = trainer(small(1));
-    let letter = Arc::new(host::sim::Letter::T.field());
+    let letter = Arc::new(sim::Letter::T.field());
     let sensors = SensorChoice::Disc.build(&t.state().sim.config).unwrap();
     let e = Trainer::resume(t.state(), letter, sensors).err().unwrap().to_string();
     assert!(e.contains("differs from the one the checkpoint trained on"), "{e}");
@@ -171,8 +172,8 @@ impl Controller for Probe {
 #[test]
 fn the_state_reached_is_the_state_decided_on_next() {
     let config = small(6).sim_config();
-    let field = Arc::new(host::sim::ScalarField::annulus());
-    let mut sim = host::sim::Simulation::new(config, field, 6).unwrap();
+    let field = Arc::new(sim::ScalarField::annulus());
+    let mut sim = sim::Simulation::new(config, field, 6).unwrap();
     let mut probe = Probe { decided: Vec::new(), after: Vec::new(), starts: 0 };
     sim.run(&mut probe, 2000);
     let ends = probe.after.iter().filter(|a| a.1).count();

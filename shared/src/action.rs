@@ -43,6 +43,8 @@ impl fmt::Display for ActionTableError {
     }
 }
 
+impl core::error::Error for ActionTableError {}
+
 /// Unicycle actions: the robot always drives at `forward_speed` (units per
 /// step) and an action sets its angular speed (radians per step; positive
 /// turns right, clockwise on screen with y down).

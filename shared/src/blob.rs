@@ -182,6 +182,8 @@ impl fmt::Display for BlobError {
     }
 }
 
+impl core::error::Error for BlobError {}
+
 impl From<ActionTableError> for BlobError {
     fn from(e: ActionTableError) -> BlobError {
         match e {

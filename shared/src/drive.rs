@@ -8,10 +8,13 @@
 //! centre and the inner one as much slower. A [`RobotProfile`] turns those
 //! track speeds into motor commands (-400..=400, the Zumo library's range).
 //!
-//! This runs with `f32` on the host only: the firmware's build computes the
-//! command of every action ahead of time (the AVR has no FPU), and the
-//! simulator uses the same function to model the motors.
+//! This runs with `f32` on the host only: the firmware's build computes
+//! every action's commands and outputs ahead of time with
+//! [`RobotProfile::action_motors`] (the AVR has no FPU) and reads them from
+//! the [`ActionMotors`] table it embeds; the log replay and the equivalence
+//! tests compute the very same table.
 
+use crate::action::{ActionId, ActionTable};
 use serde::{Deserialize, Serialize};
 
 /// The largest motor command magnitude (100 % duty; Timer1's TOP).
@@ -51,6 +54,28 @@ impl DriveOutputs {
         left: MotorOutput { duty: 0, dir_high: false },
         right: MotorOutput { duty: 0, dir_high: false },
     };
+}
+
+/// The motor commands and pin-level outputs of each action of a table
+/// (entries past the table's length are stops).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ActionMotors {
+    /// Signed commands, for the log.
+    pub commands: [MotorCommand; ActionTable::MAX_ACTIONS],
+    /// Pin-level outputs (duty, direction), for the board.
+    pub outputs: [DriveOutputs; ActionTable::MAX_ACTIONS],
+}
+
+impl ActionMotors {
+    /// The commands of `action` (a stop for an action beyond the table).
+    pub const fn command(&self, action: ActionId) -> MotorCommand {
+        self.commands[action.index() & (ActionTable::MAX_ACTIONS - 1)]
+    }
+
+    /// The pin-level outputs of `action` (a stop for an action beyond the table).
+    pub const fn outputs(&self, action: ActionId) -> DriveOutputs {
+        self.outputs[action.index() & (ActionTable::MAX_ACTIONS - 1)]
+    }
 }
 
 /// A robot's drive geometry and scaling.
@@ -107,6 +132,20 @@ impl RobotProfile {
         MotorCommand { left: round(left), right: round(right) }
     }
 
+    /// Every action's commands ([`RobotProfile::mix`] at the table's forward
+    /// speed) and outputs: the table the firmware embeds.
+    pub fn action_motors(&self, actions: &ActionTable) -> ActionMotors {
+        let mut m = ActionMotors {
+            commands: [MotorCommand::default(); ActionTable::MAX_ACTIONS],
+            outputs: [DriveOutputs::STOP; ActionTable::MAX_ACTIONS],
+        };
+        for (i, w) in actions.angular_speeds().iter().enumerate() {
+            m.commands[i] = self.mix(actions.forward_speed(), *w);
+            m.outputs[i] = self.outputs(m.commands[i]);
+        }
+        m
+    }
+
     /// Pin-level outputs for a command: duty `|command|` clamped to 400,
     /// direction pin high for reverse, inverted for a flipped motor (as the
     /// Pololu Zumo library does).
@@ -159,6 +198,19 @@ mod tests {
         // -0.55 / 4.55 x 400 = -48.35
         assert_eq!(c.right, -48);
         assert_eq!(p.mix(f32::NAN, 0.0), MotorCommand::default());
+    }
+
+    #[test]
+    fn every_action_gets_its_mix_and_outputs_and_missing_actions_stop() {
+        let actions = ActionTable::new(&[0.3, -0.15], 2.0).unwrap();
+        let m = RobotProfile::ZUMO.action_motors(&actions);
+        assert_eq!(m.command(ActionId(0)), MotorCommand { left: 341, right: -41 });
+        assert_eq!(m.command(ActionId(1)), MotorCommand { left: 54, right: 246 });
+        assert_eq!(m.outputs(ActionId(0)).right, MotorOutput { duty: 41, dir_high: true });
+        assert_eq!(m.command(ActionId(2)), MotorCommand::default());
+        assert_eq!(m.outputs(ActionId(3)), DriveOutputs::STOP);
+        // An id beyond the table's four slots wraps into them, never panics.
+        assert_eq!(m.command(ActionId(4)), m.command(ActionId(0)));
     }
 
     #[test]

@@ -134,6 +134,9 @@ impl StateHasher {
         }
     }
 
+    /// Every name [`StateHasher::from_name`] takes, as messages list them.
+    pub const NAMES: &'static str = "original, original-obstacle, bits7, bits9 (or their bit counts 8, 10, 7, 9)";
+
     /// Parses a name (`original`, `original-obstacle`, `bits7`, `bits9`) or a
     /// bit count (`7`, `8`, `9`, `10`).
     pub fn from_name(name: &str) -> Option<StateHasher> {
@@ -322,7 +325,21 @@ mod tests {
         }
         assert_eq!(StateHasher::from_bits(11), None);
         assert_eq!(StateHasher::from_name("nine"), None);
+        for h in StateHasher::ALL {
+            assert!(StateHasher::NAMES.contains(h.name()), "{h} missing from NAMES");
+            assert!(StateHasher::NAMES.contains(alloc_free_digits(h.bits()).as_str()), "{h}'s bits missing from NAMES");
+        }
         assert!(StateHasher::Original.unpack(State(256)).is_none());
+    }
+
+    /// A bit count as text, without an allocator.
+    fn alloc_free_digits(bits: u8) -> heapless::String<3> {
+        let mut s = heapless::String::new();
+        if bits >= 10 {
+            let _ = s.push(char::from(b'0' + bits / 10));
+        }
+        let _ = s.push(char::from(b'0' + bits % 10));
+        s
     }
 
     fn arb_reading() -> impl Strategy<Value = SensorReading> {

@@ -38,7 +38,7 @@ pub use action::{ActionId, ActionTable, ActionTableError};
 pub use blob::{BlobError, PolicyBlob, Provenance};
 pub use calibration::{FieldCalibration, FieldScales, SensorRange, SensorScale};
 pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
-pub use drive::{DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
+pub use drive::{ActionMotors, DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;
 pub use hasher::{State, StateHasher, StateInputs};
 pub use log::{Faults, LogError, LogFrame, RunMode};

@@ -185,6 +185,8 @@ impl fmt::Display for LogError {
     }
 }
 
+impl core::error::Error for LogError {}
+
 /// Buffer for one encoded frame.
 pub type EncodedFrame = [u8; LogFrame::MAX_ENCODED_LEN];
 

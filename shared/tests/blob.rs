@@ -254,3 +254,11 @@ proptest! {
         let _ = PolicyBlob::decode(&bytes);
     }
 }
+
+#[test]
+fn every_error_type_is_a_standard_error() {
+    fn is_error<E: std::error::Error + Send + Sync + 'static>(_: &E) {}
+    is_error(&shared::BlobError::NonFiniteSpeed);
+    is_error(&shared::LogError::BadCobs);
+    is_error(&shared::ActionTableError::NonFiniteSpeed);
+}

@@ -7,9 +7,9 @@
 //! `docs/equivalence.md` describes the checks and their figures.
 
 use anyhow::{bail, Context, Result};
-use host::scenario::{ControllerChoice, Scenario};
-use host::sensor_choice::{SelectedSensors, SensorChoice};
-use host::sim::{FieldSource, RobotObservation, RobotSensors};
+use sim::scenario::{ControllerChoice, Scenario};
+use sim::sensor_setup::{SelectedSensors, SensorSetup};
+use sim::{FieldSource, RobotObservation, RobotSensors};
 use shared::{ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, State};
 use std::path::Path;
 
@@ -52,7 +52,7 @@ pub fn sample_states(
     let scenario = Scenario {
         field,
         controller: ControllerChoice::Policy(policy.to_path_buf()),
-        sensors: SensorChoice::Robot(None),
+        sensors: SensorSetup::Robot(Box::default()),
         seed,
         ..Scenario::default()
     };
@@ -113,9 +113,8 @@ impl<'a> Expectation<'a> {
     pub fn expect(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> Expected {
         let state = self.state(ticks, frame);
         let action = self.policy.table().action(state);
-        let angular = self.policy.actions().angular(action).unwrap_or(0.0);
-        let command = RobotProfile::ZUMO.mix(self.policy.actions().forward_speed(), angular);
-        Expected { state, action, command, outputs: RobotProfile::ZUMO.outputs(command) }
+        let motors = RobotProfile::ZUMO.action_motors(self.policy.actions());
+        Expected { state, action, command: motors.command(action), outputs: motors.outputs(action) }
     }
 }
 
@@ -201,7 +200,7 @@ pub fn read_policy(file: &str) -> Result<(std::path::PathBuf, PolicyBlob)> {
             path.display()
         );
     }
-    let blob = host::policy_file::read(&path)?;
+    let blob = sim::policy_file::read(&path)?;
     Ok((path, blob))
 }
 
@@ -218,7 +217,7 @@ pub fn check_elf_embeds(elf: &Path, policy: &PolicyBlob, rebuild: &str) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
-    use host::sim::RobotSensorConfig;
+    use sim::RobotSensorConfig;
     use shared::StateHasher;
 
     /// A toy state: the mid time's bin of 10 ticks, and left < right.

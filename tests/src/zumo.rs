@@ -4,10 +4,13 @@
 //!
 //! `avr-tester` runs the simulation; what it does not offer (USART1 on the
 //! 32U4, data memory, the cycle counter, EEPROM, I/O register hooks) goes
-//! through simavr's own handle (`simavr-ffi`), which simavr passes to the
-//! global logger when it creates a core (`../shared/docs/firmware-toolchain.md`).
+//! through simavr's own handle (`simavr-ffi`): simavr passes the new core to
+//! the global logger when `avr-tester` loads an ELF, and avr-tester installs
+//! its own logger at its first load only, so ours, installed after a first
+//! throwaway load, catches every later core's handle (see `load`).
 
 use avr_tester::{AvrTester, TwiPacket};
+use firmware::pins::{self, Pin, Port, PIXY_ADDRESS};
 use firmware::pixy::encode_frame;
 use shared::{LogError, LogFrame, PixyBlock};
 use simavr_ffi as ffi;
@@ -28,7 +31,7 @@ pub const CYCLES_PER_TICK: u64 = 64;
 const OCR1A: usize = 0x88;
 /// OCR1B (left motor duty) in data memory.
 const OCR1B: usize = 0x8A;
-/// PORTB in data memory: the direction pins PB1 (right) and PB2 (left).
+/// PORTB in data memory: the direction pins.
 const PORTB: usize = 0x25;
 /// GPIOR0, the firmware's decision marker, in data memory.
 const GPIOR0: u16 = 0x3E;
@@ -40,8 +43,6 @@ const STATICS_END: usize = 0x0200;
 const RAM_END: usize = 0x0B00;
 /// The stack paint pattern.
 const PAINT: u8 = 0xA5;
-/// Pixy's 7-bit I2C address.
-const PIXY_ADDRESS: u8 = 0x54;
 
 /// The release ELF `scripts/build-firmware` writes; panics with what to run
 /// if it is missing (the tests never skip silently).
@@ -83,6 +84,7 @@ fn load(elf: &Path) -> (AvrTester, *mut ffi::avr_t) {
         // avr-tester installs its (silent) logger once, at its first load;
         // ours replaces it afterwards and is never replaced again.
         drop(AvrTester::atmega32u4().with_clock_of_16_mhz().load(elf));
+        // SAFETY: `capture_handle` only stores the handle it is given.
         unsafe { ffi::avr_global_logger_set(Some(capture_handle)) };
     });
     LAST_AVR.with(|c| c.set(null_mut()));
@@ -116,6 +118,7 @@ struct Pixy {
 
 impl Pixy {
     fn next_byte(&mut self) -> u8 {
+        // SAFETY: the core outlives the Pixy it serves (field order of `Zumo`).
         let now = unsafe { (*self.avr).cycle };
         let word_start = std::mem::replace(&mut self.word_start, false);
         let due = self.changed || now.saturating_sub(self.last_frame) >= CLOCK_HZ / 50;
@@ -157,15 +160,17 @@ struct State {
     sensors: [RcSensor; 3],
 }
 
-/// Left, mid, right: (port, bit).
-const SENSOR_PINS: [(u8, u8); 3] = [(b'F', 7), (b'F', 4), (b'D', 6)];
-
 unsafe extern "C" fn on_uart(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    // SAFETY: `param` is the boxed `State` registered with this callback,
+    // which outlives the simulator (field order of `Zumo`); simavr calls
+    // back on this thread only, while no other reference to it is live.
     let state = unsafe { &mut *(param as *mut State) };
     state.uart.push(value as u8);
 }
 
 unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v: u8, param: *mut c_void) {
+    // SAFETY: simavr passes its live core and an address inside its data
+    // space; `param` is the boxed `State`, as in `on_uart`.
     unsafe {
         *(*avr).data.add(usize::from(addr)) = v;
         let state = &mut *(param as *mut State);
@@ -175,39 +180,54 @@ unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v
 }
 
 unsafe extern "C" fn on_discharged(_: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+    // SAFETY: `param` points into the boxed `State`'s sensors (registered in
+    // `on_ddr`); its IRQ is the pin's, valid while the core lives.
     let sensor = unsafe { &*(param as *const RcSensor) };
     unsafe { ffi::avr_raise_irq(sensor.irq, 0) };
     0
 }
 
-unsafe fn on_ddr(port: u8, value: u32, param: *mut c_void) {
+/// A direction register of `port` changed to `value`: a field sensor
+/// pin that became an input starts discharging, one that became an output
+/// stops.
+///
+/// # Safety
+/// `param` must be the boxed `State` of a live core, with no other
+/// reference to it live.
+unsafe fn on_ddr(port: Port, value: u32, param: *mut c_void) {
+    // SAFETY: the caller's contract.
     let state = unsafe { &mut *(param as *mut State) };
-    let slot = usize::from(port == b'D');
+    let slot = usize::from(port == Port::D);
     let (old, new) = (state.ddr[slot], value as u8);
     state.ddr[slot] = new;
-    for (i, &(p, bit)) in SENSOR_PINS.iter().enumerate() {
+    for (i, pin) in pins::FIELD_SENSORS.iter().enumerate() {
         let sensor = &mut state.sensors[i] as *mut RcSensor;
-        if p != port {
+        if pin.port != port {
             continue;
         }
-        let mask = 1 << bit;
+        let mask = pin.mask();
         if old & mask != 0 && new & mask == 0 {
             // Charged, now an input: discharge after the sensor's delay.
             if let Some(delay) = state.delays[i] {
+                // SAFETY: the core is live; the sensor lives in the boxed
+                // state, which outlives every timer of the core.
                 unsafe { ffi::avr_cycle_timer_register(state.avr, delay, Some(on_discharged), sensor as *mut c_void) };
             }
         } else if old & mask == 0 && new & mask != 0 {
+            // SAFETY: as above; cancelling an unregistered timer is a no-op.
             unsafe { ffi::avr_cycle_timer_cancel(state.avr, Some(on_discharged), sensor as *mut c_void) };
         }
     }
 }
 
 unsafe extern "C" fn on_ddr_f(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
-    unsafe { on_ddr(b'F', value, param) }
+    // SAFETY: registered with the boxed `State` as its parameter.
+    unsafe { on_ddr(Port::F, value, param) }
 }
 
 unsafe extern "C" fn on_ddr_d(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
-    unsafe { on_ddr(b'D', value, param) }
+    // SAFETY: registered with the boxed `State` as its parameter.
+    unsafe { on_ddr(Port::D, value, param) }
 }
 
 #[repr(C)]
@@ -245,11 +265,14 @@ impl Zumo {
             decisions: 0,
             ddr: [0; 2],
             delays: [Some(CLOCK_HZ / 1000); 3],
-            sensors: SENSOR_PINS.map(|(port, bit)| RcSensor {
-                irq: unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', port), c_int::from(bit)) },
+            sensors: pins::FIELD_SENSORS.map(|pin| RcSensor {
+                // SAFETY: `avr` is the core just loaded; a null IRQ is checked below.
+                irq: unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit)) },
             }),
         });
         let state_ptr = &mut *state as *mut State;
+        // SAFETY: `avr` is the live core; the callbacks get the boxed state,
+        // which `Zumo` drops after the simulator (field order).
         unsafe {
             assert!(state.sensors.iter().all(|s| !s.irq.is_null()), "no field sensor pins");
             // USART1: bytes out, not to stdout.
@@ -259,8 +282,12 @@ impl Zumo {
             ffi::avr_ioctl(avr, ioctl(b'u', b'a', b's', b'1'), &mut flags as *mut u32 as *mut c_void);
             let uart = ffi::avr_io_getirq(avr, ioctl(b'u', b'a', b'r', b'1'), ffi::UART_IRQ_OUTPUT as c_int);
             ffi::avr_irq_register_notify(uart, Some(on_uart), state_ptr as *mut c_void);
-            for (port, f) in [(b'F', on_ddr_f as unsafe extern "C" fn(_, _, _)), (b'D', on_ddr_d)] {
-                let irq = ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', port), ffi::IOPORT_IRQ_DIRECTION_ALL as c_int);
+            for (port, f) in [(Port::F, on_ddr_f as unsafe extern "C" fn(_, _, _)), (Port::D, on_ddr_d)] {
+                let irq = ffi::avr_io_getirq(
+                    avr,
+                    ioctl(b'i', b'o', b'g', port.letter()),
+                    ffi::IOPORT_IRQ_DIRECTION_ALL as c_int,
+                );
                 ffi::avr_irq_register_notify(irq, Some(f), state_ptr as *mut c_void);
             }
             ffi::avr_register_io_write(avr, GPIOR0, Some(on_gpior0), state_ptr as *mut c_void);
@@ -276,8 +303,8 @@ impl Zumo {
         }));
         let mut zumo = Zumo { tester, state, pixy: pixy.clone(), buttons: [0; 2], decoded: 0 };
         zumo.tester.twi0().attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
-        zumo.set_button(b'B', 3, false);
-        zumo.set_button(b'D', 5, false);
+        zumo.set_button(pins::BUTTON_A, false);
+        zumo.set_button(pins::BUTTON_B_LED_GREEN, false);
         zumo
     }
 
@@ -285,6 +312,7 @@ impl Zumo {
     pub fn write_eeprom(&mut self, offset: u16, bytes: &[u8]) {
         let mut copy = bytes.to_vec();
         let mut desc = EepromDesc { ee: copy.as_mut_ptr(), offset, size: copy.len() as u32 };
+        // SAFETY: simavr copies `size` bytes from `ee`, which holds them.
         let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b's', b'p'), &mut desc as *mut _ as *mut c_void) };
         assert_eq!(r, 0, "EEPROM write refused");
     }
@@ -292,8 +320,11 @@ impl Zumo {
     /// Reads bytes of the simulated EEPROM.
     pub fn read_eeprom(&mut self, offset: u16, len: usize) -> Vec<u8> {
         let mut desc = EepromDesc { ee: null_mut(), offset, size: len as u32 };
+        // SAFETY: simavr points `ee` at its EEPROM at `offset`.
         let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b'g', b'p'), &mut desc as *mut _ as *mut c_void) };
         assert_eq!(r, 0, "EEPROM read refused");
+        // SAFETY: the read succeeded, so `ee` points at `len` bytes of the
+        // core's EEPROM (offset + len within it, or simavr refuses).
         unsafe { std::slice::from_raw_parts(desc.ee, len).to_vec() }
     }
 
@@ -326,9 +357,10 @@ impl Zumo {
         p.bytes.clear();
     }
 
-    fn set_button(&mut self, port: u8, bit: u8, pressed: bool) {
-        let slot = usize::from(port == b'D');
-        self.buttons[slot] |= 1 << bit;
+    fn set_button(&mut self, pin: Pin, pressed: bool) {
+        let (port, bit) = (pin.port.letter(), pin.bit);
+        let slot = usize::from(pin.port == Port::D);
+        self.buttons[slot] |= pin.mask();
         let mut ext = ffi::avr_ioport_external_t {
             _bitfield_align_1: [],
             _bitfield_1: Default::default(),
@@ -338,6 +370,7 @@ impl Zumo {
         ext.set_mask(u64::from(self.buttons[slot]));
         // Pull-ups make released buttons read high.
         ext.set_value(if pressed { u64::from(self.buttons[slot] & !(1 << bit)) } else { u64::from(self.buttons[slot]) });
+        // SAFETY: the core is live; `ext` is the ioport's external-state record.
         unsafe {
             ffi::avr_ioctl(self.state.avr, ioctl(b'i', b'o', b'p', port), &mut ext as *mut _ as *mut c_void);
             let irq = ffi::avr_io_getirq(self.state.avr, ioctl(b'i', b'o', b'g', port), c_int::from(bit));
@@ -347,16 +380,16 @@ impl Zumo {
 
     /// Presses button A for 60 ms (three control periods), then releases it.
     pub fn press_a(&mut self) {
-        self.set_button(b'B', 3, true);
+        self.set_button(pins::BUTTON_A, true);
         self.run_ms(60);
-        self.set_button(b'B', 3, false);
+        self.set_button(pins::BUTTON_A, false);
     }
 
     /// Presses button B for 60 ms, then releases it.
     pub fn press_b(&mut self) {
-        self.set_button(b'D', 5, true);
+        self.set_button(pins::BUTTON_B_LED_GREEN, true);
         self.run_ms(60);
-        self.set_button(b'D', 5, false);
+        self.set_button(pins::BUTTON_B_LED_GREEN, false);
     }
 
     /// Presses button B and plays the calibration sweep: the robot spins
@@ -382,15 +415,19 @@ impl Zumo {
     /// Panics if no decision comes within 100 ms.
     pub fn run_to_decision(&mut self) -> u64 {
         let before = self.state.decisions;
+        // SAFETY: the core is live while `self` is.
         let deadline = unsafe { (*self.state.avr).cycle } + CLOCK_HZ / 10;
         while self.state.decisions == before {
             self.tester.run();
+            // SAFETY: as above.
             assert!(unsafe { (*self.state.avr).cycle } < deadline, "no decision within 100 ms");
         }
         self.state.decisions
     }
 
     fn data(&self, addr: usize) -> u8 {
+        assert!(addr < RAM_END, "data address {addr:#x} outside the 32U4's data space");
+        // SAFETY: the core is live and `addr` lies in its data space.
         unsafe { *(*self.state.avr).data.add(addr) }
     }
 
@@ -403,17 +440,18 @@ impl Zumo {
         (self.word(OCR1B), self.word(OCR1A))
     }
 
-    /// Direction pin levels (left = PB2, right = PB1); high = reverse.
+    /// Direction pin levels (left, right); high = reverse.
     pub fn directions(&self) -> (bool, bool) {
         let b = self.data(PORTB);
-        (b & 0b100 != 0, b & 0b10 != 0)
+        (b & pins::DIR_LEFT.mask() != 0, b & pins::DIR_RIGHT.mask() != 0)
     }
 
     /// Fills the free SRAM between the statics and the stack pointer with a
     /// pattern, for [`Zumo::stack_low_water`].
     pub fn paint_stack(&mut self) {
         let sp = usize::from(self.word(SP));
-        for addr in STATICS_END..sp {
+        for addr in STATICS_END..sp.min(RAM_END) {
+            // SAFETY: the core is live and `addr` lies in its SRAM.
             unsafe { *(*self.state.avr).data.add(addr) = PAINT };
         }
     }

@@ -19,7 +19,7 @@
 //! `FIRMWARE_OUT`); a missing or stale one fails with the command to run.
 
 use firmware::calibration_record;
-use host::sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
+use sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
 use rand::{RngExt, SeedableRng};
 use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, RunMode, State, StateHasher};
 use std::collections::HashMap;

@@ -12,7 +12,7 @@
 use firmware::embedded;
 use host::robot::log_file::{self, SourceKind};
 use host::robot::monitor::{self, MonitorEvent, MonitorOptions, SerialOpener};
-use host::robot::replay::{replay, ReplayReport, Stage};
+use host::robot::replay::{replay, ModeCounts, ReplayReport, Stage};
 use serialport::{SerialPort, TTYPort};
 use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, RunMode};
 use std::io::Write;
@@ -169,8 +169,8 @@ fn monitor_records_the_firmware_over_a_pty_across_unplugging_and_replay_finds_no
     let other = PolicyBlob::new(*policy.actions(), table, policy.provenance().clone()).unwrap();
     let r = replay(&recording, &other, None);
     assert_eq!(r.diverged, report.frames);
-    assert_eq!(r.diverged_by_stage[Stage::Policy as usize], report.frames);
-    assert_eq!(r.diverged_by_stage[Stage::Hash as usize], 0);
+    assert_eq!(r.diverged_by_stage.of(Stage::Policy), report.frames);
+    assert_eq!(r.diverged_by_stage.of(Stage::Hash), 0);
 }
 
 fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
@@ -185,8 +185,11 @@ fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
         assert!(range.bright.abs_diff(100 + offset) <= 2 && range.dark.abs_diff(400 + offset) <= 2, "{range:?}");
     }
     let count = |m: RunMode| frames.iter().filter(|f| f.mode == m).count() as u64;
-    assert_eq!(r.modes, [count(RunMode::Idle), count(RunMode::Driving), count(RunMode::Calibrating)]);
-    assert!(r.modes[2] >= 190 && r.policy_drove >= 40, "{r}");
+    assert_eq!(
+        r.modes,
+        ModeCounts { idle: count(RunMode::Idle), driving: count(RunMode::Driving), calibrating: count(RunMode::Calibrating) }
+    );
+    assert!(r.modes.calibrating >= 190 && r.policy_drove >= 40, "{r}");
     let mut actions = vec![0u64; r.actions.len()];
     let mut states = std::collections::BTreeSet::new();
     for f in frames.iter().filter(|f| f.policy_drove()) {

@@ -2,7 +2,8 @@
 //! table laid out like the thesis' with its numbers beside ours, and the
 //! PNG figures. Every file is written atomically.
 
-use super::metric::{self, Metric};
+use super::figures;
+use super::metric::Metric;
 use super::spec::{ArmSpec, ExperimentSpec, FigureKind, FigureSpec};
 use super::trial::{TrialResult, BLOCK_STEPS};
 use crate::report::chart::{self, Band, Labels, Scatter};
@@ -90,7 +91,7 @@ fn distinct<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
 pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed: u64) -> String {
     let t = &spec.table;
     let reference = t.ratio_to.as_deref().map(|name| of_arm(results, name));
-    let value = |arm: &ArmSpec, m: Metric| metric::value(m, &of_arm(results, &arm.name), reference.as_deref());
+    let value = |arm: &ArmSpec, m: Metric| figures::value(m, &of_arm(results, &arm.name), reference.as_deref());
     let rows = distinct(spec.arms.iter().map(|a| a.row.as_str()));
     let columns = distinct(spec.arms.iter().map(|a| a.column.as_str()));
     let find = |row: &str, column: &str| spec.arms.iter().find(|a| a.row == row && a.column == column);
@@ -135,7 +136,7 @@ pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed
                 let ours = arm.map_or_else(|| "".to_string(), |a| value(a, m).cell());
                 let _ = write!(md, " {ours} |");
                 if spec.arms.iter().any(|a| a.column == *column && a.thesis.contains_key(&m)) {
-                    let thesis = arm.and_then(|a| a.thesis.get(&m)).map_or_else(|| "–".to_string(), |&v| metric::number(v));
+                    let thesis = arm.and_then(|a| a.thesis.get(&m)).map_or_else(|| "–".to_string(), |&v| figures::number(v));
                     let _ = write!(md, " {thesis} |");
                 }
             }

@@ -8,10 +8,15 @@
 //! same pre-training settings (the transfer experiment's) share its table.
 
 use super::spec::{ArmController, ExperimentSpec};
-use super::trial::RESULT_FORMAT;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
+
+/// Version of `TrialResult`'s layout and meaning, and of the
+/// simulator's results; part of the config hash, so results of another
+/// version are re-run, not mixed in. 2: headings turn through our own
+/// `sin_cos` (`sim::trig`) instead of the platform's.
+pub const RESULT_FORMAT: u32 = 2;
 
 /// Everything one trial needs.
 #[derive(Clone, Debug, PartialEq)]

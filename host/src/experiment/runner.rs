@@ -8,9 +8,9 @@
 //! - `trials.csv`, `trials.json`, `table.md` and the PNG figures.
 
 use super::outputs;
-use super::plan::{plans, PretrainPlan, TrialPlan};
+use super::plan::{plans, PretrainPlan, TrialPlan, RESULT_FORMAT};
 use super::spec::ExperimentSpec;
-use super::trial::{self, TrialResult, RESULT_FORMAT};
+use super::trial::{self, TrialResult};
 use crate::train::checkpoint;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
@@ -66,20 +66,12 @@ pub fn slug(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
 }
 
-/// Runs the experiment; `log` receives progress lines (from any thread).
-pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: &(dyn Fn(&str) + Sync)) -> Result<RunReport> {
-    if options.trials == 0 {
-        bail!("--trials 0: at least one trial is needed");
-    }
-    if !(options.scale.is_finite() && options.scale > 0.0) {
-        bail!("--scale {}: must be a positive number", options.scale);
-    }
-    let mut slugs = BTreeMap::new();
-    for arm in &spec.arms {
-        if let Some(other) = slugs.insert(slug(&arm.name), &arm.name) {
-            bail!("arms {other:?} and {:?} would share the directory trials/{}", arm.name, slug(&arm.name));
-        }
-    }
+/// Progress lines, from any thread.
+type Log<'a> = &'a (dyn Fn(&str) + Sync);
+
+/// Runs the experiment: pre-trainings, then trials, then the reports.
+pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<RunReport> {
+    check_options(spec, options)?;
     let started = Instant::now();
     let dir = options.out.clone().unwrap_or_else(|| Path::new("out/experiments").join(&spec.name));
     let seed = options.seed.unwrap_or(spec.seed);
@@ -92,53 +84,97 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: &(dyn Fn(&str) + Sy
         options.scale,
         dir.display()
     ));
-    let pool = match options.threads {
-        Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n).build().context("cannot start worker threads")?),
-        None => None,
-    };
-    let in_pool = |job: &(dyn Fn() -> Result<()> + Sync)| match &pool {
-        Some(p) => p.install(job),
-        None => job(),
-    };
+    let workers = Workers::new(options.threads)?;
+    let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &dir, &workers, log)?;
+    let (results, trials_run) = run_trials(&plans, &dir, &workers, log)?;
+    let outputs = outputs::write(spec, &dir, &results, options.scale, seed)?;
+    Ok(RunReport {
+        dir,
+        trials_run,
+        trials_skipped: plans.len() - trials_run,
+        pretrained_run,
+        pretrained_skipped,
+        outputs,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
 
-    // Pre-trainings, each distinct one once.
+/// Refuses options that cannot run: no trials, a bad scale, arms whose
+/// directories would collide.
+fn check_options(spec: &ExperimentSpec, options: &RunOptions) -> Result<()> {
+    if options.trials == 0 {
+        bail!("--trials 0: at least one trial is needed");
+    }
+    if !(options.scale.is_finite() && options.scale > 0.0) {
+        bail!("--scale {}: must be a positive number", options.scale);
+    }
+    let mut slugs = BTreeMap::new();
+    for arm in &spec.arms {
+        if let Some(other) = slugs.insert(slug(&arm.name), &arm.name) {
+            bail!("arms {other:?} and {:?} would share the directory trials/{}", arm.name, slug(&arm.name));
+        }
+    }
+    Ok(())
+}
+
+/// The worker threads: a pool of the given size, or rayon's global one.
+struct Workers(Option<rayon::ThreadPool>);
+
+impl Workers {
+    fn new(threads: Option<usize>) -> Result<Workers> {
+        let pool = match threads {
+            Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n).build().context("cannot start worker threads")?),
+            None => None,
+        };
+        Ok(Workers(pool))
+    }
+
+    /// Runs `job` (which uses rayon's parallel iterators) on these workers.
+    fn run(&self, job: &(dyn Fn() -> Result<()> + Sync)) -> Result<()> {
+        match &self.0 {
+            Some(p) => p.install(job),
+            None => job(),
+        }
+    }
+}
+
+/// Runs each distinct pre-training not yet stored; returns how many ran and
+/// how many were found done.
+fn run_pretrainings(plans: &[TrialPlan], dir: &Path, workers: &Workers, log: Log<'_>) -> Result<(usize, usize)> {
     let mut distinct: BTreeMap<&str, &PretrainPlan> = BTreeMap::new();
     for p in plans.iter().filter_map(|p| p.pretrain.as_ref()) {
         distinct.insert(&p.hash, p);
     }
-    let (pre_done, pre_todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) =
-        distinct.values().partition(|p| pretrained_table(&dir, p).is_ok());
+    let (done, todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) =
+        distinct.values().partition(|p| pretrained_table(dir, p).is_ok());
     if !distinct.is_empty() {
-        log(&format!("pre-training: {} tables, {} already done (skipped)", distinct.len(), pre_done.len()));
+        log(&format!("pre-training: {} tables, {} already done (skipped)", distinct.len(), done.len()));
     }
     let count = AtomicUsize::new(0);
-    in_pool(&|| {
-        pre_todo.par_iter().try_for_each(|p| {
+    workers.run(&|| {
+        todo.par_iter().try_for_each(|p| {
             let t = trial::pretrain(&p.config)?;
-            checkpoint::save(&pretrained_path(&dir, p), &t.state())?;
+            checkpoint::save(&pretrained_path(dir, p), &t.state())?;
             let k = count.fetch_add(1, Ordering::Relaxed) + 1;
-            log(&format!("[{k}/{}] pre-trained {} steps: {} formations", pre_todo.len(), p.config.steps, t.totals().formations));
+            log(&format!("[{k}/{}] pre-trained {} steps: {} formations", todo.len(), p.config.steps, t.totals().formations));
             Ok(())
         })
     })?;
+    Ok((todo.len(), done.len()))
+}
 
-    // Trials.
-    let mut results: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
+/// Runs every trial not yet stored, each written atomically when it ends;
+/// returns every trial's result in plan order and how many ran.
+fn run_trials(plans: &[TrialPlan], dir: &Path, workers: &Workers, log: Log<'_>) -> Result<(Vec<TrialResult>, usize)> {
+    let mut results: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(dir, p)).collect();
     let todo: Vec<usize> = (0..plans.len()).filter(|&i| results[i].is_none()).collect();
     log(&format!("trials: {}, {} already done (skipped)", plans.len(), plans.len() - todo.len()));
     let count = AtomicUsize::new(0);
     let fresh = std::sync::Mutex::new(Vec::new());
-    in_pool(&|| {
+    workers.run(&|| {
         todo.par_iter().try_for_each(|&i| {
             let plan = &plans[i];
-            let seed_table = match &plan.pretrain {
-                Some(p) => Some(pretrained_table(&dir, p)?),
-                None => None,
-            };
-            let result = trial::run(plan, seed_table).with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
-            let path = trial_path(&dir, plan);
-            let json = serde_json::to_vec_pretty(&result).context("cannot encode a trial result")?;
-            crate::atomic::write(&path, &json)?;
+            let result = run_trial(plan, dir)?;
             let k = count.fetch_add(1, Ordering::Relaxed) + 1;
             log(&format!(
                 "[{k}/{}] {} trial {}: {} formations, {} stuck, {} steps at {:.0} steps/s",
@@ -159,17 +195,20 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: &(dyn Fn(&str) + Sy
     for (i, r) in fresh.into_inner().unwrap_or_default() {
         results[i] = Some(r);
     }
-    let results: Vec<TrialResult> = results.into_iter().flatten().collect();
-    let outputs = outputs::write(spec, &dir, &results, options.scale, seed)?;
-    Ok(RunReport {
-        dir,
-        trials_run: todo.len(),
-        trials_skipped: plans.len() - todo.len(),
-        pretrained_run: pre_todo.len(),
-        pretrained_skipped: pre_done.len(),
-        outputs,
-        seconds: started.elapsed().as_secs_f64(),
-    })
+    Ok((results.into_iter().flatten().collect(), todo.len()))
+}
+
+/// Runs one trial (from its stored pre-trained table, if it has one) and
+/// writes its result.
+fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
+    let seed_table = match &plan.pretrain {
+        Some(p) => Some(pretrained_table(dir, p)?),
+        None => None,
+    };
+    let result = trial::run(plan, seed_table).with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
+    let json = serde_json::to_vec_pretty(&result).context("cannot encode a trial result")?;
+    crate::atomic::write(&trial_path(dir, plan), &json)?;
+    Ok(result)
 }
 
 fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {

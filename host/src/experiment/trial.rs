@@ -1,23 +1,17 @@
 //! One trial: an arm's controller on its configuration for its steps, with
 //! what the reports need recorded on the way.
 
-use super::plan::TrialPlan;
+use super::plan::{TrialPlan, RESULT_FORMAT};
 use super::spec::ArmController;
-use crate::controller::{OrbitalConfig, OrbitalConstruction};
+use sim::controllers::{OrbitalConfig, OrbitalConstruction};
 use crate::learn::QTable;
-use crate::scenario::orbital_innies;
-use crate::sim::{EpisodeEnd, Simulation, Totals};
+use sim::scenario::orbital_innies;
+use sim::{EpisodeEnd, Simulation, Totals};
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 use std::time::Instant;
-
-/// Version of [`TrialResult`]'s layout and meaning, and of the
-/// simulator's results; part of the config hash, so results of another
-/// version are re-run, not mixed in. 2: headings turn through our own
-/// `sin_cos` (`sim::trig`) instead of the platform's.
-pub const RESULT_FORMAT: u32 = 2;
 
 /// Steps per collision block (the thesis' chapter 6 metric).
 pub const BLOCK_STEPS: u64 = 1000;
@@ -131,7 +125,7 @@ pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> 
 }
 
 /// Pre-trains a Q-table: a plain training run of `config`.
-pub fn pretrain(config: &TrainConfig) -> Result<Trainer<crate::sensor_choice::SelectedSensors>> {
+pub fn pretrain(config: &TrainConfig) -> Result<Trainer<sim::sensor_setup::SelectedSensors>> {
     let field = Arc::new(config.field.load()?);
     let mut trainer = Trainer::new(config.clone(), field, config.sensors.build(&config.sim_config())?, None)?;
     trainer.run(config.steps);

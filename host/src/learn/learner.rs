@@ -1,9 +1,9 @@
 //! The Q-learning controller: one table, every robot's experience.
 
 use super::qtable::{QParams, QTable};
-use super::reward::Reward;
-use crate::controller::{Controller, Perception};
-use crate::sim::{EpisodeStart, SimRng, StepOutcome};
+use sim::reward::Reward;
+use sim::{Controller, Perception};
+use sim::{EpisodeStart, SimRng, StepOutcome};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
@@ -52,7 +52,7 @@ impl std::str::FromStr for StateHasherName {
 
     fn from_str(s: &str) -> Result<StateHasherName, String> {
         StateHasher::from_name(s).map(StateHasherName).ok_or_else(|| {
-            format!("unknown hasher {s:?}: expected original, original-obstacle, bits7, bits9 (or 8, 10, 7, 9)")
+            format!("unknown hasher {s:?}: expected {}", StateHasher::NAMES)
         })
     }
 }
@@ -192,7 +192,7 @@ impl Controller for QLearner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
+    use sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
     use rand::SeedableRng;
     use shared::{PolicyTable, SensorReading};
 

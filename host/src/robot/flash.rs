@@ -41,7 +41,7 @@ impl FlashPlan {
     /// one is asked for) and a checkout is found (`repo`, or the nearest
     /// ancestor of `cwd` holding one).
     pub fn new(policy: &Path, hasher: Option<StateHasher>, port: Option<String>, repo: Option<&Path>, cwd: &Path) -> Result<FlashPlan> {
-        let blob = crate::policy_file::read(policy)?;
+        let blob = sim::policy_file::read(policy)?;
         if let Some(h) = hasher {
             if h != blob.hasher() {
                 bail!(

@@ -67,7 +67,7 @@ impl TrainingVisits {
         let file: VisitsFile =
             serde_json::from_str(&text).with_context(|| format!("visits file {} is not valid JSON of the visits format", path.display()))?;
         let hasher = StateHasher::from_name(&file.hasher).with_context(|| {
-            format!("visits file {}: unknown hasher {:?} (original, original-obstacle, bits7, bits9)", path.display(), file.hasher)
+            format!("visits file {}: unknown hasher {:?} (expected {})", path.display(), file.hasher, StateHasher::NAMES)
         })?;
         TrainingVisits::new(hasher, file.visits).with_context(|| format!("visits file {}", path.display()))
     }

@@ -29,8 +29,6 @@ pub const VERSION: u16 = 1;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
-/// The policy blob's magic, recognised to say what the file is instead.
-const POLICY_MAGIC: &[u8; 4] = b"QPOL";
 
 /// Why bytes are not a checkpoint this build can resume from.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -109,7 +107,8 @@ pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()>
 /// declared length, CRC, then the body.
 pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
     let found = bytes.len() as u64;
-    if bytes.starts_with(POLICY_MAGIC) {
+    // A policy blob is recognised, to say what the file is instead.
+    if bytes.starts_with(&shared::PolicyBlob::MAGIC) {
         return Err(CheckpointError::PolicyBlob);
     }
     if bytes.len() < HEADER_LEN {

@@ -6,9 +6,10 @@ use super::checkpoint;
 use super::config::{TrainConfig, TrainOverrides};
 use super::trainer::{Trainer, TrainingState};
 use crate::learn::QTable;
-use crate::sensor_choice::SelectedSensors;
+use sim::sensor_setup::SelectedSensors;
 use anyhow::{bail, Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use shared::PolicyBlob;
+use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use std::fmt;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -18,33 +19,24 @@ use std::time::Instant;
 /// Steps between progress-bar updates.
 const PROGRESS_CHUNK: u64 = 20_000;
 
-/// The `host train` arguments.
-#[derive(Clone, Debug, Default, clap::Args)]
-pub struct TrainArgs {
-    /// TOML file with any of the settings (docs/training.md); flags override it.
-    #[arg(long)]
+/// What `host train` is asked to do (the CLI's flags, as plain settings).
+#[derive(Clone, Debug, Default)]
+pub struct TrainRequest {
+    /// TOML file with any of the settings; the overrides win over it.
     pub config: Option<PathBuf>,
-    /// The settings flags.
-    #[command(flatten)]
+    /// Settings given one by one.
     pub overrides: TrainOverrides,
-    /// Steps to run [default: 2000000; when resuming, the checkpoint's run length].
-    #[arg(long)]
+    /// Steps to run (default: the config's; when resuming, the checkpoint's run length).
     pub steps: Option<u64>,
-    /// Directory for <name>.policy and <name>.ckpt [default: out].
-    #[arg(long)]
+    /// Directory for <name>.policy and <name>.ckpt.
     pub out: Option<PathBuf>,
-    /// Name of the output files and of the policy [default: <field>-<hasher>].
-    #[arg(long)]
+    /// Name of the output files and of the policy.
     pub name: Option<String>,
-    /// Steps between checkpoints, 0 for only at the end [default: 1000000].
-    #[arg(long)]
+    /// Steps between checkpoints, 0 for only at the end.
     pub checkpoint_every: Option<u64>,
-    /// Continue a run from its checkpoint, with its settings, for --steps more steps.
-    #[arg(long, conflicts_with_all = ["config", "init_from"])]
+    /// Continue a run from its checkpoint, with its settings.
     pub resume: Option<PathBuf>,
-    /// Start from the Q-table of a checkpoint (the thesis' RL2), or from a
-    /// policy blob (its actions preferred); hasher and actions must match.
-    #[arg(long)]
+    /// Start from the Q-table of a checkpoint, or from a policy blob.
     pub init_from: Option<PathBuf>,
 }
 
@@ -84,7 +76,7 @@ impl fmt::Display for TrainReport {
 }
 
 /// Runs `host train`.
-pub fn train(args: &TrainArgs) -> Result<TrainReport> {
+pub fn train(args: &TrainRequest) -> Result<TrainReport> {
     let (mut trainer, steps) = match &args.resume {
         Some(path) => resume(args, path)?,
         None => start(args)?,
@@ -104,7 +96,7 @@ pub fn train(args: &TrainArgs) -> Result<TrainReport> {
 }
 
 /// A new run from the config file, the flags and `--init-from`.
-fn start(args: &TrainArgs) -> Result<(Trainer<SelectedSensors>, u64)> {
+fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
     let mut config = match &args.config {
         Some(path) => TrainConfig::from_file(path)?,
         None => TrainConfig::default(),
@@ -122,7 +114,7 @@ fn start(args: &TrainArgs) -> Result<(Trainer<SelectedSensors>, u64)> {
 }
 
 /// A run continued from its checkpoint, with its own settings.
-fn resume(args: &TrainArgs, path: &Path) -> Result<(Trainer<SelectedSensors>, u64)> {
+fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>, u64)> {
     let given = args.overrides.given();
     if !given.is_empty() {
         bail!(
@@ -143,8 +135,8 @@ fn resume(args: &TrainArgs, path: &Path) -> Result<(Trainer<SelectedSensors>, u6
 pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     let learn = &config.learn;
-    let (table, speeds) = if bytes.starts_with(b"QPOL") {
-        let blob = shared::PolicyBlob::decode(&bytes).map_err(|e| anyhow::anyhow!("policy file {}: {e}", path.display()))?;
+    let (table, speeds) = if bytes.starts_with(&PolicyBlob::MAGIC) {
+        let blob = sim::policy_file::decode(path, &bytes)?;
         let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
         (q, Some(blob.actions().angular_speeds().to_vec()))
     } else {
@@ -225,8 +217,10 @@ fn progress_bar(steps: u64) -> ProgressBar {
         ProgressDrawTarget::hidden()
     };
     let bar = ProgressBar::with_draw_target(Some(steps), target);
-    if let Ok(style) = ProgressStyle::with_template("{bar:30} {percent:>3}%  {human_pos}/{human_len} steps  {per_sec}  {msg}") {
-        bar.set_style(style);
+    if let Ok(style) = ProgressStyle::with_template("{bar:30} {percent:>3}%  {human_pos}/{human_len} steps  {rate}  {msg}") {
+        bar.set_style(style.with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = write!(w, "{} steps/s", HumanCount(state.per_sec().round() as u64));
+        }));
     }
     bar
 }

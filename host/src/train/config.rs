@@ -1,10 +1,11 @@
 //! What a training run is: [`TrainConfig`], read from a TOML file and/or
 //! the `host train` flags ([`TrainOverrides`]), flags winning.
 
-use crate::learn::{LearnConfig, Reward, StateHasherName};
-use crate::scenario::field_config;
+use crate::learn::{LearnConfig, StateHasherName};
+use sim::reward::Reward;
+use sim::scenario::field_config;
 use crate::sensor_choice::SensorChoice;
-use crate::sim::{FieldSource, SimConfig};
+use sim::{FieldSource, SimConfig};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -148,49 +149,35 @@ fn truncate(s: &str) -> String {
     s[..end].to_string()
 }
 
-/// The `host train` flags that change a [`TrainConfig`]; each overrides
-/// the config file's value when given.
-#[derive(Clone, Debug, Default, clap::Args)]
+/// Settings given one by one (the `host train` flags) that change a
+/// [`TrainConfig`]; each overrides the config file's value when given.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TrainOverrides {
     /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
-    #[arg(long, value_parser = parse_field)]
     pub field: Option<FieldSource>,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with
     /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
     /// photo-transistors and Pixy camera, through the firmware's arithmetic)
     /// or robot:CONFIG.json (docs/robot-sensors.md).
-    #[arg(long)]
     pub sensors: Option<SensorChoice>,
     /// Number of robots [default: 8].
-    #[arg(long)]
     pub robots: Option<usize>,
     /// Number of pucks [default: 250].
-    #[arg(long)]
     pub pucks: Option<usize>,
     /// Seed of every random choice [default: 1].
-    #[arg(long)]
     pub seed: Option<u64>,
     /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
     /// 7, 9) [default: original].
-    #[arg(long)]
     pub hasher: Option<StateHasherName>,
     /// Reward: reference, thesis, collision, collision-spread [default:
     /// reference].
-    #[arg(long)]
     pub reward: Option<Reward>,
     /// Learning rate [default: 0.2].
-    #[arg(long)]
     pub alpha: Option<f64>,
     /// Discount [default: 0.9].
-    #[arg(long)]
     pub gamma: Option<f64>,
     /// Exploration probability [default: 0].
-    #[arg(long)]
     pub epsilon: Option<f64>,
-}
-
-fn parse_field(s: &str) -> Result<FieldSource, String> {
-    s.parse().map_err(|e: crate::sim::FieldError| e.to_string())
 }
 
 impl TrainOverrides {
@@ -266,7 +253,7 @@ mod tests {
     fn names_derive_from_field_and_hasher_and_are_checked() {
         let mut c = TrainConfig::default();
         assert_eq!(c.name(), "annulus-original");
-        c.field = FieldSource::Letter(crate::sim::Letter::T);
+        c.field = FieldSource::Letter(sim::Letter::T);
         assert_eq!(c.name(), "letter-T-original");
         c.output.name = Some("../escape".into());
         assert!(c.validate().unwrap_err().to_string().contains("path separators"));

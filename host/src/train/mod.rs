@@ -7,6 +7,6 @@ pub mod command;
 pub mod config;
 pub mod trainer;
 
-pub use command::{train, TrainArgs, TrainReport};
+pub use command::{train, TrainReport, TrainRequest};
 pub use config::{OutputConfig, TrainConfig, TrainOverrides};
 pub use trainer::{Trainer, TrainingState};

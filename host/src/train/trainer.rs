@@ -3,7 +3,7 @@
 
 use super::config::{field_label, TrainConfig};
 use crate::learn::{QLearner, QTable};
-use crate::sim::{EpisodeEnd, ScalarField, SensorModel, Simulation, SimulationState, Totals};
+use sim::{EpisodeEnd, ScalarField, SensorModel, Simulation, SimulationState, Totals};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
@@ -116,11 +116,10 @@ impl<S: SensorModel> Trainer<S> {
     pub fn policy(&self) -> Result<PolicyBlob> {
         let c = &self.config;
         let actions = ActionTable::new(&c.learn.actions, self.sim.config().world.forward_speed as f32)
-            .map_err(|e| anyhow::anyhow!("cannot export the policy: {e}"))?;
+            .context("cannot export the policy")?;
         let provenance = Provenance::new(&field_label(&c.field), &c.name(), self.totals().steps, c.seed)
-            .map_err(|e| anyhow::anyhow!("cannot export the policy: {e}"))?;
-        PolicyBlob::new(actions, self.learner.table().greedy_policy(), provenance)
-            .map_err(|e| anyhow::anyhow!("cannot export the policy: {e}"))
+            .context("cannot export the policy")?;
+        PolicyBlob::new(actions, self.learner.table().greedy_policy(), provenance).context("cannot export the policy")
     }
 }
 

@@ -1,0 +1,366 @@
+//! The command line: every `clap` type of `host`, and the conversions
+//! from flags into the libraries' plain settings (`main.rs` dispatches).
+
+use anyhow::Result;
+use clap::{Args, Parser, Subcommand};
+use host::experiment::RunOptions;
+use host::learn::StateHasherName;
+use host::sensor_choice::SensorChoice;
+use host::train::{TrainOverrides, TrainRequest};
+use shared::StateHasher;
+use sim::reward::Reward;
+use sim::scenario::{ControllerChoice, Scenario};
+use sim::{BroadPhase, FieldError, FieldSource};
+use std::path::PathBuf;
+
+/// Simulate, train and inspect policies for Zumo puck-construction swarms;
+/// flash robots, record and replay their logs.
+#[derive(Parser)]
+#[command(version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Run a simulation and print formations, stuck episodes, collisions,
+    /// mean Eval and speed.
+    Run {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// Steps to run.
+        #[arg(long, default_value_t = 200_000)]
+        steps: u64,
+        /// Print one JSON object instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Draw the world (after --steps steps) as a PNG, or animate an episode.
+    Render {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// Steps to run before drawing (or to animate, with --gif).
+        #[arg(long, default_value_t = 0)]
+        steps: u64,
+        /// PNG file to write.
+        #[arg(long, required_unless_present = "gif")]
+        out: Option<PathBuf>,
+        /// Animated GIF file to write instead, one frame every --every steps.
+        #[arg(long)]
+        gif: Option<PathBuf>,
+        /// Steps between GIF frames.
+        #[arg(long, default_value_t = 100)]
+        every: u64,
+        /// Image side in pixels.
+        #[arg(long, default_value_t = 800)]
+        size: u32,
+        /// Draw each robot's sensor discs and field points.
+        #[arg(long)]
+        footprints: bool,
+    },
+    /// Measure steps per second of the standard configuration (8 robots,
+    /// 250 pucks, annulus, orbital construction), single-threaded.
+    Bench {
+        /// All-pairs contact and sensor checks, like the original simulator.
+        #[arg(long)]
+        naive: bool,
+        /// 64 robots and 1,000 pucks (arena enlarged to the same density).
+        #[arg(long)]
+        scale: bool,
+        /// Steps to time.
+        #[arg(long, default_value_t = 1_000_000)]
+        steps: u64,
+    },
+    /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
+    /// blob for the firmware) and <out>/<name>.ckpt (the complete training
+    /// state), and prints formations, stuck episodes, speed and state
+    /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
+    /// hasher, 2,000,000 steps, into out/.
+    Train(TrainArgs),
+    /// Run one of the thesis' experiments (trials in parallel, resumable)
+    /// and write CSV, JSON, a markdown table beside the thesis' numbers and
+    /// PNG figures into --out.
+    Experiment(ExperimentArgs),
+    /// Work with policy blob files.
+    #[command(subcommand)]
+    Policy(PolicyCommand),
+    /// Record a robot's serial log into a file (each frame with a host
+    /// timestamp) with a live status line; survives unplugging, Ctrl-C ends.
+    Monitor(MonitorArgs),
+    /// Check a recorded log (or a raw serial capture) against a policy:
+    /// divergences, state coverage, actions, faults, damaged records.
+    Replay(ReplayArgs),
+    /// Build the firmware with a policy and flash it with avrdude (double
+    /// press of reset); --dry-run prints the commands.
+    Flash(FlashArgs),
+}
+
+/// `host monitor`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct MonitorArgs {
+    /// Serial port of the robot's TTL adapter or radio, e.g. /dev/ttyUSB0.
+    #[arg(long, required_unless_present = "list")]
+    pub port: Option<String>,
+    /// Baud rate (the firmware sends 115200 8N1).
+    #[arg(long, default_value_t = host::robot::monitor::DEFAULT_BAUD)]
+    pub baud: u32,
+    /// Recorded-log file to write (refused if it exists, unless --append).
+    #[arg(long, required_unless_present = "list")]
+    pub out: Option<PathBuf>,
+    /// Add to an existing recorded log instead of refusing it.
+    #[arg(long)]
+    pub append: bool,
+    /// Stop after recording this many frames (for scripts and tests).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// List the serial ports and exit.
+    #[arg(long)]
+    pub list: bool,
+}
+
+/// `host replay`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct ReplayArgs {
+    /// Recorded log from `host monitor`, or a raw capture of the serial line.
+    #[arg(long)]
+    pub log: PathBuf,
+    /// The policy blob the robot was flashed with.
+    #[arg(long)]
+    pub policy: PathBuf,
+    /// The policy's training checkpoint (`host train`'s .ckpt), or a JSON
+    /// file of visit counts per state (docs/robot-logs.md): reports the
+    /// states the robot met that training never visited.
+    #[arg(long)]
+    pub visits: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `host flash`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct FlashArgs {
+    /// The policy blob to embed.
+    #[arg(long)]
+    pub policy: PathBuf,
+    /// The bootloader's serial port (appears after a double press of reset), e.g. /dev/ttyACM0.
+    #[arg(long)]
+    pub port: Option<String>,
+    /// Build for this hasher; the policy must use it (default: the policy's own).
+    #[arg(long, value_parser = parse_hasher)]
+    pub hasher: Option<StateHasher>,
+    /// The zumo-swarm checkout to build in (default: the one around the current directory).
+    #[arg(long)]
+    pub repo: Option<PathBuf>,
+    /// Validate and print the exact commands; build and write nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+}
+
+fn parse_hasher(s: &str) -> Result<StateHasher, String> {
+    StateHasher::from_name(s).ok_or_else(|| format!("{s:?} is not a hasher ({})", StateHasher::NAMES))
+}
+
+/// What to simulate.
+#[derive(Args)]
+pub struct ScenarioArgs {
+    /// oc, random or policy:FILE.
+    #[arg(long, default_value = "oc", value_parser = parse_controller)]
+    pub controller: ControllerChoice,
+    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    #[arg(long, default_value = "annulus", value_parser = parse_field)]
+    pub field: FieldSource,
+    /// Number of robots.
+    #[arg(long, default_value_t = 8)]
+    pub robots: usize,
+    /// Number of pucks.
+    #[arg(long, default_value_t = 250)]
+    pub pucks: usize,
+    /// Seed of every random choice.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// All-pairs contact checks instead of the spatial grid (same results).
+    #[arg(long)]
+    pub naive: bool,
+    /// Sensor model: disc (the reference model's discs), disc-thesis (with
+    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
+    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
+    /// or robot:CONFIG.json (the same with settings from a JSON file;
+    /// docs/robot-sensors.md).
+    #[arg(long, default_value = "disc", value_parser = parse_sensors)]
+    pub sensors: SensorChoice,
+}
+
+impl ScenarioArgs {
+    /// The scenario, with a robot sensor config file read and checked.
+    pub fn scenario(self) -> Result<Scenario> {
+        Ok(Scenario {
+            field: self.field,
+            controller: self.controller,
+            robots: self.robots,
+            pucks: self.pucks,
+            seed: self.seed,
+            broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
+            arena_size: None,
+            sensors: self.sensors.setup()?,
+        })
+    }
+}
+
+fn parse_controller(s: &str) -> Result<ControllerChoice, String> {
+    s.parse()
+}
+
+fn parse_sensors(s: &str) -> Result<SensorChoice, String> {
+    s.parse()
+}
+
+fn parse_field(s: &str) -> Result<FieldSource, String> {
+    s.parse().map_err(|e: FieldError| e.to_string())
+}
+
+#[derive(Subcommand)]
+pub enum PolicyCommand {
+    /// Print a blob's header and its state -> action table.
+    Inspect {
+        /// The policy blob file.
+        file: PathBuf,
+    },
+}
+
+/// `host train`'s options.
+#[derive(Clone, Debug, Default, Args)]
+pub struct TrainArgs {
+    /// TOML file with any of the settings (docs/training.md); flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The settings flags.
+    #[command(flatten)]
+    pub overrides: TrainOverrideArgs,
+    /// Steps to run [default: 2000000; when resuming, the checkpoint's run length].
+    #[arg(long)]
+    pub steps: Option<u64>,
+    /// Directory for <name>.policy and <name>.ckpt [default: out].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Name of the output files and of the policy [default: <field>-<hasher>].
+    #[arg(long)]
+    pub name: Option<String>,
+    /// Steps between checkpoints, 0 for only at the end [default: 1000000].
+    #[arg(long)]
+    pub checkpoint_every: Option<u64>,
+    /// Continue a run from its checkpoint, with its settings, for --steps more steps.
+    #[arg(long, conflicts_with_all = ["config", "init_from"])]
+    pub resume: Option<PathBuf>,
+    /// Start from the Q-table of a checkpoint (the thesis' RL2), or from a
+    /// policy blob (its actions preferred); hasher and actions must match.
+    #[arg(long)]
+    pub init_from: Option<PathBuf>,
+}
+
+impl TrainArgs {
+    /// The request these flags make.
+    pub fn request(self) -> TrainRequest {
+        let o = self.overrides;
+        TrainRequest {
+            config: self.config,
+            overrides: TrainOverrides {
+                field: o.field,
+                sensors: o.sensors,
+                robots: o.robots,
+                pucks: o.pucks,
+                seed: o.seed,
+                hasher: o.hasher,
+                reward: o.reward,
+                alpha: o.alpha,
+                gamma: o.gamma,
+                epsilon: o.epsilon,
+            },
+            steps: self.steps,
+            out: self.out,
+            name: self.name,
+            checkpoint_every: self.checkpoint_every,
+            resume: self.resume,
+            init_from: self.init_from,
+        }
+    }
+}
+
+/// The `host train` flags that change a training config; each overrides
+/// the config file's value when given.
+#[derive(Clone, Debug, Default, Args)]
+pub struct TrainOverrideArgs {
+    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    #[arg(long, value_parser = parse_field)]
+    pub field: Option<FieldSource>,
+    /// Sensor model: disc (the reference model's discs), disc-thesis (with
+    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
+    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
+    /// or robot:CONFIG.json (docs/robot-sensors.md).
+    #[arg(long)]
+    pub sensors: Option<SensorChoice>,
+    /// Number of robots [default: 8].
+    #[arg(long)]
+    pub robots: Option<usize>,
+    /// Number of pucks [default: 250].
+    #[arg(long)]
+    pub pucks: Option<usize>,
+    /// Seed of every random choice [default: 1].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
+    /// 7, 9) [default: original].
+    #[arg(long)]
+    pub hasher: Option<StateHasherName>,
+    /// Reward: reference, thesis, collision, collision-spread [default:
+    /// reference].
+    #[arg(long)]
+    pub reward: Option<Reward>,
+    /// Learning rate [default: 0.2].
+    #[arg(long)]
+    pub alpha: Option<f64>,
+    /// Discount [default: 0.9].
+    #[arg(long)]
+    pub gamma: Option<f64>,
+    /// Exploration probability [default: 0].
+    #[arg(long)]
+    pub epsilon: Option<f64>,
+}
+
+
+/// `host experiment`'s options.
+#[derive(Clone, Debug, Args)]
+pub struct ExperimentArgs {
+    /// annulus, transfer, letters, state-bits, obstacle, collisions (the
+    /// files of experiments/, built in), or the path of a TOML file.
+    pub experiment: String,
+    /// Trials per arm.
+    #[arg(long, default_value_t = 10)]
+    pub trials: usize,
+    /// Fraction of the thesis' step counts, for quick runs (e.g. 0.001).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Output directory [default: out/experiments/<name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Experiment seed, from which every trial's seed derives [default: the file's].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads [default: one per core].
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+impl ExperimentArgs {
+    /// The run options these arguments give.
+    pub fn options(&self) -> RunOptions {
+        RunOptions {
+            trials: self.trials,
+            scale: self.scale,
+            out: self.out.clone(),
+            seed: self.seed,
+            threads: self.threads,
+        }
+    }
+}

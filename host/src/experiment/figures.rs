@@ -1,0 +1,77 @@
+//! The figures an experiment table reports, computed over an arm's trials.
+
+use super::metric::Metric;
+use super::trial::TrialResult;
+use crate::report::stats::MeanCi;
+
+/// An arm's figure: a mean with its 95 % interval over trials, a single
+/// derived number, or nothing (no trial has the figure).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Value {
+    /// Mean over trials and the half-width of its 95 % interval; `n` trials.
+    Mean {
+        /// Mean and interval.
+        ci: MeanCi,
+        /// Trials that have the figure.
+        n: usize,
+    },
+    /// A figure derived from means (steps per formation, ratios).
+    Derived(f64),
+    /// No trial has it.
+    Missing,
+}
+
+impl Value {
+    /// As a table cell: `mean ± half-width`, or `–`.
+    pub fn cell(self) -> String {
+        match self {
+            Value::Mean { ci, n } if n > 1 => format!("{} ± {}", number(ci.mean), number(ci.half_width)),
+            Value::Mean { ci, .. } => number(ci.mean),
+            Value::Derived(v) if v.is_finite() => number(v),
+            _ => "–".into(),
+        }
+    }
+}
+
+/// A number with precision suited to its size.
+pub fn number(v: f64) -> String {
+    let a = v.abs();
+    if a >= 1000.0 {
+        format!("{v:.0}")
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+/// One figure of one arm's trials; `reference` is the `ratio_to` arm's.
+pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialResult]>) -> Value {
+    let mean_of = |f: &dyn Fn(&TrialResult) -> Option<f64>| {
+        let values: Vec<f64> = trials.iter().filter_map(f).collect();
+        if values.is_empty() {
+            Value::Missing
+        } else {
+            Value::Mean { ci: MeanCi::of(&values), n: values.len() }
+        }
+    };
+    let mean_formations = |ts: &[TrialResult]| {
+        (!ts.is_empty()).then(|| ts.iter().map(|t| t.formations as f64).sum::<f64>() / ts.len() as f64)
+    };
+    match metric {
+        Metric::Formations => mean_of(&|t| Some(t.formations as f64)),
+        Metric::Stuck => mean_of(&|t| Some(t.stuck as f64)),
+        Metric::StepsPerFormation => match (mean_formations(trials), trials.first()) {
+            (Some(f), Some(t)) if f > 0.0 => Value::Derived(t.steps as f64 / f),
+            _ => Value::Missing,
+        },
+        Metric::FirstFormation => mean_of(&|t| t.formation_steps.first().map(|&s| s as f64)),
+        Metric::CollisionsPer1000 => mean_of(&|t| Some(t.collisions_per_1000)),
+        Metric::FormationsRatio => match (mean_formations(trials), reference.and_then(mean_formations)) {
+            (Some(a), Some(b)) if b > 0.0 => Value::Derived(a / b),
+            _ => Value::Missing,
+        },
+        Metric::StatesVisited => mean_of(&|t| t.states_visited.map(|v| v as f64)),
+        Metric::StepsPerSecond => mean_of(&|t| Some(t.steps_per_second)),
+    }
+}

@@ -1,0 +1,127 @@
+//! Stage by stage, what the firmware should have decided for a frame's
+//! logged inputs, and the frames whose logged decision differs.
+
+use super::report::{Divergence, Stage, StageCounts, LISTED};
+use shared::{
+    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob, RobotProfile, RunMode,
+    SensorReading, State,
+};
+
+/// What each stage should have produced from a frame's own inputs.
+struct Expected {
+    /// Calibrated values, when a calibration was known.
+    values: Option<[FieldValue; 3]>,
+    state: State,
+    action: ActionId,
+    /// Motor commands (none for the calibration spin, which is not checked).
+    motors: Option<MotorCommand>,
+}
+
+/// Recomputes decisions with a policy and collects the divergences.
+pub struct DecisionCheck<'a> {
+    policy: &'a PolicyBlob,
+    motors: ActionMotors,
+    calibration: Option<FieldCalibration>,
+    /// Calibrations logged, each differing from the one before.
+    pub calibrations: Vec<FieldCalibration>,
+    /// Frames whose values could be checked.
+    pub calibration_checked: u64,
+    /// Frames with any divergence.
+    pub diverged: u64,
+    /// Diverged frames per stage.
+    pub by_stage: StageCounts,
+    /// The first [`LISTED`] divergences.
+    pub first: Vec<Divergence>,
+}
+
+impl<'a> DecisionCheck<'a> {
+    /// Checks against `policy` with the Zumo's drive mixing.
+    pub fn new(policy: &'a PolicyBlob) -> DecisionCheck<'a> {
+        DecisionCheck {
+            policy,
+            motors: RobotProfile::ZUMO.action_motors(policy.actions()),
+            calibration: None,
+            calibrations: Vec::new(),
+            calibration_checked: 0,
+            diverged: 0,
+            by_stage: StageCounts::default(),
+            first: Vec::new(),
+        }
+    }
+
+    /// Checks one frame (at byte `offset`); a calibration it carries
+    /// applies from this frame on.
+    pub fn frame(&mut self, offset: u64, f: &LogFrame) {
+        if let Some(c) = f.calibration {
+            if self.calibrations.last() != Some(&c) {
+                self.calibrations.push(c);
+            }
+            self.calibration = Some(c);
+        }
+        let expected = self.expected(f);
+        if expected.values.is_some() {
+            self.calibration_checked += 1;
+        }
+        let stages = divergent_stages(f, &expected);
+        if !stages.is_empty() {
+            self.record(offset, f, &expected, stages);
+        }
+    }
+
+    /// Each stage's result from the frame's logged inputs to that stage.
+    fn expected(&self, f: &LogFrame) -> Expected {
+        let values = self.calibration.map(|c| c.scales().values(&f.raw_times));
+        let state = self.policy.hasher().hash(&SensorReading::from_parts(f.values, f.blobs));
+        let in_range = f.state.index() < self.policy.hasher().num_states();
+        let action = if in_range { self.policy.table().action(f.state) } else { ActionId(u8::MAX) };
+        let motors = match f.mode {
+            RunMode::Calibrating => None,
+            _ if f.policy_drove() && f.action.index() < self.policy.actions().len() => Some(self.motors.command(f.action)),
+            _ => Some(MotorCommand::default()),
+        };
+        Expected { values, state, action, motors }
+    }
+
+    fn record(&mut self, offset: u64, f: &LogFrame, e: &Expected, stages: Vec<Stage>) {
+        self.diverged += 1;
+        for s in &stages {
+            self.by_stage.count(*s);
+        }
+        if self.first.len() < LISTED {
+            self.first.push(Divergence {
+                offset,
+                tick: f.tick,
+                stages,
+                mode: f.mode,
+                faults: f.faults.0,
+                raw_times: f.raw_times,
+                values: f.values.map(|v| v.raw()),
+                expected_values: e.values.map(|v| v.map(|x| x.raw())),
+                blobs: [f.blobs.puck_left, f.blobs.puck_right, f.blobs.obstacle_left, f.blobs.obstacle_right],
+                state: f.state.0,
+                expected_state: e.state.0,
+                action: f.action.0,
+                expected_action: e.action.0,
+                motors: [f.motors.left, f.motors.right],
+                expected_motors: e.motors.map(|m| [m.left, m.right]),
+            });
+        }
+    }
+}
+
+/// The stages whose logged result differs from the expected one, in order.
+fn divergent_stages(f: &LogFrame, e: &Expected) -> Vec<Stage> {
+    let motors_ok = match e.motors {
+        Some(m) => m == f.motors,
+        None => f.mode == RunMode::Calibrating,
+    };
+    [
+        (Stage::Calibration, e.values.is_some_and(|v| v != f.values)),
+        (Stage::Hash, e.state != f.state),
+        (Stage::Policy, e.action != f.action),
+        (Stage::Motors, !motors_ok),
+    ]
+    .into_iter()
+    .filter_map(|(stage, diverged)| diverged.then_some(stage))
+    .collect()
+}

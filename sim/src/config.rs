@@ -1,0 +1,233 @@
+//! Simulation settings, their defaults (the reference model's) and their
+//! validation.
+//!
+//! Every struct deserialises with `#[serde(default)]`, so a TOML or JSON
+//! file only names what it changes. [`SimConfig::validate`] runs before a
+//! simulation is built and names the first offending value.
+
+use crate::broadphase::BroadPhase;
+use crate::disc_sensor_config::DiscSensorConfig;
+use crate::validate::{check, positive, unit, ConfigError};
+use serde::{Deserialize, Serialize};
+
+/// The arena and what is in it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct WorldConfig {
+    /// Side of the square arena, units.
+    pub arena_size: f64,
+    /// Number of robots (bodies `0 .. robots`).
+    pub robots: usize,
+    /// How many of the robots are innies (the first ones); the rest are outies.
+    pub innies: usize,
+    /// Number of pucks (bodies `robots .. robots + pucks`).
+    pub pucks: usize,
+    /// Robot radius, units.
+    pub robot_radius: f64,
+    /// Puck radius, units.
+    pub puck_radius: f64,
+    /// Robots' constant forward speed, units per step.
+    pub forward_speed: f64,
+    /// Contact and neighbour search.
+    pub broad_phase: BroadPhase,
+}
+
+impl Default for WorldConfig {
+    /// 800 x 800 arena, 8 outies, 250 pucks, radius 10, speed 2.
+    fn default() -> WorldConfig {
+        WorldConfig {
+            arena_size: 800.0,
+            robots: 8,
+            innies: 0,
+            pucks: 250,
+            robot_radius: 10.0,
+            puck_radius: 10.0,
+            forward_speed: 2.0,
+            broad_phase: BroadPhase::Grid,
+        }
+    }
+}
+
+impl WorldConfig {
+    /// Total number of bodies.
+    pub fn bodies(&self) -> usize {
+        self.robots + self.pucks
+    }
+
+    /// The larger of the two radii.
+    pub fn max_radius(&self) -> f64 {
+        self.robot_radius.max(self.puck_radius)
+    }
+}
+
+/// The contact model's constants.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PhysicsConfig {
+    /// Velocity lost per step as a fraction of velocity (acceleration = -k v).
+    pub deceleration: f64,
+    /// Speeds below this are set to zero: the body comes to rest.
+    pub stop_speed: f64,
+    /// Overlaps up to this depth are not contacts.
+    pub overlap_threshold: f64,
+    /// Half-thickness of the four wall segments on the arena border.
+    pub wall_radius: f64,
+}
+
+impl Default for PhysicsConfig {
+    /// The reference model: 0.4, 0.001, 0.1; walls of zero thickness.
+    fn default() -> PhysicsConfig {
+        PhysicsConfig { deceleration: 0.4, stop_speed: 0.001, overlap_threshold: 0.1, wall_radius: 0.0 }
+    }
+}
+
+/// The field thresholds of the target shape; the orbital construction
+/// controller uses the same value per robot kind.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Thresholds {
+    /// T_o: pucks below it are too far out; outies orbit at it.
+    pub outie: f64,
+    /// T_i: pucks above it are too far in; innies orbit at it.
+    pub innie: f64,
+}
+
+impl Default for Thresholds {
+    /// The annulus: 0.6 and 0.8.
+    fn default() -> Thresholds {
+        Thresholds { outie: 0.6, innie: 0.8 }
+    }
+}
+
+impl Thresholds {
+    /// The letter experiments' thresholds: both 1.0.
+    pub const LETTERS: Thresholds = Thresholds { outie: 1.0, innie: 1.0 };
+}
+
+/// Episodes: formation checks, the stuck limit, and Eval' weights.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EpisodeConfig {
+    /// A formation succeeds when Eval exceeds this at a check.
+    pub success_eval: f64,
+    /// Steps between formation checks.
+    pub check_interval: u64,
+    /// An episode without success after this many steps is stuck and reset.
+    pub stuck_limit: u64,
+    /// Eval' weight phi of Eval (phi + nu = 1).
+    pub phi: f64,
+    /// Eval' weight nu of the robot term.
+    pub nu: f64,
+}
+
+impl Default for EpisodeConfig {
+    /// 0.94 checked every 100 steps, stuck after 150,000 (annulus), phi 0.6, nu 0.4.
+    fn default() -> EpisodeConfig {
+        EpisodeConfig { success_eval: 0.94, check_interval: 100, stuck_limit: 150_000, phi: 0.6, nu: 0.4 }
+    }
+}
+
+/// Everything a simulation needs besides its scalar field.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimConfig {
+    /// Arena and bodies.
+    pub world: WorldConfig,
+    /// Contact model.
+    pub physics: PhysicsConfig,
+    /// Sensor geometry.
+    pub sensors: DiscSensorConfig,
+    /// Target-shape thresholds.
+    pub thresholds: Thresholds,
+    /// Episodes and evaluation.
+    pub episode: EpisodeConfig,
+}
+
+/// Densest packing of equal circles in the plane, pi / (2 sqrt 3).
+const PACKING_DENSITY: f64 = 0.9069;
+
+impl SimConfig {
+    /// Checks every setting; the error names the first bad one and its value.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let w = &self.world;
+        positive("world.arena_size", w.arena_size)?;
+        check("world.robots", w.robots as f64, w.robots > 0, "at least one robot is needed")?;
+        check("world.innies", w.innies as f64, w.innies <= w.robots, "cannot exceed world.robots")?;
+        positive("world.robot_radius", w.robot_radius)?;
+        positive("world.puck_radius", w.puck_radius)?;
+        check("world.forward_speed", w.forward_speed, w.forward_speed >= 0.0, "must not be negative")?;
+        check(
+            "world.puck_radius",
+            w.puck_radius,
+            8.0 * w.puck_radius < w.arena_size,
+            "pucks start in [4r, size - 4r), so 8 x radius must be less than world.arena_size",
+        )?;
+        check(
+            "world.robot_radius",
+            w.robot_radius,
+            2.0 * w.robot_radius < w.arena_size,
+            "a robot must fit in the arena",
+        )?;
+        let area = std::f64::consts::PI
+            * (w.robots as f64 * w.robot_radius * w.robot_radius + w.pucks as f64 * w.puck_radius * w.puck_radius);
+        let capacity = PACKING_DENSITY * w.arena_size * w.arena_size;
+        if area > capacity {
+            return Err(ConfigError::TooManyBodies { bodies: w.bodies(), area, capacity });
+        }
+
+        let p = &self.physics;
+        unit("physics.deceleration", p.deceleration)?;
+        check("physics.stop_speed", p.stop_speed, p.stop_speed >= 0.0, "must not be negative")?;
+        check("physics.overlap_threshold", p.overlap_threshold, p.overlap_threshold >= 0.0, "must not be negative")?;
+        check("physics.wall_radius", p.wall_radius, p.wall_radius >= 0.0, "must not be negative")?;
+
+        self.sensors.validate()?;
+
+        let t = &self.thresholds;
+        unit("thresholds.outie", t.outie)?;
+        unit("thresholds.innie", t.innie)?;
+        check("thresholds.innie", t.innie, t.innie >= t.outie, "must not be below thresholds.outie")?;
+
+        let e = &self.episode;
+        unit("episode.success_eval", e.success_eval)?;
+        check("episode.check_interval", e.check_interval as f64, e.check_interval > 0, "must be positive")?;
+        check("episode.stuck_limit", e.stuck_limit as f64, e.stuck_limit > 0, "must be positive")?;
+        unit("episode.phi", e.phi)?;
+        unit("episode.nu", e.nu)?;
+        check("episode.nu", e.nu, (e.phi + e.nu - 1.0).abs() < 1e-9, "episode.phi + episode.nu must be 1")?;
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid() {
+        assert_eq!(SimConfig::default().validate(), Ok(()));
+    }
+
+    #[test]
+    fn errors_name_the_offending_value() {
+        let mut c = SimConfig::default();
+        c.world.robot_radius = -2.0;
+        assert_eq!(c.validate().unwrap_err().to_string(), "world.robot_radius = -2: must be positive");
+
+        let mut c = SimConfig::default();
+        c.world.robots = 0;
+        assert!(c.validate().unwrap_err().to_string().starts_with("world.robots = 0"));
+
+        let mut c = SimConfig::default();
+        c.thresholds.outie = 1.5;
+        assert_eq!(c.validate().unwrap_err().to_string(), "thresholds.outie = 1.5: must be in [0, 1]");
+
+        let mut c = SimConfig::default();
+        c.world.pucks = 10_000;
+        assert!(matches!(c.validate(), Err(ConfigError::TooManyBodies { bodies: 10_008, .. })));
+
+        let mut c = SimConfig::default();
+        c.world.arena_size = f64::NAN;
+        assert!(c.validate().unwrap_err().to_string().starts_with("world.arena_size = NaN"));
+    }
+}

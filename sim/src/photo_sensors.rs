@@ -1,0 +1,290 @@
+//! The robot's three field sensors as the simulator models them:
+//! photo-transistors under the front of the robot, read by RC discharge
+//! timing exactly as the firmware reads them.
+//!
+//! Chain, per sensor (`docs/robot-sensors.md` gives the physics and how to
+//! measure the parameters):
+//! 1. the field value `v` at the sensor's point (nearest cell, as the disc
+//!    sensors read it);
+//! 2. the projector's light there, `L(v) = v^gamma` of full brightness;
+//! 3. the discharge time: a photo-transistor's current is proportional to
+//!    the light on it and the capacitor discharges at that current, so the
+//!    time is inversely proportional to the light plus a dark current:
+//!    `1/t = 1/t_dark + L(v) (1/t_bright - 1/t_dark)`, which is `t_bright`
+//!    at `v = 1` and `t_dark` at `v = 0` (brighter is faster);
+//! 4. whole Timer3 ticks, `floor((t + latency) / 4 us)`, capped at the
+//!    2000 us timeout: the firmware polls the pins against the free-running
+//!    timer and keeps the elapsed whole ticks; `latency` is its mean delay
+//!    between a pin going low and the timer read that sees it, net of the
+//!    time between the pins becoming inputs and the start read;
+//! 5. the firmware's own calibration arithmetic ([`shared::FieldScales`])
+//!    with the calibration a sweep over the field would store: each
+//!    sensor's ticks at field 1.0 (bright) and 0.0 (dark).
+//!
+//! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
+//! identical inputs identically.
+
+use crate::validate::{check, ConfigError};
+use crate::field::ScalarField;
+use crate::vec2::Vec2;
+use serde::{Deserialize, Serialize};
+use shared::calibration::{RC_TICK_US, RC_TIMEOUT_TICKS};
+use shared::{FieldCalibration, FieldScales, FieldValue, SensorRange};
+
+/// A point on the robot, in robot radii from its centre.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MountPoint {
+    /// Ahead of the centre (negative: behind).
+    pub forward: f64,
+    /// To the right of the centre (negative: left).
+    pub right: f64,
+}
+
+/// How one photo-transistor's discharge time depends on the light on it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhotoResponse {
+    /// Discharge time over field value 1.0 (full projector brightness), us.
+    pub bright_us: f64,
+    /// Discharge time over field value 0.0 (projector black: ambient light
+    /// and dark current only), us.
+    pub dark_us: f64,
+}
+
+impl PhotoResponse {
+    /// The discharge time in microseconds over a field value `v` in [0, 1]
+    /// with projector gamma `gamma`.
+    pub fn discharge_us(&self, v: f64, gamma: f64) -> f64 {
+        let light = v.clamp(0.0, 1.0).powf(gamma);
+        let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
+        1.0 / (slow + light * (fast - slow))
+    }
+}
+
+/// Geometry and response of the three field sensors (left, mid, right).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PhotoSensorConfig {
+    /// Where the left, mid and right sensors (DN1, DN3, DN5) sit.
+    pub mounts: [MountPoint; 3],
+    /// Each sensor's response.
+    pub response: [PhotoResponse; 3],
+    /// Projector gamma: light = value^gamma of full brightness.
+    pub gamma: f64,
+    /// The firmware's mean timing latency, us (see the module docs).
+    pub poll_latency_us: f64,
+}
+
+impl Default for PhotoSensorConfig {
+    /// Estimates for a Zumo 32U4's front array (to be measured, see
+    /// `docs/robot-sensors.md`): the sensors 0.7 robot radii (35 mm) ahead
+    /// of the centre, DN1 and DN5 0.75 radii (37 mm) to each side; discharge 150 to
+    /// 170 us under full brightness and 1700 to 1820 us in the dark (the
+    /// three sensors differ a little, as real ones do); gamma 2.2; the
+    /// firmware's latency as measured in simavr, 2.8 us
+    /// (`docs/robot-sensors.md`).
+    fn default() -> PhotoSensorConfig {
+        let mount = |right| MountPoint { forward: 0.7, right };
+        let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
+        PhotoSensorConfig {
+            mounts: [mount(-0.75), mount(0.0), mount(0.75)],
+            response: [response(150.0, 1700.0), response(160.0, 1760.0), response(170.0, 1820.0)],
+            gamma: 2.2,
+            poll_latency_us: 2.8,
+        }
+    }
+}
+
+/// `floor(us / tick)` capped at the timeout: the firmware's reading of a
+/// discharge that takes `us` microseconds.
+pub fn quantise_us(us: f64) -> u16 {
+    let ticks = (us / f64::from(RC_TICK_US)).floor();
+    if ticks >= f64::from(RC_TIMEOUT_TICKS) {
+        RC_TIMEOUT_TICKS
+    } else if ticks > 0.0 {
+        ticks as u16
+    } else {
+        0
+    }
+}
+
+const NAMES: [&str; 3] = ["left", "mid", "right"];
+
+impl PhotoSensorConfig {
+    /// Checks every position, time and the gamma; each sensor's bright and
+    /// dark times must differ by at least one tick, or no calibration exists.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        check("field.gamma", self.gamma, self.gamma > 0.0, "must be positive")?;
+        let latency = self.poll_latency_us;
+        check("field.poll_latency_us", latency, latency >= 0.0, "must not be negative")?;
+        for (i, name) in NAMES.iter().enumerate() {
+            let m = self.mounts[i];
+            check(&format!("field.mounts[{i}].forward ({name})"), m.forward, true, "must be a finite number")?;
+            check(&format!("field.mounts[{i}].right ({name})"), m.right, true, "must be a finite number")?;
+            let r = self.response[i];
+            check(
+                &format!("field.response[{i}].bright_us ({name})"),
+                r.bright_us,
+                r.bright_us > 0.0,
+                "must be positive",
+            )?;
+            check(
+                &format!("field.response[{i}].dark_us ({name})"),
+                r.dark_us,
+                quantise_us(r.dark_us + latency) > quantise_us(r.bright_us + latency),
+                "must be at least one 4 us tick longer than bright_us",
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The calibration a sweep over a field showing both 1.0 and 0.0 stores:
+    /// per sensor, the firmware's readings of its bright and dark times.
+    pub fn calibration(&self) -> FieldCalibration {
+        let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
+        FieldCalibration {
+            ranges: self.response.map(|r| SensorRange { bright: ticks(r.bright_us), dark: ticks(r.dark_us) }),
+        }
+    }
+}
+
+/// What the three field sensors measure in one control period.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PhotoReading {
+    /// Discharge times, us (the pins' behaviour, before the firmware's
+    /// latency and quantisation).
+    pub discharge_us: [f64; 3],
+    /// The firmware's raw readings: whole Timer3 ticks, capped at the timeout.
+    pub ticks: [u16; 3],
+}
+
+/// The three sensors of a robot of a given radius, ready to read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotoSensors {
+    /// Left, mid, right points in the robot's frame (x forward, y right), units.
+    points: [Vec2; 3],
+    response: [PhotoResponse; 3],
+    gamma: f64,
+    latency_us: f64,
+    calibration: FieldCalibration,
+    scales: FieldScales,
+}
+
+impl PhotoSensors {
+    /// The sensors of `config` on a robot of `robot_radius` units.
+    pub fn new(config: &PhotoSensorConfig, robot_radius: f64) -> PhotoSensors {
+        let calibration = config.calibration();
+        PhotoSensors {
+            points: config.mounts.map(|m| Vec2::new(m.forward * robot_radius, m.right * robot_radius)),
+            response: config.response,
+            gamma: config.gamma,
+            latency_us: config.poll_latency_us,
+            calibration,
+            scales: calibration.scales(),
+        }
+    }
+
+    /// The calibration the robot stores (and the firmware applies).
+    pub fn calibration(&self) -> FieldCalibration {
+        self.calibration
+    }
+
+    /// Calibrated values of raw readings, with the firmware's arithmetic.
+    pub fn values(&self, ticks: &[u16; 3]) -> [FieldValue; 3] {
+        self.scales.values(ticks)
+    }
+
+    /// The sensor points in the robot's frame (x forward, y right), units.
+    pub fn points(&self) -> &[Vec2; 3] {
+        &self.points
+    }
+
+    /// The reading of a robot at `pos` facing `direction` (unit vector).
+    pub fn read(&self, pos: Vec2, direction: Vec2, field: &ScalarField, arena_size: f64) -> PhotoReading {
+        let mut r = PhotoReading::default();
+        for i in 0..3 {
+            let v = field.sense(pos + self.points[i].rotated(direction), arena_size);
+            r.discharge_us[i] = self.response[i].discharge_us(f64::from(v.to_f32()), self.gamma);
+            r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
+        }
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn brighter_discharges_faster_between_the_calibrated_ends() {
+        let c = PhotoSensorConfig::default();
+        let r = c.response[1];
+        assert!((r.discharge_us(1.0, c.gamma) - 160.0).abs() < 1e-9);
+        assert!((r.discharge_us(0.0, c.gamma) - 1760.0).abs() < 1e-9);
+        let mut last = f64::INFINITY;
+        for k in 0..=100 {
+            let t = r.discharge_us(f64::from(k) / 100.0, c.gamma);
+            assert!(t < last, "not faster at {k}%");
+            last = t;
+        }
+        // Inverse in the light: half the light of full brightness (above the
+        // dark current) is less than twice the bright time.
+        let half_light = 0.5f64.powf(1.0 / c.gamma);
+        assert!(r.discharge_us(half_light, c.gamma) < 2.0 * 160.0 + 1.0);
+    }
+
+    #[test]
+    fn quantisation_floors_to_ticks_and_caps_at_the_timeout() {
+        assert_eq!(quantise_us(0.0), 0);
+        assert_eq!(quantise_us(3.99), 0);
+        assert_eq!(quantise_us(4.0), 1);
+        assert_eq!(quantise_us(1759.9), 439);
+        assert_eq!(quantise_us(1999.0), 499);
+        assert_eq!(quantise_us(2000.0), RC_TIMEOUT_TICKS);
+        assert_eq!(quantise_us(1e9), RC_TIMEOUT_TICKS);
+        assert_eq!(quantise_us(-5.0), 0);
+    }
+
+    #[test]
+    fn full_and_no_light_read_one_and_zero_through_the_calibration() {
+        let config = PhotoSensorConfig::default();
+        let cal = config.calibration();
+        // (150 + 2.8) / 4 and (1700 + 2.8) / 4, floored.
+        assert_eq!(cal.ranges[0], SensorRange { bright: 38, dark: 425 });
+        let sensors = PhotoSensors::new(&config, 10.0);
+        let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
+        let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
+        // One cell over the whole arena: every point inside reads it.
+        let at = Vec2::new(20.0, 20.0);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, 100.0);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ONE; 3]);
+        assert_eq!(r.ticks, cal.ranges.map(|c| c.bright));
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, 100.0);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
+        assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
+    }
+
+    #[test]
+    fn sensors_sit_where_configured_and_turn_with_the_robot() {
+        // A field bright in its left column only (2 x 1 cells over 100 units).
+        let field = ScalarField::new(2, 1, vec![1.0, 0.0]).unwrap();
+        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 10.0);
+        // Facing down the screen (+y): the robot's right is -x, so its right
+        // sensor is over the bright column at x < 25 (cell 0 by rounding).
+        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, 100.0);
+        let values = sensors.values(&r.ticks);
+        assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
+    }
+
+    #[test]
+    fn bad_settings_are_named() {
+        let mut c = PhotoSensorConfig::default();
+        c.response[2].dark_us = c.response[2].bright_us + 1.0;
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.contains("field.response[2].dark_us (right)"), "{e}");
+        let c = PhotoSensorConfig { gamma: 0.0, ..PhotoSensorConfig::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("field.gamma"));
+        assert!(PhotoSensorConfig::default().validate().is_ok());
+    }
+}

@@ -1,0 +1,197 @@
+//! A built simulation and its controller from a few choices (field,
+//! controller, sensor model, counts, seed), with the per-field defaults of
+//! the thesis' experiments.
+
+use crate::broadphase::BroadPhase;
+use crate::config::{SimConfig, Thresholds};
+use crate::control::Controller;
+use crate::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
+use crate::field_source::{FieldError, FieldSource};
+use crate::policy_file::{self, PolicyFileError};
+use crate::sensor_setup::{SelectedSensors, SensorSetup};
+use crate::simulation::Simulation;
+use crate::validate::ConfigError;
+use shared::ActionTable;
+use std::fmt;
+use std::path::PathBuf;
+use std::str::FromStr;
+use std::sync::Arc;
+
+/// Which controller drives the robots.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ControllerChoice {
+    /// Orbital construction (`oc`).
+    Orbital,
+    /// Uniformly random actions (`random`).
+    Random,
+    /// A greedy policy blob (`policy:FILE`).
+    Policy(PathBuf),
+}
+
+impl FromStr for ControllerChoice {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<ControllerChoice, String> {
+        match s {
+            "oc" => Ok(ControllerChoice::Orbital),
+            "random" => Ok(ControllerChoice::Random),
+            _ => match s.strip_prefix("policy:") {
+                Some(path) if !path.is_empty() => Ok(ControllerChoice::Policy(PathBuf::from(path))),
+                _ => Err(format!("unknown controller {s:?}: expected oc, random or policy:FILE")),
+            },
+        }
+    }
+}
+
+impl fmt::Display for ControllerChoice {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ControllerChoice::Orbital => f.write_str("oc"),
+            ControllerChoice::Random => f.write_str("random"),
+            ControllerChoice::Policy(p) => write!(f, "policy:{}", p.display()),
+        }
+    }
+}
+
+/// What to simulate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// The field.
+    pub field: FieldSource,
+    /// The controller.
+    pub controller: ControllerChoice,
+    /// Number of robots.
+    pub robots: usize,
+    /// Number of pucks.
+    pub pucks: usize,
+    /// Seed of every generator.
+    pub seed: u64,
+    /// Contact search.
+    pub broad_phase: BroadPhase,
+    /// Arena side; `None` for the default 800.
+    pub arena_size: Option<f64>,
+    /// The robots' sensor model.
+    pub sensors: SensorSetup,
+}
+
+impl Default for Scenario {
+    /// The thesis' standard run: annulus, orbital construction, 8 robots,
+    /// 250 pucks, seed 1.
+    fn default() -> Scenario {
+        Scenario {
+            field: FieldSource::Annulus,
+            controller: ControllerChoice::Orbital,
+            robots: 8,
+            pucks: 250,
+            seed: 1,
+            broad_phase: BroadPhase::Grid,
+            arena_size: None,
+            sensors: SensorSetup::Disc,
+        }
+    }
+}
+
+/// The settings of a field's experiments: the reference defaults with the
+/// given counts; the annulus thresholds and 150,000-step stuck limit on the
+/// annulus, thresholds 1.0 and a 50,000-step limit on letters and images.
+/// Every robot is an outie.
+pub fn field_config(field: &FieldSource, robots: usize, pucks: usize) -> SimConfig {
+    let mut c = SimConfig::default();
+    c.world.robots = robots;
+    c.world.pucks = pucks;
+    if !field.has_cavity() {
+        c.thresholds = Thresholds::LETTERS;
+        c.episode.stuck_limit = 50_000;
+    }
+    c
+}
+
+/// The number of innies orbital construction uses: half the robots on a
+/// field with a cavity (the annulus), none otherwise (thesis Tables 1, 4).
+pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
+    if field.has_cavity() {
+        robots / 2
+    } else {
+        0
+    }
+}
+
+impl Scenario {
+    /// The settings: [`field_config`] with this scenario's counts, contact
+    /// search and arena, and [`orbital_innies`] for orbital construction.
+    pub fn config(&self) -> SimConfig {
+        let mut c = field_config(&self.field, self.robots, self.pucks);
+        c.world.broad_phase = self.broad_phase;
+        if let Some(size) = self.arena_size {
+            c.world.arena_size = size;
+        }
+        if self.controller == ControllerChoice::Orbital {
+            c.world.innies = orbital_innies(&self.field, self.robots);
+        }
+        c
+    }
+
+    /// Loads the field and policy, validates the settings and builds the
+    /// simulation and controller. Errors name the offending input.
+    pub fn build(&self) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
+        let mut config = self.config();
+        let controller: Box<dyn Controller> = match &self.controller {
+            ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds)),
+            ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
+            ControllerChoice::Policy(path) => {
+                let blob = policy_file::read(path)?;
+                config.world.forward_speed = f64::from(blob.actions().forward_speed());
+                Box::new(GreedyPolicy::new(blob))
+            }
+        };
+        config.validate()?;
+        if let SensorSetup::Robot(robot) = &self.sensors {
+            robot.validate()?;
+        }
+        let field = Arc::new(self.field.load()?);
+        let sensors = self.sensors.build(&config);
+        let sim = Simulation::with_sensors(config, field, sensors, self.seed)?;
+        Ok((sim, controller))
+    }
+}
+
+/// Why a [`Scenario`] cannot be built.
+#[derive(Debug)]
+pub enum ScenarioError {
+    /// A setting is out of range.
+    Config(ConfigError),
+    /// The field cannot be loaded.
+    Field(FieldError),
+    /// The policy file cannot be used.
+    Policy(PolicyFileError),
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ScenarioError::Config(e) => write!(f, "invalid simulation settings: {e}"),
+            ScenarioError::Field(e) => e.fmt(f),
+            ScenarioError::Policy(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for ScenarioError {}
+
+impl From<ConfigError> for ScenarioError {
+    fn from(e: ConfigError) -> ScenarioError {
+        ScenarioError::Config(e)
+    }
+}
+
+impl From<FieldError> for ScenarioError {
+    fn from(e: FieldError) -> ScenarioError {
+        ScenarioError::Field(e)
+    }
+}
+
+impl From<PolicyFileError> for ScenarioError {
+    fn from(e: PolicyFileError) -> ScenarioError {
+        ScenarioError::Policy(e)
+    }
+}

@@ -1,0 +1,43 @@
+//! The interface between the world and the controllers: a sensor model
+//! turns the world into one [`SensorReading`] per robot, and can show what
+//! it senses for drawing.
+
+use crate::field::ScalarField;
+use crate::vec2::Vec2;
+use crate::world::World;
+use shared::SensorReading;
+
+/// Produces every robot's reading from the world and field.
+///
+/// A model may keep state between steps (`&mut self`), for example sensor
+/// noise drawn from its own seeded generator.
+pub trait SensorModel {
+    /// Fills `out[i]` with robot `i`'s reading; `out` has one entry per robot.
+    fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]);
+
+    /// Appends the areas robot `robot` senses, for drawing. The default
+    /// draws nothing.
+    fn footprints(&self, _world: &World, _robot: usize, _out: &mut Vec<Footprint>) {}
+}
+
+/// What a drawn sensor area detects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FootprintKind {
+    /// A field sample point.
+    Field,
+    /// A puck-sensor disc.
+    Puck,
+    /// An obstacle-sensor disc.
+    Obstacle,
+}
+
+/// A sensed area in arena coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    /// Centre.
+    pub centre: Vec2,
+    /// Radius (0 for field sample points).
+    pub radius: f64,
+    /// What it detects.
+    pub kind: FootprintKind,
+}

@@ -1,0 +1,106 @@
+//! Which sensor model the simulated robots have, and the model it builds:
+//!
+//! - `disc`: the disc sensors of the reference model (obstacle discs as in
+//!   the original code: radius r/4, any body);
+//! - `disc-thesis`: the same with the obstacle discs the thesis describes
+//!   (section 5.2: the size of a puck sensor, robots only);
+//! - `robot`: the Zumo's real senses ([`RobotSensors`]: photo-transistors
+//!   through the firmware's RC timing and calibration, the Pixy camera
+//!   through the firmware's blob classification), with a
+//!   [`RobotSensorConfig`].
+
+use crate::config::SimConfig;
+use crate::disc_sensor_config::DiscSensorConfig;
+use crate::disc_sensors::DiscSensors;
+use crate::field::ScalarField;
+use crate::robot_sensors::{RobotSensorConfig, RobotSensors};
+use crate::sensor_model::{Footprint, SensorModel};
+use crate::world::World;
+use shared::SensorReading;
+
+/// A sensor model and its settings.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum SensorSetup {
+    /// The thesis' disc sensors of `SimConfig::sensors`.
+    #[default]
+    Disc,
+    /// The disc sensors with the thesis' obstacle discs
+    /// ([`DiscSensorConfig::thesis_obstacles`]).
+    DiscThesis,
+    /// The robot sensor model with these settings.
+    Robot(Box<RobotSensorConfig>),
+}
+
+impl SensorSetup {
+    /// The models' names, as messages list them.
+    pub const NAMES: &'static str = "disc, disc-thesis, robot";
+
+    /// The model of a name (`robot` with default settings), or `None`.
+    pub fn from_name(name: &str) -> Option<SensorSetup> {
+        match name {
+            "disc" => Some(SensorSetup::Disc),
+            "disc-thesis" => Some(SensorSetup::DiscThesis),
+            "robot" => Some(SensorSetup::Robot(Box::default())),
+            _ => None,
+        }
+    }
+
+    /// The sensor model for the robots of `config` (validate a robot
+    /// config first: [`RobotSensorConfig::validate`]).
+    pub fn build(&self, config: &SimConfig) -> SelectedSensors {
+        let radius = config.world.robot_radius;
+        match self {
+            SensorSetup::Disc => SelectedSensors::Disc(DiscSensors::new(&config.sensors, radius)),
+            SensorSetup::DiscThesis => {
+                let thesis = DiscSensorConfig::thesis_obstacles();
+                let discs = DiscSensorConfig {
+                    obstacle: thesis.obstacle,
+                    obstacle_targets: thesis.obstacle_targets,
+                    ..config.sensors.clone()
+                };
+                SelectedSensors::Disc(DiscSensors::new(&discs, radius))
+            }
+            SensorSetup::Robot(robot) => SelectedSensors::Robot(Box::new(RobotSensors::new(robot, radius))),
+        }
+    }
+}
+
+/// The model a [`SensorSetup`] built.
+#[derive(Clone, Debug)]
+pub enum SelectedSensors {
+    /// The thesis' discs.
+    Disc(DiscSensors),
+    /// The robot's photo-transistors and camera.
+    Robot(Box<RobotSensors>),
+}
+
+impl SensorModel for SelectedSensors {
+    fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
+        match self {
+            SelectedSensors::Disc(s) => s.sense(world, field, out),
+            SelectedSensors::Robot(s) => s.sense(world, field, out),
+        }
+    }
+
+    fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
+        match self {
+            SelectedSensors::Disc(s) => s.footprints(world, robot, out),
+            SelectedSensors::Robot(s) => s.footprints(world, robot, out),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_give_their_models_and_unknown_names_none() {
+        assert_eq!(SensorSetup::from_name("disc"), Some(SensorSetup::Disc));
+        assert_eq!(SensorSetup::from_name("disc-thesis"), Some(SensorSetup::DiscThesis));
+        assert_eq!(SensorSetup::from_name("robot"), Some(SensorSetup::Robot(Box::default())));
+        assert_eq!(SensorSetup::from_name("pixy"), None);
+        let config = SimConfig::default();
+        assert!(matches!(SensorSetup::Robot(Box::default()).build(&config), SelectedSensors::Robot(_)));
+    }
+}
