@@ -22,7 +22,7 @@ use firmware::embedded;
 use firmware::pins;
 use firmware::rc::Discharge;
 use firmware::supervisor::{Buttons, Leds};
-use shared::DriveOutputs;
+use shared::{DriveOutputs, FieldScales};
 
 /// The policy table, in flash (read with `lpm`, never copied to SRAM).
 #[link_section = ".progmem.data"]
@@ -76,10 +76,16 @@ pub struct Board {
     period_start: u16,
 }
 
+/// The field sensors' calibration curves: 246 bytes, kept in static RAM
+/// rather than on the stack, which must stay above the bootloader key at
+/// 0x0800 (`tests/tests/firmware_smoke.rs` checks).
+static mut FIELD_SCALES: FieldScales = FieldScales::UNSET;
+
 impl Board {
     /// First thing at start-up: stop the watchdog a reset may have left
     /// running (with the shortest timeout) and clear the bootloader key.
-    pub fn take() -> Board {
+    /// Returns the board and the calibration curves' storage.
+    pub fn take() -> (Board, &'static mut FieldScales) {
         // SAFETY: called once, before anything else touches the peripherals.
         let dp = unsafe { Peripherals::steal() };
         avr_device::asm::wdr();
@@ -95,7 +101,9 @@ impl Board {
             );
             core::ptr::write_volatile(BOOT_KEY, 0);
         }
-        Board { dp, period_start: 0 }
+        // SAFETY: `take` runs once, so this is the only reference ever made.
+        let scales = unsafe { &mut *core::ptr::addr_of_mut!(FIELD_SCALES) };
+        (Board { dp, period_start: 0 }, scales)
     }
 
     /// Sets up pins, timers, TWI and the USART.

@@ -8,7 +8,7 @@
 //! its table.
 
 use shared::{
-    ActionId, ActionMotors, BlobSummary, CameraConfig, DriveOutputs, FieldCalibration, FieldScales, FieldValue,
+    ActionId, ActionMotors, BlobSummary, CameraConfig, DriveOutputs, FieldScales, FieldValue,
     MotorCommand, PixyBlock, PolicyTable, SensorReading, State, StateHasher,
 };
 
@@ -41,11 +41,12 @@ pub struct Decision {
     pub outputs: DriveOutputs,
 }
 
-/// The decision's fixed inputs: calibration, camera classification, hasher,
-/// policy table and per-action motor outputs.
+/// The decision's fixed inputs: calibration curves, camera classification,
+/// hasher, policy table and per-action motor outputs. It borrows the curves
+/// (three of them take 246 bytes, which the robot keeps in one place).
 #[derive(Clone, Copy, Debug)]
 pub struct Decider<'a, P: PolicyBytes + ?Sized> {
-    scales: FieldScales,
+    scales: &'a FieldScales,
     camera: CameraConfig,
     hasher: StateHasher,
     policy: &'a P,
@@ -53,20 +54,17 @@ pub struct Decider<'a, P: PolicyBytes + ?Sized> {
 }
 
 impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
-    /// A decider. `policy` holds `hasher.num_states() / 4` packed bytes.
+    /// A decider with the curves of the robot's calibration
+    /// (`FieldCalibration::scales`, or `FieldScales::calibrate` in place).
+    /// `policy` holds `hasher.num_states() / 4` packed bytes.
     pub fn new(
-        calibration: &FieldCalibration,
+        scales: &'a FieldScales,
         camera: CameraConfig,
         hasher: StateHasher,
         policy: &'a P,
         motors: ActionMotors,
     ) -> Self {
-        Decider { scales: calibration.scales(), camera, hasher, policy, motors }
-    }
-
-    /// Replaces the calibration (after a sweep).
-    pub fn set_calibration(&mut self, calibration: &FieldCalibration) {
-        self.scales = calibration.scales();
+        Decider { scales, camera, hasher, policy, motors }
     }
 
     /// Decides for one period's raw times and blocks.
@@ -87,7 +85,7 @@ mod tests {
     use super::*;
     use crate::config::{CAMERA, UNCALIBRATED};
     use crate::embedded;
-    use shared::{PolicyBlob, RobotProfile, SensorRange};
+    use shared::{FieldCalibration, PolicyBlob, RobotProfile, SensorRange};
 
     fn motors_of(blob: &PolicyBlob) -> ActionMotors {
         RobotProfile::ZUMO.action_motors(blob.actions())
@@ -99,16 +97,26 @@ mod tests {
         assert_eq!(blob.hasher(), embedded::HASHER);
         assert_eq!(blob.table().packed(), &embedded::POLICY[..]);
         assert_eq!(motors_of(&blob), embedded::MOTORS);
-        let cal = FieldCalibration { ranges: [SensorRange { bright: 0, dark: 32768 }; 3] };
-        let d = Decider::new(&cal, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        let cal = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+        let scales = cal.scales();
+        let d = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
         // Walk states through readings: every (left < mid, right < mid, mid bin, pucks) combination.
         let k = embedded::HASHER.mid_bits();
+        let curve = scales.0[1];
         for bin in 0..(1u16 << k) {
+            // A time whose value lies in the bin: the one closest to its middle.
+            let middle = (f32::from(bin) + 0.5) / f32::from(1u16 << k);
+            let in_bin = (40..=440u16).filter(|&t| curve.value(t).bin(k) == bin);
+            let mid_time = in_bin
+                .min_by(|&a, &b| {
+                    let off = |t: u16| (curve.value(t).to_f32() - middle).abs();
+                    off(a).total_cmp(&off(b))
+                })
+                .unwrap_or_else(|| panic!("no whole-tick time reads bin {bin}"));
             for bits in 0..16u8 {
-                // mid value = (bin + 1/2) / 2^k: the middle of the bin
-                let mid_time = 32768 - (bin << (15 - k)) - (1 << (14 - k));
-                let left_time = if bits & 4 != 0 { mid_time + 100 } else { mid_time };
-                let right_time = if bits & 8 != 0 { mid_time + 100 } else { mid_time };
+                // A longer time is darker: reads less than mid.
+                let left_time = if bits & 4 != 0 { mid_time + 1 } else { mid_time };
+                let right_time = if bits & 8 != 0 { mid_time + 1 } else { mid_time };
                 let mut blocks = std::vec::Vec::new();
                 if bits & 1 != 0 {
                     blocks.push(PixyBlock { signature: 1, x: 10, y: 150, width: 5, height: 5, angle: 0 });
@@ -128,12 +136,14 @@ mod tests {
 
     #[test]
     fn uncalibrated_timeouts_are_dark_and_never_panic() {
-        let d = Decider::new(&UNCALIBRATED, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        let scales = UNCALIBRATED.scales();
+        let d = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
         let dec = d.decide(&[u16::MAX; 3], &[]);
         assert_eq!(dec.values, [FieldValue::ZERO; 3]);
         assert_eq!(dec.state, State(0));
         // A short policy slice reads zeros instead of panicking.
-        let d = Decider::new(&UNCALIBRATED, CAMERA, StateHasher::OriginalObstacle, &[0u8; 3][..], embedded::MOTORS);
+        let scales = UNCALIBRATED.scales();
+        let d = Decider::new(&scales, CAMERA, StateHasher::OriginalObstacle, &[0u8; 3][..], embedded::MOTORS);
         assert_eq!(d.decide(&[0; 3], &[]).action, ActionId(0));
     }
 }

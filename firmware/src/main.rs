@@ -22,7 +22,7 @@ fn main() -> ! {
     use firmware::supervisor::Supervisor;
     use shared::{LogFrame, RobotProfile};
 
-    let mut board = board::Board::take();
+    let (mut board, scales) = board::Board::take();
     board.init();
 
     let mut record = [0u8; RECORD_LEN];
@@ -30,7 +30,8 @@ fn main() -> ! {
     let stored = calibration_record::decode(&record).ok();
     let mut calibration = stored.unwrap_or(UNCALIBRATED);
     let policy = board::FlashPolicy;
-    let mut decider = Decider::new(&calibration, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
+    // The curves stay in place (static RAM): each period's decider borrows them.
+    scales.calibrate(&calibration);
     let mut supervisor = Supervisor::new(stored.is_some());
     let mut camera = Camera::new();
     let spin = RobotProfile::ZUMO.outputs(CALIBRATION_SPIN);
@@ -48,6 +49,7 @@ fn main() -> ! {
         let camera_ok = camera.acquire(&mut board).is_ok();
         let plan = supervisor.period(buttons, &times, camera_ok);
 
+        let decider = Decider::new(scales, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
         let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors, &spin);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
@@ -59,7 +61,7 @@ fn main() -> ! {
 
         if let Some(new) = plan.save {
             board.eeprom_write(CALIBRATION_EEPROM_ADDR, &calibration_record::encode(&new));
-            decider.set_calibration(&new);
+            scales.calibrate(&new);
             calibration = new;
             since_calibration = LogFrame::CALIBRATION_EVERY - 1;
         }

@@ -4,7 +4,7 @@
 //! controller, physics, and Eval at the default check interval.
 
 use crate::run_summary::run_timed;
-use sim::scenario::Scenario;
+use sim::scenario::{Arena, Scenario};
 use sim::BroadPhase;
 use anyhow::Result;
 
@@ -26,10 +26,10 @@ impl BenchVariant {
             ..Scenario::default()
         };
         if self.scale {
-            s.robots = 64;
-            s.pucks = 1000;
+            s.robots = Some(64);
+            s.pucks = Some(1000);
             let standard = (8 + 250) as f64;
-            s.arena_size = Some((800.0 * (1064.0 / standard).sqrt()).round());
+            s.arena = Arena::Square((800.0 * (1064.0 / standard).sqrt()).round());
         }
         s
     }

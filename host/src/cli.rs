@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+use host::arena_choice::ArenaChoice;
 use host::experiment::RunOptions;
 use host::learn::StateHasherName;
 use host::sensor_choice::SensorChoice;
@@ -171,15 +172,20 @@ pub struct ScenarioArgs {
     /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, default_value = "annulus", value_parser = parse_field)]
     pub field: FieldSource,
-    /// Number of robots.
-    #[arg(long, default_value_t = 8)]
-    pub robots: usize,
-    /// Number of pucks.
-    #[arg(long, default_value_t = 250)]
-    pub pucks: usize,
+    /// Number of robots [default: the arena's: 8 in the thesis' arena, 5 on tv75].
+    #[arg(long)]
+    pub robots: Option<usize>,
+    /// Number of pucks [default: the arena's: 250 in the thesis' arena, 12 on tv75].
+    #[arg(long)]
+    pub pucks: Option<usize>,
     /// Seed of every random choice.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// thesis (the reference model's 800 x 800 square), tv75 (the thesis'
+    /// 75" TV lying flat) or a FILE.toml of a screen arena
+    /// (docs/robot-sensors.md) [default: tv75 with --sensors robot, else thesis].
+    #[arg(long)]
+    pub arena: Option<ArenaChoice>,
     /// All-pairs contact checks instead of the spatial grid (same results).
     #[arg(long)]
     pub naive: bool,
@@ -193,8 +199,9 @@ pub struct ScenarioArgs {
 }
 
 impl ScenarioArgs {
-    /// The scenario, with a robot sensor config file read and checked.
+    /// The scenario, with robot sensor and arena files read and checked.
     pub fn scenario(self) -> Result<Scenario> {
+        let arena = self.arena.unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()));
         Ok(Scenario {
             field: self.field,
             controller: self.controller,
@@ -202,7 +209,7 @@ impl ScenarioArgs {
             pucks: self.pucks,
             seed: self.seed,
             broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
-            arena_size: None,
+            arena: arena.arena()?,
             sensors: self.sensors.setup()?,
         })
     }

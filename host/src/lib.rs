@@ -3,6 +3,7 @@
 //! the tools around policy blobs.
 #![warn(missing_docs)]
 
+pub mod arena_choice;
 pub mod atomic;
 pub mod bench;
 pub mod experiment;

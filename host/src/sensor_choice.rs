@@ -88,6 +88,11 @@ impl SensorChoice {
         })
     }
 
+    /// Whether this is the robot sensor model.
+    pub fn is_robot(&self) -> bool {
+        matches!(self, SensorChoice::Robot(_))
+    }
+
     /// The sensor model for the robots of `config`.
     pub fn build(&self, config: &SimConfig) -> Result<SelectedSensors> {
         Ok(self.setup()?.build(config))

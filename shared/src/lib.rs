@@ -11,8 +11,8 @@
 //! - [`PolicyTable`]: the greedy policy, 2 bits per state;
 //! - [`PolicyBlob`]: the versioned, checksummed file that carries a policy
 //!   from the trainer to the firmware;
-//! - [`FieldCalibration`]: RC discharge times -> calibrated field values,
-//!   as the robot's photo-transistors are read;
+//! - [`FieldCalibration`]: RC discharge times -> the field values the
+//!   screen showed, as the robot's photo-transistors are read;
 //! - [`CameraConfig`]: Pixy camera blocks -> puck and obstacle bits;
 //! - [`RobotProfile`]: an action's unicycle speeds -> motor commands;
 //! - [`LogFrame`]: what the robot reports each control period.
@@ -36,7 +36,7 @@ pub mod reading;
 
 pub use action::{ActionId, ActionTable, ActionTableError};
 pub use blob::{BlobError, PolicyBlob, Provenance};
-pub use calibration::{FieldCalibration, FieldScales, SensorRange, SensorScale};
+pub use calibration::{FieldCalibration, FieldScales, SensorCurve, SensorRange, SensorScale};
 pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
 pub use drive::{ActionMotors, DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;

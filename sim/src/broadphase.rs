@@ -52,12 +52,12 @@ impl Candidates {
 }
 
 impl NeighbourIndex {
-    /// An index of the given kind over `bodies` in a `size` x `size`
-    /// arena; grid cells are at least `cell` units wide.
-    pub fn new(kind: BroadPhase, size: f64, cell: f64, bodies: &[Body]) -> NeighbourIndex {
+    /// An index of the given kind over `bodies` in an arena of `size`
+    /// (width, height); grid cells are at least `cell` units wide.
+    pub fn new(kind: BroadPhase, size: Vec2, cell: f64, bodies: &[Body]) -> NeighbourIndex {
         let cell = match kind {
             BroadPhase::Grid => cell,
-            BroadPhase::Naive => size,
+            BroadPhase::Naive => size.x.max(size.y),
         };
         NeighbourIndex { grid: SpatialGrid::new(size, cell, bodies.iter().map(|b| (b.pos, b.radius))) }
     }

@@ -7,15 +7,24 @@
 
 use crate::broadphase::BroadPhase;
 use crate::disc_sensor_config::DiscSensorConfig;
+use crate::field::{FieldFrame, FieldLayout, FieldSampling};
+use crate::vec2::Vec2;
 use crate::validate::{check, positive, unit, ConfigError};
 use serde::{Deserialize, Serialize};
 
-/// The arena and what is in it.
+/// The arena and what is in it. Lengths are in units: a tenth of the
+/// robot's radius in every built-in arena (so the thesis' constants keep
+/// their meaning relative to the robot).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct WorldConfig {
-    /// Side of the square arena, units.
-    pub arena_size: f64,
+    /// Width of the rectangular arena (x from 0), units.
+    pub arena_width: f64,
+    /// Height of the arena (y from 0, downwards on screen), units.
+    pub arena_height: f64,
+    /// Millimetres per unit on the floor (for the robot's physical parts
+    /// and the display; the physics does not use it).
+    pub unit_mm: f64,
     /// Number of robots (bodies `0 .. robots`).
     pub robots: usize,
     /// How many of the robots are innies (the first ones); the rest are outies.
@@ -26,24 +35,38 @@ pub struct WorldConfig {
     pub robot_radius: f64,
     /// Puck radius, units.
     pub puck_radius: f64,
+    /// Puck mass; `None` for the reference model's 10 x radius (the same
+    /// rule as robots').
+    pub puck_mass: Option<f64>,
     /// Robots' constant forward speed, units per step.
     pub forward_speed: f64,
     /// Contact and neighbour search.
     pub broad_phase: BroadPhase,
+    /// Where the field's grid lies in the arena; `None` for the whole arena.
+    pub field_frame: Option<FieldFrame>,
+    /// How positions read the field.
+    pub field_sampling: FieldSampling,
 }
 
 impl Default for WorldConfig {
-    /// 800 x 800 arena, 8 outies, 250 pucks, radius 10, speed 2.
+    /// The reference model's: an 800 x 800 arena (robots of 50 mm radius,
+    /// so 5 mm per unit), 8 outies, 250 pucks, radius 10, speed 2, the
+    /// field stretched over the arena and read at the nearest cell.
     fn default() -> WorldConfig {
         WorldConfig {
-            arena_size: 800.0,
+            arena_width: 800.0,
+            arena_height: 800.0,
+            unit_mm: 5.0,
             robots: 8,
             innies: 0,
             pucks: 250,
             robot_radius: 10.0,
             puck_radius: 10.0,
+            puck_mass: None,
             forward_speed: 2.0,
             broad_phase: BroadPhase::Grid,
+            field_frame: None,
+            field_sampling: FieldSampling::Nearest,
         }
     }
 }
@@ -57,6 +80,17 @@ impl WorldConfig {
     /// The larger of the two radii.
     pub fn max_radius(&self) -> f64 {
         self.robot_radius.max(self.puck_radius)
+    }
+
+    /// The arena's width and height.
+    pub fn arena(&self) -> Vec2 {
+        Vec2::new(self.arena_width, self.arena_height)
+    }
+
+    /// Where the field lies and how it is read.
+    pub fn field_layout(&self) -> FieldLayout {
+        let frame = self.field_frame.unwrap_or(FieldFrame::whole(self.arena_width, self.arena_height));
+        FieldLayout { frame, sampling: self.field_sampling }
     }
 }
 
@@ -150,27 +184,39 @@ impl SimConfig {
     /// Checks every setting; the error names the first bad one and its value.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let w = &self.world;
-        positive("world.arena_size", w.arena_size)?;
+        positive("world.arena_width", w.arena_width)?;
+        positive("world.arena_height", w.arena_height)?;
+        positive("world.unit_mm", w.unit_mm)?;
         check("world.robots", w.robots as f64, w.robots > 0, "at least one robot is needed")?;
         check("world.innies", w.innies as f64, w.innies <= w.robots, "cannot exceed world.robots")?;
         positive("world.robot_radius", w.robot_radius)?;
         positive("world.puck_radius", w.puck_radius)?;
+        if let Some(mass) = w.puck_mass {
+            positive("world.puck_mass", mass)?;
+        }
         check("world.forward_speed", w.forward_speed, w.forward_speed >= 0.0, "must not be negative")?;
+        let short_side = w.arena_width.min(w.arena_height);
         check(
             "world.puck_radius",
             w.puck_radius,
-            8.0 * w.puck_radius < w.arena_size,
-            "pucks start in [4r, size - 4r), so 8 x radius must be less than world.arena_size",
+            8.0 * w.puck_radius < short_side,
+            "pucks start at least 4 radii from the walls, so 8 x radius must be less than the arena's shorter side",
         )?;
         check(
             "world.robot_radius",
             w.robot_radius,
-            2.0 * w.robot_radius < w.arena_size,
+            2.0 * w.robot_radius < short_side,
             "a robot must fit in the arena",
         )?;
+        if let Some(f) = &w.field_frame {
+            positive("world.field_frame.width", f.width)?;
+            positive("world.field_frame.height", f.height)?;
+            check("world.field_frame.x", f.x, true, "must be a finite number")?;
+            check("world.field_frame.y", f.y, true, "must be a finite number")?;
+        }
         let area = std::f64::consts::PI
             * (w.robots as f64 * w.robot_radius * w.robot_radius + w.pucks as f64 * w.puck_radius * w.puck_radius);
-        let capacity = PACKING_DENSITY * w.arena_size * w.arena_size;
+        let capacity = PACKING_DENSITY * w.arena_width * w.arena_height;
         if area > capacity {
             return Err(ConfigError::TooManyBodies { bodies: w.bodies(), area, capacity });
         }
@@ -227,7 +273,12 @@ mod tests {
         assert!(matches!(c.validate(), Err(ConfigError::TooManyBodies { bodies: 10_008, .. })));
 
         let mut c = SimConfig::default();
-        c.world.arena_size = f64::NAN;
-        assert!(c.validate().unwrap_err().to_string().starts_with("world.arena_size = NaN"));
+        c.world.arena_width = f64::NAN;
+        assert!(c.validate().unwrap_err().to_string().starts_with("world.arena_width = NaN"));
+
+        let mut c = SimConfig::default();
+        c.world.arena_height = 70.0;
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.starts_with("world.puck_radius = 10") && e.contains("shorter side"), "{e}");
     }
 }

@@ -71,7 +71,7 @@ impl DiscSensors {
 
 impl SensorModel for DiscSensors {
     fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
-        let size = world.config().arena_size;
+        let layout = world.config().field_layout();
         let obstacles = match self.targets {
             ObstacleTargets::Robots => world.robots().len(),
             ObstacleTargets::AnyBody => world.bodies().len(),
@@ -100,9 +100,9 @@ impl SensorModel for DiscSensors {
                 seen_left && seen_right
             });
             *reading = SensorReading {
-                left: field.sense(at(self.field[0]), size),
-                mid: field.sense(at(self.field[1]), size),
-                right: field.sense(at(self.field[2]), size),
+                left: field.sense(at(self.field[0]), &layout),
+                mid: field.sense(at(self.field[1]), &layout),
+                right: field.sense(at(self.field[2]), &layout),
                 puck_left: any_puck(left, &mut witness[0]),
                 puck_right: any_puck(right, &mut witness[1]),
                 obstacle_left: seen_left,

@@ -8,7 +8,7 @@
 //! - Eval' (thesis chapter 6), two variants; see [`EvalPrime`].
 
 use crate::config::Thresholds;
-use crate::field::ScalarField;
+use crate::field::{FieldLayout, ScalarField};
 use crate::vec2::Vec2;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -31,8 +31,8 @@ const DISTANCE_ONE: f64 = 4_294_967_296.0;
 /// independent of the order of the sum, so [`EvalTracker`]'s running total
 /// equals a fresh [`eval`] exactly; the rounding (at most 2^-33 per puck)
 /// is far below anything Eval is compared with.
-fn fixed_distance(p: Vec2, arena_size: f64, field: &ScalarField, t: &Thresholds) -> u64 {
-    let d = band_distance(f64::from(field.evaluate(p, arena_size)), t);
+fn fixed_distance(p: Vec2, layout: &FieldLayout, field: &ScalarField, t: &Thresholds) -> u64 {
+    let d = band_distance(f64::from(field.evaluate(p, layout)), t);
     (d * DISTANCE_ONE).round() as u64
 }
 
@@ -47,8 +47,8 @@ fn eval_of(total: u64, pucks: usize, t: &Thresholds) -> f64 {
 
 /// Eval of the pucks' positions, 1 when every puck is in the band.
 pub fn eval(world: &World, field: &ScalarField, t: &Thresholds) -> f64 {
-    let size = world.config().arena_size;
-    let total = world.pucks().iter().map(|p| fixed_distance(p.pos, size, field, t)).sum();
+    let layout = world.config().field_layout();
+    let total = world.pucks().iter().map(|p| fixed_distance(p.pos, &layout, field, t)).sum();
     eval_of(total, world.pucks().len(), t)
 }
 
@@ -74,9 +74,9 @@ impl EvalTracker {
     /// Looks every puck up again (after a reset), without allocating.
     pub fn rebuild(&mut self, world: &World, field: &ScalarField, t: &Thresholds) {
         self.distances.fill(0);
-        let size = world.config().arena_size;
+        let layout = world.config().field_layout();
         for i in world.puck_range() {
-            self.distances[i] = fixed_distance(world.bodies()[i].pos, size, field, t);
+            self.distances[i] = fixed_distance(world.bodies()[i].pos, &layout, field, t);
         }
         self.total = self.distances.iter().sum();
     }
@@ -84,10 +84,10 @@ impl EvalTracker {
     /// Catches up with the world: looks up the pucks that moved since the
     /// last update (the world's moved set, which this empties).
     pub fn update(&mut self, world: &mut World, field: &ScalarField, t: &Thresholds) {
-        let (first_puck, size) = (world.puck_range().start, world.config().arena_size);
+        let (first_puck, layout) = (world.puck_range().start, world.config().field_layout());
         world.drain_moved(|i, body| {
             if i >= first_puck {
-                let d = fixed_distance(body.pos, size, field, t);
+                let d = fixed_distance(body.pos, &layout, field, t);
                 self.total = self.total - self.distances[i] + d;
                 self.distances[i] = d;
             }
@@ -119,10 +119,10 @@ pub enum EvalPrime {
 pub fn eval_prime(world: &World, field: &ScalarField, t: &Thresholds, variant: EvalPrime, phi: f64, nu: f64) -> f64 {
     let robots = &world.bodies()[..world.robots().len()];
     let n = robots.len();
-    let size = world.config().arena_size;
+    let layout = world.config().field_layout();
     let robot_term = match variant {
         EvalPrime::AsWritten => {
-            let value = |b: &crate::body::Body| f64::from(field.evaluate(b.pos, size));
+            let value = |b: &crate::body::Body| f64::from(field.evaluate(b.pos, &layout));
             let total_ad: f64 = robots
                 .iter()
                 .map(|j| robots.iter().map(|k| (value(j) - value(k)).abs()).sum::<f64>() / n as f64)
@@ -138,9 +138,20 @@ pub fn eval_prime(world: &World, field: &ScalarField, t: &Thresholds, variant: E
                     .flat_map(|j| (j + 1..n).map(move |k| (j, k)))
                     .map(|(j, k)| (robots[j].pos - robots[k].pos).length())
                     .sum();
-                total / pairs as f64 / (size * std::f64::consts::SQRT_2)
+                total / pairs as f64 / diagonal(world.config().arena())
             }
         }
     };
     phi * eval(world, field, t) + nu * robot_term
+}
+
+/// The arena's diagonal: side x sqrt 2 for a square (the reference model's
+/// expression, so square arenas keep their results bit for bit), the
+/// hypotenuse otherwise.
+fn diagonal(arena: Vec2) -> f64 {
+    if arena.x == arena.y {
+        arena.x * std::f64::consts::SQRT_2
+    } else {
+        arena.x.hypot(arena.y)
+    }
 }

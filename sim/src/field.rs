@@ -1,12 +1,63 @@
-//! Scalar fields: a grid of values in [0, 1] stretched over the arena.
+//! Scalar fields: a grid of values in [0, 1] laid over a rectangle of the
+//! arena (its [`FieldFrame`]: the whole arena unless an arena places it
+//! otherwise), read in one of two ways ([`FieldSampling`]):
 //!
-//! Sensors read the nearest cell, `index = round(cells x position /
-//! arena_size)`; the evaluation of pucks truncates instead. Positions whose
-//! index falls outside the grid read 0 (so sensor points in the last half
-//! cell along the right and bottom edges read 0, as in the original).
+//! - `Nearest`, the reference model's: sensors read the nearest cell,
+//!   `index = round(cells x (position - origin) / frame size)`, and the
+//!   evaluation of pucks truncates instead. Positions whose index falls
+//!   outside the grid read 0 (so sensor points in the last half cell along
+//!   the right and bottom edges read 0, as in the original).
+//! - `Bilinear`, as a TV shows an image scaled to its panel: cell `(i, j)`
+//!   is the pixel centred at `((i + 1/2), (j + 1/2))` cell widths from the
+//!   frame's origin; a position between centres interpolates the four
+//!   around it (past the outermost centres, the edge pixels extend to the
+//!   frame's border); outside the frame the screen is black (0). Sensors
+//!   and the evaluation of pucks both read this value.
 
 use crate::vec2::Vec2;
+use serde::{Deserialize, Serialize};
 use shared::FieldValue;
+
+/// The rectangle of the arena a field's grid covers, units.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FieldFrame {
+    /// Left edge.
+    pub x: f64,
+    /// Top edge.
+    pub y: f64,
+    /// Width.
+    pub width: f64,
+    /// Height.
+    pub height: f64,
+}
+
+impl FieldFrame {
+    /// The whole of a `width` x `height` arena.
+    pub const fn whole(width: f64, height: f64) -> FieldFrame {
+        FieldFrame { x: 0.0, y: 0.0, width, height }
+    }
+}
+
+/// How a position reads the field.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldSampling {
+    /// The reference model's nearest cell (sensors) and truncated cell (Eval).
+    #[default]
+    Nearest,
+    /// Bilinear between pixel centres, as a TV scales an image.
+    Bilinear,
+}
+
+/// Where a field lies and how it is read: what every reading needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FieldLayout {
+    /// The rectangle the grid covers.
+    pub frame: FieldFrame,
+    /// How positions read it.
+    pub sampling: FieldSampling,
+}
 
 /// A grid of field values, row-major, row 0 at the top (y = 0).
 #[derive(Clone, Debug, PartialEq)]
@@ -33,16 +84,23 @@ impl ScalarField {
     /// `1 - distance((i, j), (32, 32)) / (32 sqrt 2)`, so cell (32, 32) is
     /// exactly 1 and the farthest cell (0, 0) is 0.
     pub fn annulus() -> ScalarField {
-        const N: usize = 64;
-        let centre = (N / 2) as f64;
-        let farthest = centre.hypot(centre);
-        let values = (0..N * N)
+        ScalarField::annulus_of(64, 64)
+    }
+
+    /// The annulus on `width` x `height` square cells: value `1 -
+    /// distance((i, j), (width / 2, height / 2))` over the distance from the
+    /// centre to cell (0, 0), so contours are circles and the corner cell
+    /// (0, 0) is 0. (The 64 x 64 one is the reference model's.)
+    pub fn annulus_of(width: usize, height: usize) -> ScalarField {
+        let centre = ((width / 2) as f64, (height / 2) as f64);
+        let farthest = centre.0.hypot(centre.1);
+        let values = (0..width * height)
             .map(|k| {
-                let (x, y) = ((k % N) as f64, (k / N) as f64);
-                (1.0 - (x - centre).hypot(y - centre) / farthest) as f32
+                let (x, y) = ((k % width) as f64, (k / width) as f64);
+                (1.0 - (x - centre.0).hypot(y - centre.1) / farthest) as f32
             })
             .collect();
-        ScalarField::new(N, N, values).expect("64 x 64 values")
+        ScalarField::new(width, height, values).expect("width x height values")
     }
 
     /// Grid width (columns).
@@ -65,26 +123,78 @@ impl ScalarField {
         inside.then(|| y as usize * self.width + x as usize)
     }
 
-    /// The cell a sensor at `p` reads: nearest cell by rounding.
-    pub fn nearest_cell(&self, p: Vec2, arena_size: f64) -> (i64, i64) {
-        let x = round_half_away(self.width as f64 * p.x / arena_size);
-        let y = round_half_away(self.height as f64 * p.y / arena_size);
+    /// The cell a sensor at `p` reads with [`FieldSampling::Nearest`]:
+    /// nearest cell by rounding.
+    pub fn nearest_cell(&self, p: Vec2, frame: &FieldFrame) -> (i64, i64) {
+        let x = round_half_away(self.width as f64 * (p.x - frame.x) / frame.width);
+        let y = round_half_away(self.height as f64 * (p.y - frame.y) / frame.height);
         (x, y)
     }
 
-    /// The sensor reading at `p`, in fixed point (nearest cell; 0 outside).
-    pub fn sense(&self, p: Vec2, arena_size: f64) -> FieldValue {
-        let (x, y) = self.nearest_cell(p, arena_size);
-        self.cell_index(x, y).map_or(FieldValue::ZERO, |k| self.fixed[k])
+    /// A sensor's reading at `p`, in fixed point.
+    pub fn sense(&self, p: Vec2, layout: &FieldLayout) -> FieldValue {
+        match layout.sampling {
+            FieldSampling::Nearest => {
+                let (x, y) = self.nearest_cell(p, &layout.frame);
+                self.cell_index(x, y).map_or(FieldValue::ZERO, |k| self.fixed[k])
+            }
+            FieldSampling::Bilinear => FieldValue::from_f32(self.bilinear(p, &layout.frame) as f32),
+        }
     }
 
-    /// The value used to evaluate a puck at `p`: the cell found by
-    /// truncation (0 outside).
-    pub fn evaluate(&self, p: Vec2, arena_size: f64) -> f32 {
-        let x = (self.width as f64 * p.x / arena_size) as i64;
-        let y = (self.height as f64 * p.y / arena_size) as i64;
-        self.cell(x, y)
+    /// The field value the screen shows at `p` (what a photo-transistor
+    /// there sees): the sensor reading's value with nearest sampling, the
+    /// exact interpolation with bilinear.
+    pub fn shown(&self, p: Vec2, layout: &FieldLayout) -> f64 {
+        match layout.sampling {
+            FieldSampling::Nearest => f64::from(self.sense(p, layout).to_f32()),
+            FieldSampling::Bilinear => self.bilinear(p, &layout.frame),
+        }
     }
+
+    /// The value used to evaluate a puck at `p`: with nearest sampling the
+    /// cell found by truncation (0 outside), with bilinear the interpolation.
+    pub fn evaluate(&self, p: Vec2, layout: &FieldLayout) -> f32 {
+        match layout.sampling {
+            FieldSampling::Nearest => {
+                let f = &layout.frame;
+                let x = (self.width as f64 * (p.x - f.x) / f.width) as i64;
+                let y = (self.height as f64 * (p.y - f.y) / f.height) as i64;
+                self.cell(x, y)
+            }
+            FieldSampling::Bilinear => self.bilinear(p, &layout.frame) as f32,
+        }
+    }
+
+    /// The bilinear interpolation at `p` between pixel centres (0 outside
+    /// the frame; the edge pixels extend to its border).
+    pub fn bilinear(&self, p: Vec2, frame: &FieldFrame) -> f64 {
+        let u = self.width as f64 * (p.x - frame.x) / frame.width;
+        let v = self.height as f64 * (p.y - frame.y) / frame.height;
+        if !((0.0..=self.width as f64).contains(&u) && (0.0..=self.height as f64).contains(&v)) {
+            return 0.0;
+        }
+        let (i0, tx) = split(u - 0.5, self.width);
+        let (j0, ty) = split(v - 0.5, self.height);
+        let (i1, j1) = ((i0 + 1).min(self.width - 1), (j0 + 1).min(self.height - 1));
+        let at = |i: usize, j: usize| f64::from(self.values[j * self.width + i]);
+        let top = at(i0, j0) + (at(i1, j0) - at(i0, j0)) * tx;
+        let bottom = at(i0, j1) + (at(i1, j1) - at(i0, j1)) * tx;
+        top + (bottom - top) * ty
+    }
+}
+
+/// The pixel at or left of coordinate `t` (in pixel widths from the first
+/// centre) and the fraction towards the next, clamped to the `n` pixels.
+fn split(t: f64, n: usize) -> (usize, f64) {
+    if t <= 0.0 {
+        return (0, 0.0);
+    }
+    let i = t.floor();
+    if i as usize >= n - 1 {
+        return (n - 1, 0.0);
+    }
+    (i as usize, t - i)
 }
 
 /// `t.round() as i64` without the libm call `round` compiles to on
@@ -108,24 +218,75 @@ mod tests {
         assert_eq!(f.cell(32, 32), 1.0);
         assert_eq!(f.cell(0, 0), 0.0);
         assert!(f.cell(63, 63) > 0.0);
-        assert_eq!(f.sense(Vec2::new(400.0, 400.0), 800.0), FieldValue::ONE);
+        assert_eq!(f.sense(Vec2::new(400.0, 400.0), &THESIS), FieldValue::ONE);
     }
+
+    /// The reference model's layout: the 800 x 800 arena, nearest cell.
+    const THESIS: FieldLayout = FieldLayout { frame: FieldFrame::whole(800.0, 800.0), sampling: FieldSampling::Nearest };
 
     #[test]
     fn sensors_round_and_read_zero_past_the_last_half_cell() {
         let f = ScalarField::annulus();
+        let frame = THESIS.frame;
         // 64 cells over 800 units: 12.5 units per cell.
-        assert_eq!(f.nearest_cell(Vec2::new(6.0, 6.0), 800.0), (0, 0));
-        assert_eq!(f.nearest_cell(Vec2::new(6.25, 18.7), 800.0), (1, 1));
-        assert_eq!(f.nearest_cell(Vec2::new(793.0, 400.0), 800.0), (63, 32));
-        assert_eq!(f.nearest_cell(Vec2::new(793.75, 400.0), 800.0), (64, 32));
-        assert_eq!(f.sense(Vec2::new(793.75, 400.0), 800.0), FieldValue::ZERO);
-        assert_eq!(f.sense(Vec2::new(400.0, 795.0), 800.0), FieldValue::ZERO);
-        assert_eq!(f.sense(Vec2::new(793.0, 400.0), 800.0), FieldValue::from_f32(f.cell(63, 32)));
-        assert_eq!(f.sense(Vec2::new(-7.0, 400.0), 800.0), FieldValue::ZERO);
+        assert_eq!(f.nearest_cell(Vec2::new(6.0, 6.0), &frame), (0, 0));
+        assert_eq!(f.nearest_cell(Vec2::new(6.25, 18.7), &frame), (1, 1));
+        assert_eq!(f.nearest_cell(Vec2::new(793.0, 400.0), &frame), (63, 32));
+        assert_eq!(f.nearest_cell(Vec2::new(793.75, 400.0), &frame), (64, 32));
+        assert_eq!(f.sense(Vec2::new(793.75, 400.0), &THESIS), FieldValue::ZERO);
+        assert_eq!(f.sense(Vec2::new(400.0, 795.0), &THESIS), FieldValue::ZERO);
+        assert_eq!(f.sense(Vec2::new(793.0, 400.0), &THESIS), FieldValue::from_f32(f.cell(63, 32)));
+        assert_eq!(f.sense(Vec2::new(-7.0, 400.0), &THESIS), FieldValue::ZERO);
         // evaluation truncates: 799 -> cell 63
-        assert_eq!(f.evaluate(Vec2::new(799.0, 400.0), 800.0), f.cell(63, 32));
-        assert_eq!(f.evaluate(Vec2::new(12.4, 12.4), 800.0), f.cell(0, 0));
+        assert_eq!(f.evaluate(Vec2::new(799.0, 400.0), &THESIS), f.cell(63, 32));
+        assert_eq!(f.evaluate(Vec2::new(12.4, 12.4), &THESIS), f.cell(0, 0));
+    }
+
+    #[test]
+    fn bilinear_sampling_matches_hand_computed_values_and_is_black_outside_the_frame() {
+        // 2 x 2 pixels over a 20 x 10 frame at (100, 50): centres at x 105
+        // and 115, y 52.5 and 57.5.
+        let f = ScalarField::new(2, 2, vec![0.0, 1.0, 0.5, 0.25]).unwrap();
+        let layout = FieldLayout {
+            frame: FieldFrame { x: 100.0, y: 50.0, width: 20.0, height: 10.0 },
+            sampling: FieldSampling::Bilinear,
+        };
+        let at = |x, y| f.shown(Vec2::new(x, y), &layout);
+        assert_eq!(at(105.0, 52.5), 0.0);
+        assert_eq!(at(115.0, 52.5), 1.0);
+        assert_eq!(at(110.0, 52.5), 0.5);
+        // Halfway down between the rows: top 0.5, bottom (0.5 + 0.25) / 2.
+        assert!((at(110.0, 55.0) - (0.5 + 0.375) / 2.0).abs() < 1e-12);
+        // A quarter of the way from the left centre, three quarters down.
+        let (tx, ty) = (0.25, 0.75);
+        let (top, bottom) = (0.0 + (1.0 - 0.0) * tx, 0.5 + (0.25 - 0.5) * tx);
+        assert!((at(107.5, 52.5 + 5.0 * ty) - (top + (bottom - top) * ty)).abs() < 1e-12);
+        // Past the outermost centres the edge pixels extend to the border.
+        assert_eq!(at(100.0, 50.0), 0.0);
+        assert_eq!(at(120.0, 50.0), 1.0);
+        assert_eq!(at(119.0, 60.0), 0.25);
+        // Outside the frame: black.
+        assert_eq!(at(99.9, 55.0), 0.0);
+        assert_eq!(at(121.0, 55.0), 0.0);
+        assert_eq!(f.sense(Vec2::new(115.0, 52.5), &layout), FieldValue::ONE);
+        assert_eq!(f.evaluate(Vec2::new(110.0, 52.5), &layout), 0.5);
+    }
+
+    #[test]
+    fn two_sensors_37_mm_apart_on_a_gradient_read_different_values_bilinear_but_often_one_cell_nearest() {
+        // The annulus over the thesis' arena: cells of 12.5 units (62.5 mm
+        // at 5 mm per unit); sensors 37 mm = 7.4 units apart across a radius.
+        let f = ScalarField::annulus();
+        let bilinear = FieldLayout { sampling: FieldSampling::Bilinear, ..THESIS };
+        let (mut same_cell, mut differ) = (0, 0);
+        for k in 0..100 {
+            let x = 420.0 + 2.0 * f64::from(k);
+            let (a, b) = (Vec2::new(x, 400.0), Vec2::new(x + 7.4, 400.0));
+            same_cell += usize::from(f.sense(a, &THESIS) == f.sense(b, &THESIS));
+            differ += usize::from(f.sense(a, &bilinear) > f.sense(b, &bilinear));
+        }
+        assert_eq!(differ, 100, "bilinear: the inner sensor always reads more");
+        assert!(same_cell >= 30, "nearest: {same_cell} of 100 pairs read one cell");
     }
 
     #[test]

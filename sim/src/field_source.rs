@@ -1,6 +1,7 @@
 //! Where a field comes from: the annulus, a generated letter, or an image
 //! file (one cell per pixel, the mean of R, G and B over 255).
 
+use crate::arena::ArenaSpec;
 use crate::field::ScalarField;
 use crate::letters::Letter;
 use serde::{Deserialize, Serialize};
@@ -8,7 +9,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// Where a field comes from: the `--field` argument.
+/// Where a field comes from, by name: `annulus`, `letter:T`, or an image
+/// file's path.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum FieldSource {
@@ -95,6 +97,18 @@ impl FieldSource {
             FieldSource::Annulus => Ok(ScalarField::annulus()),
             FieldSource::Letter(l) => Ok(l.field()),
             FieldSource::Image(path) => load_image(path),
+        }
+    }
+
+    /// Builds or loads the field for a screen arena: the annulus generated
+    /// for the screen's shape, any other field as [`FieldSource::load`].
+    pub fn load_for(&self, arena: &ArenaSpec) -> Result<ScalarField, FieldError> {
+        match self {
+            FieldSource::Annulus => {
+                let (width, height) = arena.annulus_cells();
+                Ok(ScalarField::annulus_of(width, height))
+            }
+            _ => self.load(),
         }
     }
 

@@ -1,4 +1,4 @@
-//! The spatial grid broad phase: square cells in row-major order whose
+//! The spatial grid broad phase: cells in row-major order whose
 //! bodies are stored cell by cell in one array, so that the cells of a
 //! row that a query covers are one contiguous slice.
 //!
@@ -25,15 +25,18 @@ pub struct Neighbour {
 /// fall in the outermost cells of the arena, which keeps every query a
 /// superset of the bodies it must find.
 ///
-/// A ring of cells that stay empty surrounds the arena's `cols` x `cols`
+/// A ring of cells that stay empty surrounds the arena's `cols` x `rows`
 /// cells, so that the eight cells around any body's cell exist: the
 /// neighbourhood of a body is three runs of three cells, found from its
 /// cell index alone ([`SpatialGrid::any_around`]).
 #[derive(Clone, Debug)]
 pub struct SpatialGrid {
-    cells_per_unit: f64,
+    /// Columns per unit of x, rows per unit of y.
+    cells_per_unit: Vec2,
     /// Cells across the arena.
     cols: usize,
+    /// Cells down the arena.
+    rows: usize,
     /// Cells across the arena and its empty ring: `cols + 2`.
     stride: usize,
     /// Cell `c` holds the slots `start[c] .. start[c + 1]`.
@@ -47,15 +50,18 @@ pub struct SpatialGrid {
 }
 
 impl SpatialGrid {
-    /// A grid over a `size` x `size` arena with cells of at least
-    /// `min_cell` units, holding bodies of the given centres and radii.
-    pub fn new(size: f64, min_cell: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
-        let cols = ((size / min_cell).floor() as usize).clamp(1, u16::MAX as usize);
+    /// A grid over an arena of `size` (width, height) with cells of at
+    /// least `min_cell` units each way, holding bodies of the given centres
+    /// and radii.
+    pub fn new(size: Vec2, min_cell: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
+        let count = |side: f64| ((side / min_cell).floor() as usize).clamp(1, u16::MAX as usize);
+        let (cols, rows) = (count(size.x), count(size.y));
         let mut grid = SpatialGrid {
-            cells_per_unit: cols as f64 / size,
+            cells_per_unit: Vec2::new(cols as f64 / size.x, rows as f64 / size.y),
             cols,
+            rows,
             stride: cols + 2,
-            start: vec![0; (cols + 2) * (cols + 2) + 1],
+            start: vec![0; (cols + 2) * (rows + 2) + 1],
             slots: bodies.enumerate().map(|(body, (pos, radius))| Neighbour { pos, radius, body: body as u32 }).collect(),
             slot_of: Vec::new(),
             cell_of: Vec::new(),
@@ -77,19 +83,25 @@ impl SpatialGrid {
         grid
     }
 
-    /// Column or row index of a coordinate, clamped to the arena's cells
-    /// (the empty ring excluded: from 1 to `cols`). (`as`
-    /// truncates, which is the floor for the non-negative values it sees;
-    /// `floor` would be a libm call on baseline x86-64, and a cast to `u32`
-    /// is cheaper than one to `usize`.)
+    /// Column index of an x coordinate, clamped to the arena's cells (the
+    /// empty ring excluded: from 1 to `cols`). (`as` truncates, which is
+    /// the floor for the non-negative values it sees; `floor` would be a
+    /// libm call on baseline x86-64, and a cast to `u32` is cheaper than
+    /// one to `usize`.)
     #[inline]
-    fn axis(&self, v: f64) -> usize {
-        ((v * self.cells_per_unit) as u32 as usize).min(self.cols - 1) + 1
+    fn column(&self, x: f64) -> usize {
+        ((x * self.cells_per_unit.x) as u32 as usize).min(self.cols - 1) + 1
+    }
+
+    /// Row index of a y coordinate, as [`SpatialGrid::column`].
+    #[inline]
+    fn row(&self, y: f64) -> usize {
+        ((y * self.cells_per_unit.y) as u32 as usize).min(self.rows - 1) + 1
     }
 
     #[inline]
     fn cell(&self, p: Vec2) -> u32 {
-        (self.axis(p.y) * self.stride + self.axis(p.x)) as u32
+        (self.row(p.y) * self.stride + self.column(p.x)) as u32
     }
 
     /// Records that `body` is now at `p`.
@@ -133,8 +145,8 @@ impl SpatialGrid {
     /// until it returns true; returns whether it did.
     #[inline]
     pub fn any_in_box(&self, min: Vec2, max: Vec2, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
-        let (first_col, last_col) = (self.axis(min.x), self.axis(max.x));
-        for row in self.axis(min.y)..self.axis(max.y) + 1 {
+        let (first_col, last_col) = (self.column(min.x), self.column(max.x));
+        for row in self.row(min.y)..self.row(max.y) + 1 {
             let base = row * self.stride;
             let (from, to) = (self.start[base + first_col], self.start[base + last_col + 1]);
             if pred(&self.slots[from as usize..to as usize]) {
@@ -157,9 +169,9 @@ impl SpatialGrid {
         })
     }
 
-    /// The width of a cell.
+    /// The smaller of a cell's width and height.
     pub fn cell_width(&self) -> f64 {
-        1.0 / self.cells_per_unit
+        1.0 / self.cells_per_unit.x.max(self.cells_per_unit.y)
     }
 }
 
@@ -168,7 +180,7 @@ mod tests {
     use super::*;
 
     fn grid(size: f64, cell: f64, pts: &[Vec2]) -> SpatialGrid {
-        SpatialGrid::new(size, cell, pts.iter().map(|&p| (p, 1.0)))
+        SpatialGrid::new(Vec2::new(size, size), cell, pts.iter().map(|&p| (p, 1.0)))
     }
 
     fn found(g: &SpatialGrid, min: Vec2, max: Vec2) -> Vec<u32> {
@@ -231,6 +243,17 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_rectangular_arena_has_its_own_rows_and_columns_and_clamps_outside_points_into_them() {
+        let pts = [Vec2::new(5.0, 5.0), Vec2::new(395.0, 95.0), Vec2::new(500.0, -20.0), Vec2::new(200.0, 150.0)];
+        let g = SpatialGrid::new(Vec2::new(400.0, 100.0), 20.0, pts.iter().map(|&p| (p, 1.0)));
+        assert_eq!((g.cols, g.rows), (20, 5));
+        assert_eq!(found(&g, Vec2::new(390.0, 90.0), Vec2::new(399.0, 99.0)), vec![1]);
+        assert_eq!(found(&g, Vec2::new(195.0, 95.0), Vec2::new(205.0, 99.0)), vec![3], "below the arena: last row");
+        assert_eq!(found(&g, Vec2::new(390.0, 0.0), Vec2::new(399.0, 10.0)), vec![2]);
+        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(400.0, 100.0)), vec![0, 1, 2, 3]);
     }
 
     /// Many bodies carried across many cells in both directions stay

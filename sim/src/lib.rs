@@ -12,11 +12,15 @@
 //! [`scenario`] builds a simulation from a few choices; [`render`] draws
 //! it; [`policy_file`] reads policy blobs.
 //!
+//! Arenas: the thesis' square, or a screen lying flat with the field on
+//! it ([`arena`]: the 75" TV of the thesis' hardware).
+//!
 //! Everything random comes from a seeded [`SimRng`]; the whole state is
 //! serde-serialisable for bit-exact checkpoints. The crate reads field
 //! images and policy files, and writes no files.
 #![warn(missing_docs)]
 
+pub mod arena;
 pub mod bitset;
 pub mod body;
 pub mod broadphase;
@@ -48,6 +52,7 @@ pub mod validate;
 pub mod vec2;
 pub mod world;
 
+pub use arena::{ArenaSpec, FieldFit};
 pub use body::{Body, Robot, RobotKind};
 pub use broadphase::BroadPhase;
 pub use config::{EpisodeConfig, PhysicsConfig, SimConfig, Thresholds, WorldConfig};
@@ -56,13 +61,13 @@ pub use disc_sensor_config::{DiscSensorConfig, ObstacleTargets, SensorDisc};
 pub use disc_sensors::DiscSensors;
 pub use episode::{EpisodeEnd, EpisodeStart, StepOutcome};
 pub use eval::{eval, eval_prime, EvalPrime, EvalTracker};
-pub use field::ScalarField;
+pub use field::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
 pub use field_source::{FieldError, FieldSource};
 pub use letters::Letter;
 pub use reward::Reward;
 pub use rng::SimRng;
 pub use robot_sensors::{RobotObservation, RobotSensorConfig, RobotSensors};
-pub use scenario::{ControllerChoice, Scenario, ScenarioError};
+pub use scenario::{Arena, ControllerChoice, Scenario, ScenarioError};
 pub use sensor_model::{Footprint, FootprintKind, SensorModel};
 pub use sensor_setup::{SelectedSensors, SensorSetup};
 pub use simulation::{Simulation, SimulationState, StepReport, Totals};

@@ -25,7 +25,7 @@
 //! identical inputs identically.
 
 use crate::validate::{check, ConfigError};
-use crate::field::ScalarField;
+use crate::field::{FieldLayout, ScalarField};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{RC_TICK_US, RC_TIMEOUT_TICKS};
@@ -201,11 +201,11 @@ impl PhotoSensors {
     }
 
     /// The reading of a robot at `pos` facing `direction` (unit vector).
-    pub fn read(&self, pos: Vec2, direction: Vec2, field: &ScalarField, arena_size: f64) -> PhotoReading {
+    pub fn read(&self, pos: Vec2, direction: Vec2, field: &ScalarField, layout: &FieldLayout) -> PhotoReading {
         let mut r = PhotoReading::default();
         for i in 0..3 {
-            let v = field.sense(pos + self.points[i].rotated(direction), arena_size);
-            r.discharge_us[i] = self.response[i].discharge_us(f64::from(v.to_f32()), self.gamma);
+            let v = field.shown(pos + self.points[i].rotated(direction), layout);
+            r.discharge_us[i] = self.response[i].discharge_us(v, self.gamma);
             r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
         }
         r
@@ -215,6 +215,10 @@ impl PhotoSensors {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::field::{FieldFrame, FieldSampling};
+
+    /// A 100 x 100 arena, nearest cell.
+    const SQUARE_100: FieldLayout = FieldLayout { frame: FieldFrame::whole(100.0, 100.0), sampling: FieldSampling::Nearest };
 
     #[test]
     fn brighter_discharges_faster_between_the_calibrated_ends() {
@@ -257,10 +261,10 @@ mod tests {
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
         // One cell over the whole arena: every point inside reads it.
         let at = Vec2::new(20.0, 20.0);
-        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, 100.0);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, &SQUARE_100);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ONE; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.bright));
-        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, 100.0);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
     }
@@ -272,7 +276,7 @@ mod tests {
         let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 10.0);
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
-        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, 100.0);
+        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, &SQUARE_100);
         let values = sensors.values(&r.ticks);
         assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
     }

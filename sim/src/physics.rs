@@ -112,8 +112,8 @@ pub struct StepContext<'a> {
     pub forward_speed: f64,
     /// Contact model.
     pub config: &'a PhysicsConfig,
-    /// Arena side.
-    pub arena_size: f64,
+    /// Arena width and height.
+    pub arena: Vec2,
     /// The largest body radius.
     pub max_radius: f64,
     /// Neighbour index, kept up to date with every move.
@@ -208,14 +208,14 @@ impl StepContext<'_> {
     /// The four border walls in a fixed order (top, right, bottom, left),
     /// each as a segment with the wall radius.
     fn resolve_walls(&mut self, i: usize) {
-        let s = self.arena_size;
+        let (w, h) = (self.arena.x, self.arena.y);
         let reach = self.bodies[i].radius + self.config.wall_radius - self.config.overlap_threshold;
         let p = self.bodies[i].pos;
-        if (p.x >= reach) & (p.x <= s - reach) & (p.y >= reach) & (p.y <= s - reach) {
+        if (p.x >= reach) & (p.x <= w - reach) & (p.y >= reach) & (p.y <= h - reach) {
             return; // farther than `reach` from every wall: no contact possible
         }
         // (axis is x?, wall coordinate, inward normal)
-        let walls = [(false, 0.0, Vec2::new(0.0, 1.0)), (true, s, Vec2::new(-1.0, 0.0)), (false, s, Vec2::new(0.0, -1.0)), (true, 0.0, Vec2::new(1.0, 0.0))];
+        let walls = [(false, 0.0, Vec2::new(0.0, 1.0)), (true, w, Vec2::new(-1.0, 0.0)), (false, h, Vec2::new(0.0, -1.0)), (true, 0.0, Vec2::new(1.0, 0.0))];
         for (vertical, at, inward) in walls {
             let b = self.bodies[i];
             let across = if vertical { b.pos.x - at } else { b.pos.y - at };
@@ -223,9 +223,9 @@ impl StepContext<'_> {
                 continue;
             }
             let point = if vertical {
-                Vec2::new(at, b.pos.y.clamp(0.0, s))
+                Vec2::new(at, b.pos.y.clamp(0.0, h))
             } else {
-                Vec2::new(b.pos.x.clamp(0.0, s), at)
+                Vec2::new(b.pos.x.clamp(0.0, w), at)
             };
             let delta = b.pos - point;
             let d = delta.length();
@@ -300,10 +300,9 @@ impl StepContext<'_> {
     }
 
     fn clamp(&mut self, i: usize) {
-        let s = self.arena_size;
         let b = &mut self.bodies[i];
-        let (lo, hi) = (b.radius, s - b.radius);
-        let clamped = Vec2::new(b.pos.x.clamp(lo, hi), b.pos.y.clamp(lo, hi));
+        let r = b.radius;
+        let clamped = Vec2::new(b.pos.x.clamp(r, self.arena.x - r), b.pos.y.clamp(r, self.arena.y - r));
         if clamped != b.pos {
             b.pos = clamped;
             self.relocated(i);

@@ -18,7 +18,7 @@ const FIELD_SENSOR: Rgb<u8> = Rgb([0, 200, 0]);
 /// How to draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderOptions {
-    /// Image side, pixels.
+    /// Image width, pixels (the height follows the arena's shape).
     pub size: u32,
     /// Draw each robot's sensor discs and field points.
     pub footprints: bool,
@@ -34,11 +34,12 @@ impl Default for RenderOptions {
 /// Draws the simulation's current world.
 pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbImage {
     let world = sim.world();
-    let arena = world.config().arena_size;
-    let scale = f64::from(options.size) / arena;
-    let mut img = RgbImage::from_fn(options.size, options.size, |x, y| {
+    let (arena, layout) = (world.config().arena(), world.config().field_layout());
+    let scale = f64::from(options.size) / arena.x;
+    let height = (arena.y * scale).round().max(1.0) as u32;
+    let mut img = RgbImage::from_fn(options.size, height, |x, y| {
         let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
-        let v = (sim.field().evaluate(p, arena) * 255.0).round() as u8;
+        let v = (sim.field().evaluate(p, &layout) * 255.0).round() as u8;
         Rgb([v, v, v])
     });
     let to_px = |p: Vec2| p * scale;

@@ -99,7 +99,7 @@ impl RobotSensors {
     /// Robot `robot`'s observation of the world (reuses `out`'s buffer).
     pub fn observe(&mut self, world: &World, field: &ScalarField, robot: usize, out: &mut RobotObservation) {
         let pos = world.bodies()[robot].pos;
-        let photo = self.photo.read(pos, world.robots()[robot].direction, field, world.config().arena_size);
+        let photo = self.photo.read(pos, world.robots()[robot].direction, field, &world.config().field_layout());
         self.camera.frame(world, robot, &mut out.frame);
         out.discharge_us = photo.discharge_us;
         out.ticks = photo.ticks;

@@ -2,10 +2,12 @@
 //! controller, sensor model, counts, seed), with the per-field defaults of
 //! the thesis' experiments.
 
+use crate::arena::ArenaSpec;
 use crate::broadphase::BroadPhase;
 use crate::config::{SimConfig, Thresholds};
 use crate::control::Controller;
 use crate::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
+use crate::field::ScalarField;
 use crate::field_source::{FieldError, FieldSource};
 use crate::policy_file::{self, PolicyFileError};
 use crate::sensor_setup::{SelectedSensors, SensorSetup};
@@ -60,16 +62,16 @@ pub struct Scenario {
     pub field: FieldSource,
     /// The controller.
     pub controller: ControllerChoice,
-    /// Number of robots.
-    pub robots: usize,
-    /// Number of pucks.
-    pub pucks: usize,
+    /// Number of robots; `None` for the arena's (8 in the thesis' arena).
+    pub robots: Option<usize>,
+    /// Number of pucks; `None` for the arena's (250 in the thesis' arena).
+    pub pucks: Option<usize>,
     /// Seed of every generator.
     pub seed: u64,
     /// Contact search.
     pub broad_phase: BroadPhase,
-    /// Arena side; `None` for the default 800.
-    pub arena_size: Option<f64>,
+    /// The arena.
+    pub arena: Arena,
     /// The robots' sensor model.
     pub sensors: SensorSetup,
 }
@@ -81,11 +83,11 @@ impl Default for Scenario {
         Scenario {
             field: FieldSource::Annulus,
             controller: ControllerChoice::Orbital,
-            robots: 8,
-            pucks: 250,
+            robots: None,
+            pucks: None,
             seed: 1,
             broad_phase: BroadPhase::Grid,
-            arena_size: None,
+            arena: Arena::default(),
             sensors: SensorSetup::Disc,
         }
     }
@@ -116,17 +118,55 @@ pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
     }
 }
 
-impl Scenario {
-    /// The settings: [`field_config`] with this scenario's counts, contact
-    /// search and arena, and [`orbital_innies`] for orbital construction.
-    pub fn config(&self) -> SimConfig {
-        let mut c = field_config(&self.field, self.robots, self.pucks);
-        c.world.broad_phase = self.broad_phase;
-        if let Some(size) = self.arena_size {
-            c.world.arena_size = size;
+/// The arena a scenario runs in.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Arena {
+    /// The reference model's square arena of this side (800 in the thesis),
+    /// the field stretched over it and read at the nearest cell.
+    Square(f64),
+    /// A screen arena (`docs/robot-sensors.md`).
+    Screen(Box<ArenaSpec>),
+}
+
+impl Default for Arena {
+    /// The thesis' 800 x 800 square.
+    fn default() -> Arena {
+        Arena::Square(800.0)
+    }
+}
+
+impl Arena {
+    /// The field of `source` as this arena shows it.
+    pub fn load(&self, source: &FieldSource) -> Result<ScalarField, FieldError> {
+        match self {
+            Arena::Square(_) => source.load(),
+            Arena::Screen(spec) => source.load_for(spec),
         }
+    }
+}
+
+impl Scenario {
+    /// The settings for `field` (loaded by [`Arena::load`]): [`field_config`]
+    /// in this scenario's arena, with its counts and contact search, and
+    /// [`orbital_innies`] for orbital construction.
+    pub fn config(&self, field: &ScalarField) -> SimConfig {
+        let mut c = field_config(&self.field, 8, 250);
+        match &self.arena {
+            Arena::Square(size) => {
+                c.world.arena_width = *size;
+                c.world.arena_height = *size;
+            }
+            Arena::Screen(spec) => spec.apply(&mut c, field),
+        }
+        if let Some(robots) = self.robots {
+            c.world.robots = robots;
+        }
+        if let Some(pucks) = self.pucks {
+            c.world.pucks = pucks;
+        }
+        c.world.broad_phase = self.broad_phase;
         if self.controller == ControllerChoice::Orbital {
-            c.world.innies = orbital_innies(&self.field, self.robots);
+            c.world.innies = orbital_innies(&self.field, c.world.robots);
         }
         c
     }
@@ -134,7 +174,11 @@ impl Scenario {
     /// Loads the field and policy, validates the settings and builds the
     /// simulation and controller. Errors name the offending input.
     pub fn build(&self) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
-        let mut config = self.config();
+        if let Arena::Screen(spec) = &self.arena {
+            spec.validate()?;
+        }
+        let field = Arc::new(self.arena.load(&self.field)?);
+        let mut config = self.config(&field);
         let controller: Box<dyn Controller> = match &self.controller {
             ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds)),
             ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
@@ -148,7 +192,6 @@ impl Scenario {
         if let SensorSetup::Robot(robot) = &self.sensors {
             robot.validate()?;
         }
-        let field = Arc::new(self.field.load()?);
         let sensors = self.sensors.build(&config);
         let sim = Simulation::with_sensors(config, field, sensors, self.seed)?;
         Ok((sim, controller))

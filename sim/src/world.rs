@@ -76,7 +76,7 @@ impl World {
     pub fn scene(config: &SimConfig, robots: &[(Vec2, f64, RobotKind)], pucks: &[Vec2], seed: u64) -> World {
         let c = &config.world;
         let mut bodies: Vec<Body> = robots.iter().map(|&(p, _, _)| Body::new(p, c.robot_radius)).collect();
-        bodies.extend(pucks.iter().map(|&p| Body::new(p, c.puck_radius)));
+        bodies.extend(pucks.iter().map(|&p| puck(Body::new(p, c.puck_radius), c)));
         let robot_state = robots.iter().map(|&(_, heading, kind)| Robot::new(heading, kind)).collect();
         let innies = robots.iter().filter(|r| r.2 == RobotKind::Innie).count();
         World::from_state(WorldState {
@@ -116,7 +116,7 @@ impl World {
             robots: &s.robots,
             forward_speed: s.config.forward_speed,
             config: &s.physics,
-            arena_size: s.config.arena_size,
+            arena: s.config.arena(),
             max_radius: s.config.max_radius(),
             index: &mut self.index,
             rng: &mut s.rng,
@@ -236,23 +236,32 @@ pub fn disc_overlaps(centre: Vec2, radius: f64, pos: Vec2, circle_radius: f64) -
 fn index_of(state: &WorldState) -> NeighbourIndex {
     NeighbourIndex::new(
         state.config.broad_phase,
-        state.config.arena_size,
+        state.config.arena(),
         candidate_reach(state.config.max_radius()),
         &state.bodies,
     )
 }
 
-/// Robots uniformly in `[r, size - r)`, then pucks in `[4r, size - 4r)`, on
-/// each axis.
+/// Robots uniformly in `[r, side - r)`, then pucks in `[4r, side - 4r)`,
+/// on each axis (x drawn before y).
 fn start_positions(c: &WorldConfig, rng: &mut SimRng) -> Vec<Body> {
     let mut place = |r: f64, margin: f64| {
-        let range = margin..c.arena_size - margin;
-        Body::new(Vec2::new(rng.random_range(range.clone()), rng.random_range(range)), r)
+        let x = rng.random_range(margin..c.arena_width - margin);
+        let y = rng.random_range(margin..c.arena_height - margin);
+        Body::new(Vec2::new(x, y), r)
     };
     let mut bodies = Vec::with_capacity(c.bodies());
     bodies.extend((0..c.robots).map(|_| place(c.robot_radius, c.robot_radius)));
-    bodies.extend((0..c.pucks).map(|_| place(c.puck_radius, 4.0 * c.puck_radius)));
+    bodies.extend((0..c.pucks).map(|_| puck(place(c.puck_radius, 4.0 * c.puck_radius), c)));
     bodies
+}
+
+/// A puck body with the configured mass, if one is set.
+fn puck(mut body: Body, c: &WorldConfig) -> Body {
+    if let Some(mass) = c.puck_mass {
+        body.mass = mass;
+    }
+    body
 }
 
 /// Uniformly random headings; the first `innies` robots are innies.

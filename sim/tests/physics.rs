@@ -90,11 +90,12 @@ fn pushed_pucks_slow_down_and_stop() {
     assert!(rest.x > 303.0 && rest.x < 303.75, "{rest:?}");
 }
 
-/// A dense world (24 robots, 400 pucks in a 500 x 500 arena) under random
-/// turns; the final bodies, robots and generator, serialised.
-fn dense_run(broad_phase: BroadPhase, steps: u64) -> String {
+/// A dense world (24 robots, 400 pucks in an arena of `width` x `height`)
+/// under random turns; the final bodies, robots and generator, serialised.
+fn dense_run(broad_phase: BroadPhase, (width, height): (f64, f64), steps: u64) -> String {
     let mut config = SimConfig::default();
-    config.world.arena_size = 500.0;
+    config.world.arena_width = width;
+    config.world.arena_height = height;
     config.world.robots = 24;
     config.world.pucks = 400;
     config.world.broad_phase = broad_phase;
@@ -108,7 +109,23 @@ fn dense_run(broad_phase: BroadPhase, steps: u64) -> String {
 
 #[test]
 fn grid_and_all_pairs_give_bit_identical_trajectories() {
-    let grid = dense_run(BroadPhase::Grid, 10_000);
-    let naive = dense_run(BroadPhase::Naive, 10_000);
+    let grid = dense_run(BroadPhase::Grid, (500.0, 500.0), 10_000);
+    let naive = dense_run(BroadPhase::Naive, (500.0, 500.0), 10_000);
     assert!(grid == naive, "trajectories differ");
+}
+
+#[test]
+fn grid_and_all_pairs_agree_in_a_rectangular_arena_and_every_body_stays_inside_its_walls() {
+    let grid = dense_run(BroadPhase::Grid, (700.0, 330.0), 6_000);
+    let naive = dense_run(BroadPhase::Naive, (700.0, 330.0), 6_000);
+    assert!(grid == naive, "trajectories differ");
+    let (bodies, ..): (Vec<Body>, serde_json::Value, serde_json::Value, u64) = serde_json::from_str(&grid).unwrap();
+    // Within the walls, up to the overlap a step's motion can leave before
+    // the next step resolves it (speed 2, overlap threshold 0.1).
+    let slack = 2.1;
+    for b in &bodies {
+        assert!(b.pos.x >= b.radius - slack && b.pos.x <= 700.0 - b.radius + slack, "{b:?}");
+        assert!(b.pos.y >= b.radius - slack && b.pos.y <= 330.0 - b.radius + slack, "{b:?}");
+    }
+    assert!(bodies.iter().any(|b| b.pos.y > 300.0) && bodies.iter().any(|b| b.pos.x > 650.0), "the far walls are reached");
 }

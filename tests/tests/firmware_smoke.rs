@@ -39,7 +39,8 @@ fn decoded(z: &mut Zumo) -> Vec<LogFrame> {
 
 /// The frame's decision, recomputed on the host from its raw times.
 fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutputs {
-    let decider = Decider::new(&CALIBRATION, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+    let scales = CALIBRATION.scales();
+    let decider = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
     let expected = decider.decide(&frame.raw_times, blocks);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);

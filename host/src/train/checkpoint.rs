@@ -25,7 +25,9 @@ use std::path::Path;
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// The format version this build writes and reads.
-pub const VERSION: u16 = 1;
+/// 2: the world config of a rectangular arena (width, height, the
+/// field's frame and sampling, puck mass, millimetres per unit).
+pub const VERSION: u16 = 2;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
