@@ -64,7 +64,7 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
         Decider { scales: calibration.scales(), camera, hasher, policy, motors }
     }
 
-    /// Replaces the calibration (after a sweep).
+    /// Replaces the calibration (after a new one was stored).
     pub fn set_calibration(&mut self, calibration: &FieldCalibration) {
         self.scales = calibration.scales();
     }

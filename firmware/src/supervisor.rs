@@ -14,7 +14,7 @@
 //! LEDs: yellow on = driving, yellow blinking (1 Hz) = ready; green on =
 //! calibrating, waiting for white; green blinking (5 Hz) = white seen,
 //! waiting for black; red blinking (5 Hz) = camera or sensor fault; red steady =
-//! no valid calibration (missing, corrupt, or the last sweep failed).
+//! no valid calibration (missing, corrupt, or the last calibration failed).
 
 use crate::health::Health;
 use crate::rc::all_timed_out;

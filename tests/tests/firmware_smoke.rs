@@ -328,3 +328,85 @@ fn a_device_holding_sda_low_is_clocked_free_and_the_camera_reads_again() {
     assert_eq!((last.faults, last.blocks), (Faults::NONE, 1));
 }
 
+
+/// Flash (.text + .data) and static RAM (.data + .bss) of an ELF, from `avr-size -B`.
+fn sizes(elf: &std::path::Path) -> (u64, u64) {
+    let out = std::process::Command::new("avr-size")
+        .arg("-B")
+        .arg(elf)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run avr-size ({e}): install binutils-avr (`scripts/setup`)"));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let n: Vec<u64> = text.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|v| v.parse().ok()).collect();
+    assert_eq!(n.len(), 3, "avr-size output: {text}");
+    (n[0] + n[1], n[1] + n[2])
+}
+
+#[test]
+fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
+    use tests::figures::{compiler_of, thousands, Figures, Outcome};
+    use tests::zumo::{firmware_elf, firmware_elf_in};
+    const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
+    let elf = firmware_elf();
+    let mut figures = Figures::new(&compiler_of(&elf));
+    figures.fixed(&["log frame, longest", &format!("{} bytes", LogFrame::MAX_ENCODED_LEN), "-", "`shared::LogFrame::MAX_ENCODED_LEN`"]);
+
+    let build = "scripts/test (or scripts/build-firmware with FIRMWARE_OUT, docs/equivalence.md)";
+    let (flash, ram) = sizes(&elf);
+    let (flash10, _) = sizes(&firmware_elf_in("robot-annulus-10bit", build));
+    figures.compiled(&[
+        "flash (.text + .data)",
+        &format!("{} bytes (10-bit policy: {})", thousands(flash), thousands(flash10)),
+        "16,384",
+        "`scripts/build-firmware` (avr-size -B)",
+    ]);
+    figures.compiled(&["static RAM (.data + .bss)", &format!("{} bytes", thousands(ram)), "1,024", "`scripts/build-firmware`"]);
+
+    // Driving with the camera and sensors busy: decisions and the stack.
+    let mut z = calibrated_zumo();
+    z.show(&[PUCK_LEFT, ROBOT_RIGHT]);
+    z.run_ms(1);
+    z.paint_stack();
+    z.run_ms(40);
+    z.press_a();
+    z.run_ms(300);
+    let cycles = z.decision_cycles();
+    let low = z.stack_low_water();
+    figures.compiled(&[
+        "stack, deepest",
+        &format!("{} bytes (down to {low:#06X})", 0x0B00 - low),
+        "above 0x0801",
+        "this test",
+    ]);
+    figures.compiled(&[
+        "one decision (this test's driving run)",
+        &format!("{} to {} cycles", thousands(*cycles.iter().min().unwrap()), thousands(*cycles.iter().max().unwrap())),
+        "2,000",
+        "this test; over the trained policies: `docs/equivalence.md`",
+    ]);
+
+    // The heaviest period: odometry at 6,000 counts/s per wheel, eight colour-code blocks, sensors near timeout.
+    let mut z = calibrated_zumo();
+    z.run_ms(40);
+    z.press_a();
+    z.set_wheel_counts_per_second([6_000, 6_000]);
+    z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
+    let cc = |i: u16| PixyBlock { signature: 0o12, x: 10 + 30 * i, y: 150, width: 20, height: 20, angle: -45 };
+    z.show(&(0..8).map(cc).collect::<Vec<_>>());
+    z.run_ms(400);
+    decoded(&mut z);
+    let work = *z.period_work_cycles().iter().max().unwrap();
+    let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
+    figures.compiled(&[
+        "a period's work, heaviest (odometry at 6,000 counts/s, 4 colour-code blocks read, sensors near timeout)",
+        &format!("{} cycles ({:.1} ms)", thousands(work), work as f64 / 16_000.0),
+        &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+
+    match figures.check("docs/firmware.md", "firmware", &["figure", "value", "budget", "measured by"], REGENERATE) {
+        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
+        Ok(_) => {}
+        Err(e) => panic!("{e:#}"),
+    }
+}
