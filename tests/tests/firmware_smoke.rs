@@ -231,19 +231,24 @@ fn encoder_edges_are_counted_per_period_in_the_log_and_the_robot_id_with_them() 
     assert!(frames.iter().all(|f| f.robot_id == 0), "the default build has robot id 0");
 }
 
-#[test]
-fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period() {
+/// 400 ms of the heaviest periods: driving, both wheels at 6,000 counts/s
+/// (about 0.8 m/s on 75:1 motors, faster than a Zumo drives), the sensors
+/// near their timeout, and frames of eight colour-code blocks.
+fn heaviest_periods() -> Zumo {
     let mut z = calibrated_zumo();
     z.run_ms(40);
     z.press_a();
-    // Both wheels at 6,000 counts/s (about 0.8 m/s on 75:1 motors, faster than a Zumo drives),
-    // the sensors near their timeout, and a frame of eight colour-code blocks.
     z.set_wheel_counts_per_second([6_000, 6_000]);
     z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
     let cc = |i: u16| PixyBlock { signature: 0o12, x: 10 + 30 * i, y: 150, width: 20, height: 20, angle: -45 };
-    let blocks: Vec<PixyBlock> = (0..8).map(cc).collect();
-    z.show(&blocks);
+    z.show(&(0..8).map(cc).collect::<Vec<_>>());
     z.run_ms(400);
+    z
+}
+
+#[test]
+fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period() {
+    let mut z = heaviest_periods();
     let frames = decoded(&mut z);
     let last = frames.last().unwrap();
     assert_eq!(last.blocks, 4);
@@ -386,14 +391,7 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
     ]);
 
     // The heaviest period: odometry at 6,000 counts/s per wheel, eight colour-code blocks, sensors near timeout.
-    let mut z = calibrated_zumo();
-    z.run_ms(40);
-    z.press_a();
-    z.set_wheel_counts_per_second([6_000, 6_000]);
-    z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
-    let cc = |i: u16| PixyBlock { signature: 0o12, x: 10 + 30 * i, y: 150, width: 20, height: 20, angle: -45 };
-    z.show(&(0..8).map(cc).collect::<Vec<_>>());
-    z.run_ms(400);
+    let mut z = heaviest_periods();
     decoded(&mut z);
     let work = *z.period_work_cycles().iter().max().unwrap();
     let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
