@@ -8,8 +8,11 @@
 //! - `FIRMWARE_HASHER`: the hasher the firmware is built for (a name or bit
 //!   count as in `docs/state-hash.md`; default `original`). A blob of
 //!   another hasher fails the build.
+//! - `FIRMWARE_ROBOT_ID`: the robot's id, 0..=255 (default 0, none given),
+//!   stored with the policy's CRC in the image's identity record
+//!   (`shared::FirmwareIdentity`) and sent in every log frame.
 
-use shared::{PolicyBlob, RobotProfile, StateHasher};
+use shared::{FirmwareIdentity, PolicyBlob, RobotProfile, StateHasher};
 use std::fmt::Write as _;
 use std::path::PathBuf;
 use std::{env, fs};
@@ -25,6 +28,7 @@ fn fail(message: &str) -> ! {
 fn main() {
     println!("cargo:rerun-if-env-changed=FIRMWARE_POLICY");
     println!("cargo:rerun-if-env-changed=FIRMWARE_HASHER");
+    println!("cargo:rerun-if-env-changed=FIRMWARE_ROBOT_ID");
     println!("cargo:rerun-if-changed=build.rs");
     let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR")).join("..");
     let policy = root.join(env::var("FIRMWARE_POLICY").unwrap_or_else(|_| DEFAULT_POLICY.into()));
@@ -45,6 +49,13 @@ fn main() {
         ));
     }
 
+    let robot_id = match env::var("FIRMWARE_ROBOT_ID") {
+        Ok(v) => v.parse::<u8>().unwrap_or_else(|_| fail(&format!("FIRMWARE_ROBOT_ID={v} is not a robot id (0..=255)"))),
+        Err(_) => 0,
+    };
+    let policy_crc = FirmwareIdentity::policy_crc_of(&bytes).unwrap_or_else(|| fail("policy file too short"));
+    let identity = FirmwareIdentity { robot_id, policy_crc }.to_bytes();
+
     let motors = RobotProfile::ZUMO.action_motors(blob.actions());
     let mut out = String::new();
     let hasher = format!("{:?}", blob.hasher());
@@ -53,6 +64,8 @@ fn main() {
     writeln!(out, "pub const POLICY_PATH: &str = {:?};", policy.display().to_string()).unwrap();
     writeln!(out, "/// The embedded policy blob itself (for host tests; not linked into the AVR image).").unwrap();
     writeln!(out, "pub const POLICY_BLOB: &[u8] = include_bytes!({:?});", policy.display().to_string()).unwrap();
+    writeln!(out, "/// The image's identity record: robot id {robot_id}, policy CRC-32 {policy_crc:#010x}.").unwrap();
+    writeln!(out, "pub const IDENTITY: [u8; shared::FirmwareIdentity::LEN] = {identity:?};").unwrap();
     writeln!(out, "/// The policy's state hasher.").unwrap();
     writeln!(out, "pub const HASHER: shared::StateHasher = shared::StateHasher::{hasher};").unwrap();
     writeln!(out, "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout).").unwrap();

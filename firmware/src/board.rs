@@ -8,17 +8,26 @@
 //! | motors              | Timer1 mode 8, TOP (ICR1) 400 = 20 kHz; OCR1A/PB5 right, OCR1B/PB6 left; DIR PB1 right, PB2 left |
 //! | field sensors       | PF7 left (DN1), PF4 mid (DN3), PD6 right (DN5); emitters (LEDON, PB7) off |
 //! | clock               | Timer3 free-running at clk/64 (4 us ticks): control period and RC timing |
-//! | Pixy                | TWI master 100 kHz, address 0x54, one 2-byte read per word |
+//! | Pixy                | TWI master 100 kHz, address 0x54, one 2-byte read per word; a stuck bus is freed by clocking SCL by hand |
+//! | encoders            | left XOR PB4 (PCINT0 vector), B PE2; right XOR PE6 (INT6, any edge), B PF0; pulled-up inputs |
 //! | log                 | USART1 TX (PD3), 115200 8N1, U2X1            |
 //! | buttons             | A PB3, B PD5 (shared with the green LED), both active low |
 //! | LEDs                | yellow PC7 (high = on), green PD5 and red PB0 (low = on) |
-//! | decision marker     | GPIOR0: 1 before a decision, 2 after the motor writes (simulator cycle counting) |
+//! | markers             | GPIOR0 (simulator cycle counting): 4 at a period's start, 1 before a decision, 2 after the motor writes, 3 after the log frame is sent |
+//! | identity            | `shared::FirmwareIdentity` record in flash: robot id and policy CRC |
+//!
+//! Interrupts: only the two encoder interrupts are enabled; the timed
+//! sequences (watchdog, EEPROM) and the reads of the counts run with
+//! interrupts off.
 
 use avr_device::atmega32u4::Peripherals;
+use avr_device::interrupt::{self, Mutex};
 use core::arch::asm;
+use core::cell::Cell;
 use firmware::camera::{BusError, WordSource};
-use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, RC_TIMEOUT_TICKS, TICK_US, TWI_TIMEOUT_TICKS};
+use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS};
 use firmware::embedded;
+use firmware::odometry::Quadrature;
 use firmware::pins;
 use firmware::rc::Discharge;
 use firmware::supervisor::{Buttons, Leds};
@@ -28,17 +37,66 @@ use shared::{DriveOutputs, FieldScales};
 #[link_section = ".progmem.data"]
 static POLICY: [u8; embedded::POLICY.len()] = embedded::POLICY;
 
+/// The image's identity record (robot id, policy CRC), in flash; `host
+/// flash` finds it in the hex before writing it.
+#[link_section = ".progmem.data"]
+static IDENTITY: [u8; shared::FirmwareIdentity::LEN] = embedded::IDENTITY;
+
+/// Reads a byte of program memory.
+fn flash_byte(addr: *const u8) -> u8 {
+    let byte: u8;
+    // SAFETY: `lpm` reads program memory at Z; callers pass addresses of flash statics.
+    unsafe { asm!("lpm {0}, Z", out(reg) byte, in("Z") addr, options(pure, readonly, nostack)) };
+    byte
+}
+
+/// The robot id of this build, from the identity record in flash.
+pub fn robot_id() -> u8 {
+    flash_byte(IDENTITY.as_ptr().wrapping_add(shared::FirmwareIdentity::ROBOT_ID_OFFSET))
+}
+
+/// The left and right encoders, updated by their interrupts.
+static LEFT_ENCODER: Mutex<Cell<Quadrature>> = Mutex::new(Cell::new(Quadrature::new(false, false)));
+static RIGHT_ENCODER: Mutex<Cell<Quadrature>> = Mutex::new(Cell::new(Quadrature::new(false, false)));
+
+/// I/O addresses of the pin registers the encoder interrupts read.
+const PINB: *const u8 = 0x23 as *const u8;
+const PINE: *const u8 = 0x2C as *const u8;
+const PINF: *const u8 = 0x2F as *const u8;
+
+fn pin_high(register: *const u8, mask: u8) -> bool {
+    // SAFETY: a read of an I/O register, which has no side effects.
+    unsafe { core::ptr::read_volatile(register) & mask != 0 }
+}
+
+/// One encoder edge, in its interrupt (interrupts are off there).
+#[inline(always)]
+fn encoder_edge(encoder: &Mutex<Cell<Quadrature>>, xor: bool, b: bool) {
+    // SAFETY: called only from an interrupt handler, which runs with interrupts disabled.
+    let cs = unsafe { interrupt::CriticalSection::new() };
+    let cell = encoder.borrow(cs);
+    let mut q = cell.get();
+    q.edge(xor, b);
+    cell.set(q);
+}
+
+#[avr_device::interrupt(atmega32u4)]
+fn PCINT0() {
+    encoder_edge(&LEFT_ENCODER, pin_high(PINB, ENCODER_LEFT_XOR), pin_high(PINE, ENCODER_LEFT_B));
+}
+
+#[avr_device::interrupt(atmega32u4)]
+fn INT6() {
+    encoder_edge(&RIGHT_ENCODER, pin_high(PINE, ENCODER_RIGHT_XOR), pin_high(PINF, ENCODER_RIGHT_B));
+}
+
 /// The flash-resident policy table, readable by the decision.
 pub struct FlashPolicy;
 
 impl firmware::decision::PolicyBytes for FlashPolicy {
     fn byte(&self, index: usize) -> u8 {
         // Masked into the table (its length is a power of two).
-        let addr = POLICY.as_ptr().wrapping_add(index & (POLICY.len() - 1));
-        let byte: u8;
-        // SAFETY: `lpm` reads program memory at Z; the address lies in POLICY.
-        unsafe { asm!("lpm {0}, Z", out(reg) byte, in("Z") addr, options(pure, readonly, nostack)) };
-        byte
+        flash_byte(POLICY.as_ptr().wrapping_add(index & (POLICY.len() - 1)))
     }
 }
 
@@ -55,12 +113,27 @@ const BUTTON_B: u8 = pins::BUTTON_B_LED_GREEN.mask();
 const SENSOR_LEFT: u8 = pins::FIELD_SENSORS[0].mask(); // on PORTF
 const SENSOR_MID: u8 = pins::FIELD_SENSORS[1].mask(); // on PORTF
 const SENSOR_RIGHT: u8 = pins::FIELD_SENSORS[2].mask(); // on PORTD
+const ENCODER_LEFT_XOR: u8 = pins::ENCODER_LEFT_XOR.mask(); // on PORTB
+const ENCODER_LEFT_B: u8 = pins::ENCODER_LEFT_B.mask(); // on PORTE
+const ENCODER_RIGHT_XOR: u8 = pins::ENCODER_RIGHT_XOR.mask(); // on PORTE
+const ENCODER_RIGHT_B: u8 = pins::ENCODER_RIGHT_B.mask(); // on PORTF
+const SCL: u8 = pins::I2C_SCL.mask(); // on PORTD
+const SDA: u8 = pins::I2C_SDA.mask(); // on PORTD
 // Register bits (ATmega32U4 datasheet).
 const TWINT: u8 = 1 << 7;
 const TWEA: u8 = 1 << 6;
 const TWSTA: u8 = 1 << 5;
 const TWSTO: u8 = 1 << 4;
 const TWEN: u8 = 1 << 2;
+// TWI status codes (TWSR & 0xF8), master receiver.
+const TW_START: u8 = 0x08;
+const TW_REP_START: u8 = 0x10;
+const TW_SLA_ACK: u8 = 0x40;
+const TW_SLA_NACK: u8 = 0x48;
+const TW_DATA_ACK: u8 = 0x50;
+const TW_DATA_NACK: u8 = 0x58;
+/// Clock pulses that free any slave holding SDA (it sends at most 8 more bits).
+const RECOVERY_CLOCKS: u8 = 9;
 const PIXY_READ: u8 = (pins::PIXY_ADDRESS << 1) | 1;
 const WDE: u8 = 1 << 3;
 const WDCE: u8 = 1 << 4;
@@ -90,7 +163,8 @@ impl Board {
         let dp = unsafe { Peripherals::steal() };
         avr_device::asm::wdr();
         dp.CPU.mcusr().write(|w| unsafe { w.bits(0) }); // WDRF forces WDE on until cleared
-        // SAFETY: timed sequence (<= 4 cycles): set WDCE|WDE, then write 0.
+        // SAFETY: timed sequence (<= 4 cycles): set WDCE|WDE, then write 0
+        // (interrupts are not enabled yet).
         unsafe {
             asm!(
                 "sts 0x60, {ce}",
@@ -114,7 +188,8 @@ impl Board {
         dp.TC3.tccr3b().write(|w| unsafe { w.bits(0b011) });
         // Motors: outputs low; Timer1 mode 8 (phase and frequency correct,
         // TOP = ICR1 = 400), non-inverting OC1A/OC1B, clk/1: 20 kHz.
-        dp.PORTB.portb().write(|w| unsafe { w.bits(BUTTON_A | LED_RED) }); // A pull-up, red LED off, LEDON low
+        // A and the left encoder's XOR pulled up, red LED off, LEDON low.
+        dp.PORTB.portb().write(|w| unsafe { w.bits(BUTTON_A | LED_RED | ENCODER_LEFT_XOR) });
         dp.PORTB.ddrb().write(|w| unsafe { w.bits(LED_RED | DIR_RIGHT | DIR_LEFT | PWM_RIGHT | PWM_LEFT | EMITTERS) });
         dp.TC1.tccr1a().write(|w| unsafe { w.bits(0b1010_0000) });
         dp.TC1.tccr1b().write(|w| unsafe { w.bits(0b0001_0001) });
@@ -129,19 +204,50 @@ impl Board {
         dp.TWI.twsr().write(|w| unsafe { w.bits(0) });
         dp.TWI.twbr().write(|w| unsafe { w.bits(72) });
         dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
+        // Encoders: pulled-up inputs (PORTE, PF0; PB4 above); pin change
+        // interrupt on PB4 only, INT6 on any edge.
+        dp.PORTE.porte().write(|w| unsafe { w.bits(ENCODER_LEFT_B | ENCODER_RIGHT_XOR) });
+        dp.PORTF.portf().modify(|r, w| unsafe { w.bits(r.bits() | ENCODER_RIGHT_B) });
+        dp.EXINT.pcmsk0().write(|w| unsafe { w.bits(ENCODER_LEFT_XOR) });
+        dp.EXINT.pcicr().write(|w| unsafe { w.bits(1) }); // PCIE0
+        dp.EXINT.eicrb().write(|w| unsafe { w.bits(0b01 << 4) }); // ISC61..60 = 01: any edge
+        dp.EXINT.pcifr().write(|w| unsafe { w.bits(1) });
+        dp.EXINT.eifr().write(|w| unsafe { w.bits(1 << 6) });
+        dp.EXINT.eimsk().write(|w| unsafe { w.bits(1 << 6) });
+        interrupt::free(|cs| {
+            let left = Quadrature::new(pin_high(PINB, ENCODER_LEFT_XOR), pin_high(PINE, ENCODER_LEFT_B));
+            let right = Quadrature::new(pin_high(PINE, ENCODER_RIGHT_XOR), pin_high(PINF, ENCODER_RIGHT_B));
+            LEFT_ENCODER.borrow(cs).set(left);
+            RIGHT_ENCODER.borrow(cs).set(right);
+        });
         // USART1: 115200 8N1, U2X1 first, then UBRR1 = 16 (117.6 kbaud, +2.1 %).
         dp.USART1.ucsr1a().write(|w| unsafe { w.bits(1 << 1) });
         dp.USART1.ubrr1().write(|w| w.set(16));
         dp.USART1.ucsr1c().write(|w| unsafe { w.bits(0b0000_0110) });
         dp.USART1.ucsr1b().write(|w| unsafe { w.bits(1 << 3) }); // TXEN1
         self.period_start = self.now();
+        // SAFETY: the encoder state is initialised; nothing else uses interrupts.
+        unsafe { interrupt::enable() };
+    }
+
+    /// The encoder counts (left, right) since the last call.
+    pub fn take_encoder_counts(&self) -> [i16; 2] {
+        interrupt::free(|cs| {
+            [&LEFT_ENCODER, &RIGHT_ENCODER].map(|encoder| {
+                let cell = encoder.borrow(cs);
+                let mut q = cell.get();
+                let n = q.take();
+                cell.set(q);
+                n
+            })
+        })
     }
 
     /// Enables the watchdog (250 ms) for the control loop.
     pub fn watchdog_on(&mut self) {
         avr_device::asm::wdr();
-        // SAFETY: timed sequence (<= 4 cycles): WDCE|WDE, then WDE + prescaler.
-        unsafe {
+        // SAFETY: timed sequence (<= 4 cycles, interrupts off): WDCE|WDE, then WDE + prescaler.
+        interrupt::free(|_| unsafe {
             asm!(
                 "sts 0x60, {ce}",
                 "sts 0x60, {on}",
@@ -149,7 +255,7 @@ impl Board {
                 on = in(reg) WDE | WDP2,
                 options(nostack),
             );
-        }
+        });
     }
 
     /// Timer3 now, in 4 us ticks.
@@ -217,32 +323,16 @@ impl Board {
         f.portf().modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
         d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
         d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
-        // Poll: only sample the pins and the timer, and note when the pins
-        // change (at most once per sensor); the measurement is worked out
-        // from those changes afterwards, so a slow update never delays the
-        // detection of the next pin.
-        let start = self.now();
-        let mut changes = [(0u16, 0u8); 3];
-        let mut count = 0;
-        let mut seen = 0u8;
+        // Poll: only sample the pins and the timer; `Discharge` notes when a
+        // sensor is first seen low and works the times out afterwards.
+        let mut discharge = Discharge::start(self.now());
         loop {
             let (pf, pd) = (f.pinf().read().bits(), d.pind().read().bits());
             let now = self.now();
             let low = u8::from(pf & SENSOR_LEFT == 0) | u8::from(pf & SENSOR_MID == 0) << 1 | u8::from(pd & SENSOR_RIGHT == 0) << 2;
-            if low != seen {
-                if let Some(change) = changes.get_mut(count) {
-                    *change = (now, low);
-                    count += 1;
-                }
-                seen = low;
-            }
-            if low == 0b111 || now.wrapping_sub(start) >= RC_TIMEOUT_TICKS {
+            if discharge.sample(now, low) {
                 break;
             }
-        }
-        let mut discharge = Discharge::start(start);
-        for &(now, low) in changes.iter().take(count) {
-            discharge.sample(now, low);
         }
         discharge.times()
     }
@@ -262,7 +352,7 @@ impl Board {
         self.dp.TC1.ocr1b().write(|w| w.set(out.left.duty));
     }
 
-    /// Writes the decision marker (GPIOR0) the simulator test watches.
+    /// Writes a marker (GPIOR0) the simulator tests watch (see the module table).
     #[inline(always)]
     pub fn mark(&self, value: u8) {
         self.dp.CPU.gpior0().write(|w| unsafe { w.bits(value) });
@@ -305,22 +395,21 @@ impl Board {
             }
             e.eear().write(|w| w.set(addr + i as u16));
             e.eedr().write(|w| unsafe { w.bits(*byte) });
-            // SAFETY: timed sequence (<= 4 cycles, no interrupts are enabled):
-            // EEMPE, then EEPE, in EECR (I/O 0x1F).
-            unsafe { asm!("sbi 0x1f, 2", "sbi 0x1f, 1", options(nostack)) };
+            // SAFETY: timed sequence (<= 4 cycles, interrupts off): EEMPE,
+            // then EEPE, in EECR (I/O 0x1F).
+            interrupt::free(|_| unsafe { asm!("sbi 0x1f, 2", "sbi 0x1f, 1", options(nostack)) });
         }
     }
 
-    /// Waits for TWINT, or gives up after [`TWI_TIMEOUT_TICKS`]; returns TWSR's status.
+    /// Waits for TWINT, or gives up after [`TWI_TIMEOUT_TICKS`] (and
+    /// frees the bus); returns TWSR's status.
     fn twi_step(&self, control: u8) -> Result<u8, BusError> {
         let t = &self.dp.TWI;
         t.twcr().write(|w| unsafe { w.bits(control) });
         let start = self.now();
         while t.twcr().read().bits() & TWINT == 0 {
             if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
-                // Release the bus: disable and re-enable the TWI.
-                t.twcr().write(|w| unsafe { w.bits(0) });
-                t.twcr().write(|w| unsafe { w.bits(TWEN) });
+                self.twi_recover();
                 return Err(BusError::Stalled);
             }
         }
@@ -332,11 +421,47 @@ impl Board {
         let start = self.now();
         while self.dp.TWI.twcr().read().bits() & TWSTO != 0 {
             if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
-                self.dp.TWI.twcr().write(|w| unsafe { w.bits(0) });
-                self.dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
+                self.twi_recover();
                 return;
             }
         }
+    }
+
+    fn sda_low(&self) -> bool {
+        self.dp.PORTD.pind().read().bits() & SDA == 0
+    }
+
+    /// Frees a bus whose SDA a slave holds low (it was cut off mid-byte):
+    /// with the TWI off, clocks SCL by hand (open drain: driven low, or
+    /// released to the pull-up) until SDA is released, at most
+    /// [`RECOVERY_CLOCKS`] times, then sends a STOP and turns the TWI back
+    /// on. Returns whether SDA is free.
+    fn twi_recover(&self) -> bool {
+        let d = &self.dp.PORTD;
+        self.dp.TWI.twcr().write(|w| unsafe { w.bits(0) });
+        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
+        let half_period = || {
+            let t = self.now();
+            self.wait_until(t, 2);
+        };
+        for _ in 0..RECOVERY_CLOCKS {
+            if !self.sda_low() {
+                break;
+            }
+            d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | SCL) });
+            half_period();
+            d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !SCL) });
+            half_period();
+        }
+        // STOP: SDA rises while SCL is high.
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | SDA) });
+        half_period();
+        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !SDA) });
+        half_period();
+        let free = !self.sda_low();
+        self.dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
+        free
     }
 
     /// One read transaction of `N` bytes from the Pixy: START, SLA+R, the
@@ -347,19 +472,28 @@ impl Board {
         result
     }
 
+    /// Every step's status is checked: START (or repeated START), SLA+R
+    /// acknowledged, each byte received with the acknowledgement asked for.
     fn twi_read_inner<const N: usize>(&self) -> Result<[u8; N], BusError> {
+        if self.sda_low() && !self.twi_recover() {
+            return Err(BusError::Stuck);
+        }
         let status = self.twi_step(TWINT | TWSTA | TWEN)?;
-        if status != 0x08 && status != 0x10 {
-            return Err(BusError::Stalled);
+        if status != TW_START && status != TW_REP_START {
+            return Err(BusError::Unexpected);
         }
         self.dp.TWI.twdr().write(|w| unsafe { w.bits(PIXY_READ) });
-        if self.twi_step(TWINT | TWEN)? != 0x40 {
-            return Err(BusError::Nack);
+        match self.twi_step(TWINT | TWEN)? {
+            TW_SLA_ACK => {}
+            TW_SLA_NACK => return Err(BusError::Nack),
+            _ => return Err(BusError::Unexpected),
         }
         let mut out = [0u8; N];
         for (i, byte) in out.iter_mut().enumerate() {
-            let ack = if i + 1 < N { TWEA } else { 0 };
-            self.twi_step(TWINT | TWEN | ack)?;
+            let (ack, expected) = if i + 1 < N { (TWEA, TW_DATA_ACK) } else { (0, TW_DATA_NACK) };
+            if self.twi_step(TWINT | TWEN | ack)? != expected {
+                return Err(BusError::Unexpected);
+            }
             *byte = self.dp.TWI.twdr().read().bits();
         }
         Ok(out)

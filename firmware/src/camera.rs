@@ -20,6 +20,11 @@ pub enum BusError {
     Nack,
     /// A bus step did not complete in time (the bus is stalled).
     Stalled,
+    /// A device held SDA low and clocking SCL did not free it.
+    Stuck,
+    /// A step ended in a state the transaction does not allow (arbitration
+    /// lost, a bus error, a byte acknowledged other than asked).
+    Unexpected,
 }
 
 /// Where words come from: the board's TWI driver, or a test's script.

@@ -3,7 +3,7 @@
 //! Every duration is in ticks of Timer3, which runs free at clk/64: one
 //! tick is 4 us at 16 MHz, and the 16-bit counter wraps every 262 ms.
 
-use shared::{CameraConfig, FieldCalibration, MotorCommand, SensorRange};
+use shared::{CameraConfig, FieldCalibration, SensorRange};
 
 /// Length of one Timer3 tick, in microseconds (`shared`: the simulator
 /// quantises to the same ticks).
@@ -30,13 +30,12 @@ pub const PIXY_HOLD_PERIODS: u8 = 2;
 pub const TWI_TIMEOUT_TICKS: u16 = 1_000 / TICK_US;
 /// A fault is raised after this many bad control periods in a row.
 pub const FAULT_PERIODS: u8 = 3;
-/// Length of a calibration sweep: 4 s.
-pub const CALIBRATION_PERIODS: u16 = 200;
-/// Smallest calibrated range a sensor needs (100 us): less means it never
-/// saw the field's contrast.
+/// How long an armed calibration waits for the white-then-black screens
+/// before it fails: 60 s.
+pub const CALIBRATION_PERIODS: u16 = 3_000;
+/// Smallest calibrated range a sensor needs (100 us) between the white and
+/// the black screen: less means it does not see the display.
 pub const CALIBRATION_MIN_SPAN: u16 = 100 / TICK_US;
-/// Motor commands during a calibration sweep: a slow spin in place.
-pub const CALIBRATION_SPIN: MotorCommand = MotorCommand { left: 100, right: -100 };
 /// The calibration used until a valid one exists (the robot does not drive
 /// then; the values in the log are only indicative): the whole timing range.
 pub const UNCALIBRATED: FieldCalibration =

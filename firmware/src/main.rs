@@ -1,12 +1,13 @@
 //! Firmware entry point: the control loop. On the host this binary is empty
 //! so that the workspace builds; the AVR build is `scripts/build-firmware`.
 //!
-//! Each 20 ms period: buttons -> field sensors (RC timing) -> Pixy blocks
+//! Each 20 ms period: encoder counts of the period before -> buttons -> field sensors (RC timing) -> Pixy blocks
 //! -> supervisor (mode, faults) -> decision -> motors -> EEPROM (after a
-//! calibration sweep) -> LEDs -> log frame on USART1.
+//! calibration from the display's screens) -> LEDs -> log frame on USART1.
 #![cfg_attr(target_arch = "avr", no_std)]
 #![cfg_attr(target_arch = "avr", no_main)]
 #![cfg_attr(target_arch = "avr", feature(asm_experimental_arch))]
+#![cfg_attr(target_arch = "avr", feature(abi_avr_interrupt))]
 
 #[cfg(target_arch = "avr")]
 mod board;
@@ -16,11 +17,11 @@ mod board;
 fn main() -> ! {
     use firmware::calibration_record::{self, RECORD_LEN};
     use firmware::camera::Camera;
-    use firmware::config::{CALIBRATION_EEPROM_ADDR, CALIBRATION_SPIN, CAMERA, UNCALIBRATED};
+    use firmware::config::{CALIBRATION_EEPROM_ADDR, CAMERA, UNCALIBRATED};
     use firmware::decision::Decider;
     use firmware::embedded;
     use firmware::supervisor::Supervisor;
-    use shared::{LogFrame, RobotProfile};
+    use shared::LogFrame;
 
     let (mut board, scales) = board::Board::take();
     board.init();
@@ -34,23 +35,25 @@ fn main() -> ! {
     scales.calibrate(&calibration);
     let mut supervisor = Supervisor::new(stored.is_some());
     let mut camera = Camera::new();
-    let spin = RobotProfile::ZUMO.outputs(CALIBRATION_SPIN);
     let mut frame = [0u8; LogFrame::MAX_ENCODED_LEN];
     // Frames since the log last carried the calibration in use: it goes out
     // in the first frame, after a new one takes effect, and every
     // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
     let mut since_calibration = LogFrame::CALIBRATION_EVERY - 1;
+    let robot_id = board::robot_id();
 
     board.watchdog_on();
     loop {
         board.wait_period();
+        board.mark(4);
+        let encoder_counts = board.take_encoder_counts();
         let buttons = board.buttons();
         let times = board.field_sensors();
         let camera_ok = camera.acquire(&mut board).is_ok();
         let plan = supervisor.period(buttons, &times, camera_ok);
 
         let decider = Decider::new(scales, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
-        let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors, &spin);
+        let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;
@@ -78,9 +81,12 @@ fn main() -> ! {
             action: decision.action,
             motors: command,
             calibration: logged_calibration,
+            robot_id,
+            encoder_counts,
         };
         let n = log.encode(&mut frame);
         board.send(frame.get(..n).unwrap_or(&[]));
+        board.mark(3);
     }
 }
 
@@ -99,7 +105,6 @@ fn decide_and_drive(
     times: &[u16; 3],
     blocks: &[shared::PixyBlock],
     source: firmware::supervisor::MotorSource,
-    spin: &shared::DriveOutputs,
 ) -> (firmware::decision::Decision, shared::MotorCommand) {
     use firmware::supervisor::MotorSource;
     use shared::{DriveOutputs, MotorCommand};
@@ -107,7 +112,6 @@ fn decide_and_drive(
     let decision = decider.decide(times, blocks);
     let (outputs, command) = match source {
         MotorSource::Policy => (decision.outputs, decision.command),
-        MotorSource::Spin => (*spin, firmware::config::CALIBRATION_SPIN),
         MotorSource::Stop => (DriveOutputs::STOP, MotorCommand::default()),
     };
     board.set_motors(&outputs);

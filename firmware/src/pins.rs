@@ -2,8 +2,9 @@
 //! layer (`src/board.rs`) and the simavr harness (`tests/src/zumo.rs`) read
 //! them from. Pins are the ATmega32U4's port and bit as Pololu's Zumo 32U4
 //! library drives them (motors in `Zumo32U4Motors`, the front sensor array
-//! in `Zumo32U4LineSensors`, buttons and LEDs in `Zumo32U4Buttons.h` and
-//! `Zumo32U4.h`); the Pixy's address is its I2C default.
+//! in `Zumo32U4LineSensors`, encoders in `Zumo32U4Encoders`, buttons and
+//! LEDs in `Zumo32U4Buttons.h` and `Zumo32U4.h`); the Pixy's address is
+//! its I2C default.
 
 /// An I/O port of the ATmega32U4.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -75,6 +76,19 @@ pub const BUTTON_B_LED_GREEN: Pin = Pin::new(Port::D, 5);
 /// (PF4) and DN5 (PD6), read by RC discharge timing.
 pub const FIELD_SENSORS: [Pin; 3] = [Pin::new(Port::F, 7), Pin::new(Port::F, 4), Pin::new(Port::D, 6)];
 
+/// Left encoder, A XOR B, pin-change interrupt PCINT4 (PB4).
+pub const ENCODER_LEFT_XOR: Pin = Pin::new(Port::B, 4);
+/// Left encoder, channel B (PE2).
+pub const ENCODER_LEFT_B: Pin = Pin::new(Port::E, 2);
+/// Right encoder, A XOR B, external interrupt INT6 (PE6).
+pub const ENCODER_RIGHT_XOR: Pin = Pin::new(Port::E, 6);
+/// Right encoder, channel B (PF0).
+pub const ENCODER_RIGHT_B: Pin = Pin::new(Port::F, 0);
+/// I2C clock, SCL (PD0): driven by hand only to free a stuck bus.
+pub const I2C_SCL: Pin = Pin::new(Port::D, 0);
+/// I2C data, SDA (PD1).
+pub const I2C_SDA: Pin = Pin::new(Port::D, 1);
+
 /// The Pixy's 7-bit I2C address.
 pub const PIXY_ADDRESS: u8 = 0x54;
 
@@ -97,6 +111,12 @@ mod tests {
             FIELD_SENSORS[0],
             FIELD_SENSORS[1],
             FIELD_SENSORS[2],
+            ENCODER_LEFT_XOR,
+            ENCODER_LEFT_B,
+            ENCODER_RIGHT_XOR,
+            ENCODER_RIGHT_B,
+            I2C_SCL,
+            I2C_SDA,
         ];
         for (i, a) in all.iter().enumerate() {
             assert!(a.bit < 8);

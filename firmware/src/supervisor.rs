@@ -2,21 +2,23 @@
 //!
 //! - Button A starts and stops driving; it starts only with a valid
 //!   calibration.
-//! - Button B (while not driving) starts a calibration sweep: the robot
-//!   spins in place for [`CALIBRATION_PERIODS`] periods, recording each
-//!   sensor's extremes, then saves them (or flags the failure). A during a
-//!   sweep aborts it.
+//! - Button B (while not driving) arms the calibration from the display's
+//!   screens ([`ScreenCalibration`]): the robot stands still while the
+//!   display shows white, then black; it saves each sensor's two readings,
+//!   or flags the failure when no such sequence came within
+//!   [`CALIBRATION_PERIODS`](crate::config::CALIBRATION_PERIODS). A during
+//!   a calibration aborts it.
 //! - While driving, any runtime fault ([`Health`]) stops the motors until
 //!   the readings return.
 //!
 //! LEDs: yellow on = driving, yellow blinking (1 Hz) = ready; green on =
-//! calibrating; red blinking (5 Hz) = camera or sensor fault; red steady =
-//! no valid calibration (missing, corrupt, or the last sweep failed).
+//! calibrating, waiting for white; green blinking (5 Hz) = white seen,
+//! waiting for black; red blinking (5 Hz) = camera or sensor fault; red steady =
+//! no valid calibration (missing, corrupt, or the last calibration failed).
 
-use crate::config::CALIBRATION_PERIODS;
 use crate::health::Health;
 use crate::rc::all_timed_out;
-use crate::sweep::Sweep;
+use crate::screen_calibration::{Progress, ScreenCalibration};
 use shared::{FieldCalibration, Faults, RunMode};
 
 /// Button levels sampled this period (true = pressed).
@@ -35,8 +37,6 @@ pub enum MotorSource {
     Stop,
     /// The policy's decision.
     Policy,
-    /// The calibration spin.
-    Spin,
 }
 
 /// LED states (true = lit).
@@ -72,8 +72,7 @@ pub struct Supervisor {
     calibrated: bool,
     sticky: Faults,
     health: Health,
-    sweep: Sweep,
-    sweep_left: u16,
+    calibration: ScreenCalibration,
     last: Buttons,
     tick: u32,
 }
@@ -86,8 +85,7 @@ impl Supervisor {
             calibrated,
             sticky: Faults::NONE.set(Faults::NO_CALIBRATION, !calibrated),
             health: Health::default(),
-            sweep: Sweep::new(),
-            sweep_left: 0,
+            calibration: ScreenCalibration::new(),
             last: Buttons::default(),
             tick: 0,
         }
@@ -110,20 +108,19 @@ impl Supervisor {
         self.mode = match self.mode {
             RunMode::Idle if a && self.calibrated => RunMode::Driving,
             RunMode::Idle if b => {
-                self.sweep = Sweep::new();
-                self.sweep_left = CALIBRATION_PERIODS;
+                self.calibration = ScreenCalibration::new();
                 self.sticky = self.sticky.without(Faults::CALIBRATION_FAILED);
                 RunMode::Calibrating
             }
             RunMode::Driving if a => RunMode::Idle,
             RunMode::Calibrating if a => RunMode::Idle,
-            RunMode::Calibrating => {
-                self.sweep.add(times);
-                self.sweep_left = self.sweep_left.saturating_sub(1);
-                if self.sweep_left > 0 {
-                    RunMode::Calibrating
-                } else {
-                    save = self.sweep.finish();
+            RunMode::Calibrating => match self.calibration.add(times) {
+                Progress::Waiting => RunMode::Calibrating,
+                progress => {
+                    save = match progress {
+                        Progress::Done(c) => Some(c),
+                        _ => None,
+                    };
                     self.calibrated |= save.is_some();
                     self.sticky = self
                         .sticky
@@ -131,12 +128,11 @@ impl Supervisor {
                         .set(Faults::NO_CALIBRATION, !self.calibrated);
                     RunMode::Idle
                 }
-            }
+            },
             mode => mode,
         };
         let motors = match self.mode {
             RunMode::Driving if runtime.is_empty() => MotorSource::Policy,
-            RunMode::Calibrating => MotorSource::Spin,
             _ => MotorSource::Stop,
         };
         let blink = |periods: u32| (self.tick / periods) % 2 == 0;
@@ -146,7 +142,7 @@ impl Supervisor {
                 RunMode::Idle => self.calibrated && blink(25),
                 RunMode::Calibrating => false,
             },
-            green: self.mode == RunMode::Calibrating,
+            green: self.mode == RunMode::Calibrating && (!self.calibration.saw_white() || blink(5)),
             red: if !runtime.is_empty() { blink(5) } else { !self.sticky.is_empty() },
         };
         Plan { mode: self.mode, faults: self.sticky.with(runtime), motors, save, leds }
@@ -206,26 +202,27 @@ mod tests {
     }
 
     #[test]
-    fn a_sweep_calibrates_and_enables_driving() {
+    fn white_then_black_calibrates_standing_still_and_enables_driving() {
         let mut s = Supervisor::new(false);
         let mut p = press(&mut s, B);
-        assert_eq!((p.mode, p.motors), (RunMode::Calibrating, MotorSource::Spin));
+        assert_eq!((p.mode, p.motors), (RunMode::Calibrating, MotorSource::Stop));
         assert!(p.leds.green);
-        let mut n = 1;
+        let mut periods = 0;
         while p.mode == RunMode::Calibrating {
-            let t = 100 + (n % 2) * (CALIBRATION_MIN_SPAN + 50);
+            let t = if periods < 20 { 40 } else { 40 + CALIBRATION_MIN_SPAN + 50 };
             p = s.period(NONE, &[t; 3], true);
-            n += 1;
+            assert_eq!(p.motors, MotorSource::Stop);
+            periods += 1;
         }
-        assert_eq!(n, CALIBRATION_PERIODS);
+        assert_eq!(periods, 20 + crate::screen_calibration::WINDOW);
         let cal = p.save.expect("a calibration to save");
-        assert_eq!(cal.ranges[0].bright, 100);
+        assert_eq!((cal.ranges[0].bright, cal.ranges[0].dark), (40, 40 + CALIBRATION_MIN_SPAN + 50));
         assert!(p.faults.is_empty());
         assert_eq!(press(&mut s, A).mode, RunMode::Driving);
     }
 
     #[test]
-    fn a_sweep_without_contrast_fails_and_keeps_the_old_state() {
+    fn a_calibration_that_never_sees_black_fails_and_keeps_the_old_state() {
         let mut s = Supervisor::new(false);
         let mut p = press(&mut s, B);
         while p.mode == RunMode::Calibrating {
@@ -234,5 +231,13 @@ mod tests {
         assert_eq!(p.save, None);
         assert!(p.faults.contains(Faults::CALIBRATION_FAILED.with(Faults::NO_CALIBRATION)));
         assert_eq!(press(&mut s, A).mode, RunMode::Idle);
+    }
+
+    #[test]
+    fn a_aborts_a_calibration() {
+        let mut s = Supervisor::new(true);
+        press(&mut s, B);
+        let p = press(&mut s, A);
+        assert_eq!((p.mode, p.save, p.faults), (RunMode::Idle, None, Faults::NONE));
     }
 }

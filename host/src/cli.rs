@@ -137,6 +137,28 @@ pub struct ReplayArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Write each robot's measured wheel_speed_factor and turn_bias to this
+    /// JSON file ({"robots": [...]}); an existing fit file keeps its other
+    /// robots, so the logs of a swarm merge into one file.
+    #[arg(long)]
+    pub fit_profile: Option<PathBuf>,
+    /// Millimetres per simulator unit (a tenth of the robot radius; 6.5 for
+    /// the Zumo in its 65 mm skirt on the TV arena).
+    #[arg(long, default_value_t = 6.5, value_parser = parse_positive)]
+    pub mm_per_unit: f64,
+    /// Wheel encoder counts per millimetre of track travel (909.7 / 119 on 75:1 motors).
+    #[arg(long, default_value_t = 909.7 / 119.0, value_parser = parse_positive)]
+    pub counts_per_mm: f64,
+    /// Distance between the tracks' centre lines, mm.
+    #[arg(long, default_value_t = 85.0, value_parser = parse_positive)]
+    pub track_mm: f64,
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a positive number")),
+    }
 }
 
 /// `host flash`'s options (docs/robot-logs.md).
@@ -154,6 +176,10 @@ pub struct FlashArgs {
     /// The zumo-swarm checkout to build in (default: the one around the current directory).
     #[arg(long)]
     pub repo: Option<PathBuf>,
+    /// The robot's id, 0..=255, built into the firmware and sent in every
+    /// log frame (default 0: none); give each robot of a swarm its own.
+    #[arg(long, default_value_t = 0)]
+    pub robot_id: u8,
     /// Validate and print the exact commands; build and write nothing.
     #[arg(long)]
     pub dry_run: bool,

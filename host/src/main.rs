@@ -82,7 +82,17 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Monitor(args) => monitor(args),
         Command::Replay(args) => {
-            let report = host::robot::replay::replay_files(&args.log, &args.policy, args.visits.as_deref())?;
+            use host::robot::replay::{odometry, replay_files};
+            let settings = odometry::OdometrySettings {
+                mm_per_unit: args.mm_per_unit,
+                counts_per_mm: args.counts_per_mm,
+                track_mm: args.track_mm,
+            };
+            let report = replay_files(&args.log, &args.policy, args.visits.as_deref(), settings)?;
+            if let Some(path) = &args.fit_profile {
+                let file = odometry::merge_into_file(path, &report.motion)?;
+                eprintln!("replay: wrote {} ({} robots)", path.display(), file.robots.len());
+            }
             let text = if args.json {
                 serde_json::to_string(&report).context("cannot encode the report")? + "\n"
             } else {
@@ -93,7 +103,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Flash(args) => {
             use host::robot::flash;
             let cwd = std::env::current_dir().context("cannot read the current directory")?;
-            let plan = flash::FlashPlan::new(&args.policy, args.hasher, args.port, args.repo.as_deref(), &cwd)?;
+            let plan = flash::FlashPlan::new(&args.policy, args.hasher, args.port, args.repo.as_deref(), &cwd)?
+                .for_robot(args.robot_id);
             if args.dry_run {
                 return std::io::stdout().write_all(plan.describe().as_bytes()).context("cannot write the commands");
             }

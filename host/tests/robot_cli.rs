@@ -75,6 +75,69 @@ fn replay_reports_in_text_and_json_and_names_damaged_records() {
     assert_eq!(v["calibration_checked"].as_u64(), Some(4));
 }
 
+/// Driving frames of robot `id`, its tracks `counts` per period, as raw capture bytes.
+fn driving_capture(id: u8, motors: shared::MotorCommand, counts: [i16; 2]) -> Vec<u8> {
+    let blob = PolicyBlob::decode(&std::fs::read(policy_path()).unwrap()).unwrap();
+    let mut bytes = Vec::new();
+    for tick in 1..=20u32 {
+        let values = CAL.scales().values(&[240; 3]);
+        let reading = shared::SensorReading { left: values[0], mid: values[1], right: values[2], ..Default::default() };
+        let state = blob.hasher().hash(&reading);
+        let frame = LogFrame {
+            tick,
+            mode: RunMode::Driving,
+            raw_times: [240; 3],
+            values,
+            state,
+            action: blob.table().action(state),
+            motors,
+            robot_id: id,
+            encoder_counts: counts,
+            ..LogFrame::default()
+        };
+        let mut buf = [0u8; LogFrame::MAX_ENCODED_LEN];
+        let n = frame.encode(&mut buf);
+        bytes.extend(&buf[..n]);
+    }
+    bytes
+}
+
+#[test]
+fn replay_fits_each_robots_wheel_speed_and_turn_bias_into_one_file_for_the_swarm() {
+    let dir = tempfile::tempdir().unwrap();
+    let fit = dir.path().join("fit.json");
+    let straight = shared::MotorCommand { left: 150, right: 150 }; // 2 units per step
+    // Robot 1: 2 units x 6.5 mm x 2 counts/mm = 26 counts per track: as intended, drifting right.
+    // Robot 2: 10 % slow.
+    for (id, counts) in [(1u8, [27i16, 25]), (2, [23, 24])] {
+        let log = dir.path().join(format!("robot{id}.bin"));
+        std::fs::write(&log, driving_capture(id, straight, counts)).unwrap();
+        let out = host()
+            .args(["replay", "--counts-per-mm", "2", "--track-mm", "100", "--fit-profile"])
+            .arg(&fit)
+            .arg("--log")
+            .arg(&log)
+            .arg("--policy")
+            .arg(policy_path())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        assert!(text.contains(&format!("motion of robot {id}")) && text.contains("intended 2.000"), "{text}");
+    }
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&fit).unwrap()).unwrap();
+    let robots = v["robots"].as_array().unwrap();
+    assert_eq!(robots.len(), 2);
+    let get = |i: usize, k: &str| robots[i][k].as_f64().unwrap();
+    assert_eq!(robots[0]["id"].as_u64(), Some(1));
+    assert!((get(0, "wheel_speed_factor") - 1.0).abs() < 1e-3, "{v}");
+    // (27 - 25) counts / 2 per mm / 100 mm = 0.01 rad per step to the right.
+    assert!((get(0, "turn_bias") - 0.01).abs() < 1e-4, "{v}");
+    assert!((get(1, "wheel_speed_factor") - 23.5 / 26.0).abs() < 1e-3, "{v}");
+    assert!((get(1, "turn_bias") + 0.005).abs() < 1e-4, "{v}");
+    assert_eq!(robots[0].as_object().unwrap().keys().collect::<Vec<_>>(), ["id", "turn_bias", "wheel_speed_factor"]);
+}
+
 #[test]
 fn replay_and_monitor_errors_name_the_input() {
     let dir = tempfile::tempdir().unwrap();
@@ -100,6 +163,14 @@ fn replay_and_monitor_errors_name_the_input() {
     let e = fails(host().args(["replay", "--log"]).arg(&future).arg("--policy").arg(policy_path()));
     assert!(e.contains("future.log") && e.contains("format version 2 is not supported"), "{e}");
 
+    // 5,000 random bytes: no frame decodes, which is an error.
+    let noise = dir.path().join("noise.bin");
+    let mut x = 12345u32;
+    let bytes: Vec<u8> = (0..5000).map(|_| { x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345); (x >> 16) as u8 }).collect();
+    std::fs::write(&noise, bytes).unwrap();
+    let e = fails(host().args(["replay", "--log"]).arg(&noise).arg("--policy").arg(policy_path()));
+    assert!(e.contains("no frame in") && e.contains("noise.bin") && e.contains("decodes"), "{e}");
+
     let e = fails(host().args(["monitor", "--port", "/dev/null-port", "--out"]).arg(&log));
     assert!(e.contains("already exists") && e.contains("run.log"), "{e}");
     let e = fails(host().args(["monitor", "--out", "x.log"]));
@@ -108,14 +179,23 @@ fn replay_and_monitor_errors_name_the_input() {
 
 #[test]
 fn flash_dry_run_prints_the_exact_commands_and_validates_first() {
-    let out = host().current_dir(repo().join("host")).args(["flash", "--dry-run", "--port", "/dev/ttyACM0", "--policy"]).arg(policy_path()).output().unwrap();
+    let out = host()
+        .current_dir(repo().join("host"))
+        .args(["flash", "--dry-run", "--port", "/dev/ttyACM0", "--robot-id", "3", "--policy"])
+        .arg(policy_path())
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let repo = repo();
+    let crc = shared::FirmwareIdentity::policy_crc_of(&std::fs::read(policy_path()).unwrap()).unwrap();
     let expected = format!(
-        "FIRMWARE_POLICY={} FIRMWARE_HASHER=original {}/scripts/build-firmware\n\
-         # then double-press the robot's reset button (its bootloader waits 8 s); once /dev/ttyACM0 exists:\n\
-         avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U flash:w:{}/target/avr-none/firmware/firmware.hex:i\n",
+        "env -u CARGO_TARGET_DIR FIRMWARE_POLICY={} FIRMWARE_HASHER=original FIRMWARE_ROBOT_ID=3 \
+         FIRMWARE_OUT={}/target/flash/{crc:08x}-robot3 {}/scripts/build-firmware\n\
+         # check that the hex embeds policy CRC {crc:08x} and robot id 3, then double-press the robot's reset button \
+         (its bootloader waits 8 s); once /dev/ttyACM0 appears:\n\
+         avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U flash:w:{}/target/flash/{crc:08x}-robot3/firmware.hex:i\n",
         policy_path().display(),
+        repo.display(),
         repo.display(),
         repo.display()
     );

@@ -132,6 +132,17 @@ impl RobotProfile {
         MotorCommand { left: round(left), right: round(right) }
     }
 
+    /// The unicycle speeds (forward units per step, radians per step,
+    /// positive = right) that a motor command asks for: [`RobotProfile::mix`]
+    /// undone (before rounding and saturation, the same speeds; after
+    /// saturation, the slower ones the robot is really asked to drive).
+    pub fn unicycle(&self, command: MotorCommand) -> (f32, f32) {
+        let steps_per_second = 1000.0 / f32::from(self.control_period_ms.max(1));
+        let per_step = |c: i16| f32::from(c) / self.speed_scale / steps_per_second;
+        let (left, right) = (per_step(command.left), per_step(command.right));
+        ((left + right) / 2.0, (left - right) / self.wheel_track)
+    }
+
     /// Every action's commands ([`RobotProfile::mix`] at the table's forward
     /// speed) and outputs: the table the firmware embeds.
     pub fn action_motors(&self, actions: &ActionTable) -> ActionMotors {
@@ -188,6 +199,14 @@ mod tests {
         assert_eq!(c, MotorCommand { left: 341, right: -41 });
         let c = RobotProfile::ZUMO.mix(2.0, -0.15);
         assert_eq!(c, MotorCommand { left: 54, right: 246 });
+    }
+
+    #[test]
+    fn unicycle_undoes_the_mix() {
+        let p = RobotProfile::ZUMO;
+        let (v, w) = p.unicycle(p.mix(2.0, 0.3));
+        assert!((v - 2.0).abs() < 0.01 && (w - 0.3).abs() < 0.001, "{v} {w}");
+        assert_eq!(p.unicycle(MotorCommand { left: 150, right: 150 }), (2.0, 0.0));
     }
 
     #[test]

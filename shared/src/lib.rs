@@ -15,7 +15,8 @@
 //!   screen showed, as the robot's photo-transistors are read;
 //! - [`CameraConfig`]: Pixy camera blocks -> puck and obstacle bits;
 //! - [`RobotProfile`]: an action's unicycle speeds -> motor commands;
-//! - [`LogFrame`]: what the robot reports each control period.
+//! - [`LogFrame`]: what the robot reports each control period;
+//! - [`FirmwareIdentity`]: the policy and robot a firmware image is for.
 //!
 //! The crate is `no_std` and allocation-free so that the firmware links
 //! the very same code the simulator runs.
@@ -30,6 +31,7 @@ pub mod camera;
 pub mod drive;
 pub mod field;
 pub mod hasher;
+pub mod identity;
 pub mod log;
 pub mod policy;
 pub mod reading;
@@ -41,6 +43,7 @@ pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
 pub use drive::{ActionMotors, DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;
 pub use hasher::{State, StateHasher, StateInputs};
+pub use identity::FirmwareIdentity;
 pub use log::{Faults, LogError, LogFrame, RunMode};
 pub use policy::PolicyTable;
 pub use reading::SensorReading;

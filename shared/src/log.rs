@@ -1,14 +1,16 @@
 //! The robot's log frame: one per control period, sent on the serial line
 //! and decoded on the host with this same code.
 //!
-//! Wire format, format version 2:
+//! Wire format, format version 3:
 //!
 //! ```text
 //! COBS( version (1 byte) | postcard(LogFrame) | CRC-16 (LE) ) | 0x00
 //! ```
 //!
 //! Version 2 added [`LogFrame::calibration`], so that a host can recompute
-//! the calibrated values from the raw times (`host replay`).
+//! the calibrated values from the raw times (`host replay`); version 3
+//! added [`LogFrame::robot_id`] and [`LogFrame::encoder_counts`] (odometry).
+//! Frames of other versions are refused, by their version.
 //!
 //! - The first byte of every format's payload is its version, so a host
 //!   refuses frames of another format with [`LogError::UnsupportedVersion`]
@@ -34,8 +36,9 @@ const CRC16: Crc<u16, NoTable> = Crc::<u16, NoTable>::new(&CRC_16_IBM_3740);
 
 /// Largest body postcard can produce for a [`LogFrame`] (every varint at
 /// its longest): tick, mode, faults, raw times, values, blobs, blocks,
-/// state, action, motors, and the calibration (tag + six times).
-const MAX_BODY_LEN: usize = 5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3;
+/// state, action, motors, the calibration (tag + six times), the robot id
+/// and the two encoder counts.
+const MAX_BODY_LEN: usize = 5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3;
 /// Version byte + body + CRC.
 const MAX_RAW_LEN: usize = 1 + MAX_BODY_LEN + 2;
 
@@ -47,7 +50,8 @@ pub enum RunMode {
     Idle,
     /// Running the policy (motors stopped while a fault is flagged).
     Driving,
-    /// Sweeping the field to calibrate the field sensors.
+    /// Standing still, calibrating the field sensors on the display's white
+    /// and black screens.
     Calibrating,
 }
 
@@ -59,7 +63,8 @@ impl Faults {
     /// No valid calibration in EEPROM (missing or corrupt): the robot
     /// does not drive until calibrated.
     pub const NO_CALIBRATION: Faults = Faults(1);
-    /// The last calibration sweep saw too little contrast and was not saved.
+    /// The last calibration saw no white-then-black sequence of screens (or
+    /// too little contrast between them) and saved nothing.
     pub const CALIBRATION_FAILED: Faults = Faults(2);
     /// The Pixy has not acknowledged or has stalled the bus for several periods.
     pub const CAMERA_SILENT: Faults = Faults(4);
@@ -144,6 +149,13 @@ pub struct LogFrame {
     /// [`LogFrame::CALIBRATION_EVERY`] frames; it holds until the next
     /// one. `None` in the other frames.
     pub calibration: Option<FieldCalibration>,
+    /// The robot's id (`host flash --robot-id`, 0 when none was given), so
+    /// that logs of a whole swarm can be told apart and merged.
+    pub robot_id: u8,
+    /// Wheel encoder counts, left and right, during the control period
+    /// before this one (while the previous frame's motor commands drove);
+    /// positive = forward.
+    pub encoder_counts: [i16; 2],
 }
 
 /// Why a frame was refused.
@@ -177,9 +189,16 @@ impl fmt::Display for LogError {
             LogError::CrcMismatch { stored, computed } => {
                 write!(f, "log frame is corrupt: CRC-16 is {computed:#06x}, frame says {stored:#06x}")
             }
-            LogError::UnsupportedVersion(v) => {
-                write!(f, "log frame format version {v} is not supported (this build reads version {})", LogFrame::VERSION)
-            }
+            LogError::UnsupportedVersion(v) => write!(
+                f,
+                "log frame format version {v} is not supported (this build reads version {}; {})",
+                LogFrame::VERSION,
+                if v < LogFrame::VERSION {
+                    "recorded by older firmware: flash the robot again and record a new log"
+                } else {
+                    "recorded by newer firmware: update the host"
+                }
+            ),
             LogError::Malformed => f.write_str("log frame body does not decode"),
         }
     }
@@ -192,7 +211,7 @@ pub type EncodedFrame = [u8; LogFrame::MAX_ENCODED_LEN];
 
 impl LogFrame {
     /// The format version this build writes and reads.
-    pub const VERSION: u8 = 2;
+    pub const VERSION: u8 = 3;
     /// The robot repeats its calibration at least every this many frames
     /// (one second), so a host that starts listening mid-run learns it.
     pub const CALIBRATION_EVERY: u8 = 50;
@@ -272,6 +291,8 @@ mod tests {
             action: ActionId(3),
             motors: MotorCommand { left: 341, right: -41 },
             calibration: None,
+            robot_id: 7,
+            encoder_counts: [81, -12],
         }
     }
 
@@ -304,10 +325,12 @@ mod tests {
             mode: RunMode::Calibrating,
             blobs: BlobSummary { puck_left: true, puck_right: true, obstacle_left: true, obstacle_right: true },
             calibration: Some(FieldCalibration { ranges: [SensorRange { bright: u16::MAX, dark: u16::MAX }; 3] }),
+            robot_id: u8::MAX,
+            encoder_counts: [i16::MIN; 2],
         };
         let (buf, n) = encoded(&big);
         assert!(n <= LogFrame::MAX_ENCODED_LEN);
-        assert_eq!(LogFrame::MAX_ENCODED_LEN, 64, "docs/firmware.md states this bound");
+        assert_eq!(LogFrame::MAX_ENCODED_LEN, 71, "docs/firmware.md states this bound");
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(big));
     }
 
@@ -320,6 +343,9 @@ mod tests {
         let mut enc = [0u8; 16];
         let n = cobs::try_encode(&raw, &mut enc).unwrap();
         assert_eq!(LogFrame::decode(&enc[..n]), Err(LogError::UnsupportedVersion(1)));
+        extern crate std;
+        let message = std::format!("{}", LogError::UnsupportedVersion(2));
+        assert!(message.contains("version 2 is not supported") && message.contains("older firmware"), "{message}");
     }
 
     #[test]
@@ -371,11 +397,11 @@ mod tests {
         }
 
         #[test]
-        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>()) {
+        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>(), id in any::<u8>(), counts in any::<[i16; 2]>()) {
             let calibration = cal.map(|t| FieldCalibration {
                 ranges: [SensorRange { bright: t[0], dark: t[1] }, SensorRange { bright: t[2], dark: t[3] }, SensorRange { bright: t[4], dark: t[5] }],
             });
-            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, calibration, ..sample() };
+            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, calibration, robot_id: id, encoder_counts: counts, ..sample() };
             let (buf, n) = encoded(&f);
             prop_assert_eq!(LogFrame::decode(&buf[..n]), Ok(f));
         }

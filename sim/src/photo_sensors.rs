@@ -18,8 +18,9 @@
 //!    between a pin going low and the timer read that sees it, net of the
 //!    time between the pins becoming inputs and the start read;
 //! 5. the firmware's own calibration arithmetic ([`shared::FieldScales`])
-//!    with the calibration a sweep over the field would store: each
-//!    sensor's ticks at field 1.0 (bright) and 0.0 (dark).
+//!    with the calibration the robot's procedure stores (its readings on
+//!    the display's full-white and full-black screens, `docs/firmware.md`):
+//!    each sensor's ticks at field 1.0 (bright) and 0.0 (dark).
 //!
 //! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
 //! identical inputs identically.
@@ -139,8 +140,9 @@ impl PhotoSensorConfig {
         Ok(())
     }
 
-    /// The calibration a sweep over a field showing both 1.0 and 0.0 stores:
-    /// per sensor, the firmware's readings of its bright and dark times.
+    /// The calibration the robot stores from the display's white (1.0) and
+    /// black (0.0) screens: per sensor, the firmware's readings of its
+    /// bright and dark times.
     pub fn calibration(&self) -> FieldCalibration {
         let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
         FieldCalibration {

@@ -3,7 +3,9 @@
 //! [`zumo::Zumo`] runs the firmware's release ELF in simavr on an emulated
 //! Zumo 32U4 (field sensors, Pixy, buttons, motors, serial log);
 //! [`equivalence`] samples robot states from simulated episodes and
-//! computes what the firmware must do with them.
+//! computes what the firmware must do with them; [`figures`] keeps the
+//! figures the tests measure current in the docs.
 
 pub mod equivalence;
+pub mod figures;
 pub mod zumo;

@@ -1,6 +1,9 @@
 //! The firmware ELF running in simavr, wired like a Zumo 32U4 on a field:
-//! RC-timed field sensors, a Pixy on TWI, buttons, motor registers, the
-//! USART1 log and the decision marker.
+//! RC-timed field sensors (which check that the firmware's pull-ups are off
+//! while they discharge), a Pixy on TWI (its frames encoded here, from the
+//! Pixy's protocol, not by the firmware's code), wheel encoders, the I2C
+//! lines' pull-ups (and a device that can hold SDA low), buttons, motor
+//! registers, the USART1 log and the firmware's cycle markers.
 //!
 //! `avr-tester` runs the simulation; what it does not offer (USART1 on the
 //! 32U4, data memory, the cycle counter, EEPROM, I/O register hooks) goes
@@ -11,7 +14,6 @@
 
 use avr_tester::{AvrTester, TwiPacket};
 use firmware::pins::{self, Pin, Port, PIXY_ADDRESS};
-use firmware::pixy::encode_frame;
 use shared::{LogError, LogFrame, PixyBlock};
 use simavr_ffi as ffi;
 use std::cell::{Cell, RefCell};
@@ -43,6 +45,49 @@ const STATICS_END: usize = 0x0500;
 const RAM_END: usize = 0x0B00;
 /// The stack paint pattern.
 const PAINT: u8 = 0xA5;
+/// PORTD and PORTF in data memory: the field sensors' pull-up bits.
+const PORTD: usize = 0x2B;
+const PORTF: usize = 0x31;
+/// How long after a sensor pin becomes an input its pull-up must be off, cycles.
+const PULLUP_CHECK_CYCLES: u64 = 32;
+
+/// Pixy (CMUcam5) protocol words (`../shared/docs/hardware.md` section 5):
+/// a normal block's sync, a colour-code block's sync, a sync read one
+/// byte off.
+pub const PIXY_SYNC: u16 = 0xAA55;
+/// See [`PIXY_SYNC`].
+pub const PIXY_SYNC_CC: u16 = 0xAA56;
+/// See [`PIXY_SYNC`].
+pub const PIXY_SYNC_SWAPPED: u16 = 0x55AA;
+
+/// One camera frame as the Pixy sends it, written here from the protocol
+/// (not with the firmware's encoder): an extra sync starts the frame, then
+/// each block: its sync, the checksum (wrapping sum of the data words),
+/// signature, x, y, width, height and, for a colour code (signature above
+/// 7, octal digits), the angle.
+pub fn pixy_frame_words(blocks: &[PixyBlock]) -> Vec<u16> {
+    let mut words = Vec::new();
+    if blocks.is_empty() {
+        return words;
+    }
+    words.push(PIXY_SYNC);
+    for b in blocks {
+        let colour_code = b.signature > 7;
+        let mut data = vec![b.signature, b.x, b.y, b.width, b.height];
+        if colour_code {
+            data.push(b.angle as u16);
+        }
+        words.push(if colour_code { PIXY_SYNC_CC } else { PIXY_SYNC });
+        words.push(data.iter().fold(0u16, |sum, w| sum.wrapping_add(*w)));
+        words.extend(data);
+    }
+    words
+}
+
+/// Words as the Pixy sends them on I2C: little-endian.
+pub fn pixy_bytes(words: &[u16]) -> Vec<u8> {
+    words.iter().flat_map(|w| w.to_le_bytes()).collect()
+}
 
 /// The release ELF `scripts/build-firmware` writes; panics with what to run
 /// if it is missing (the tests never skip silently).
@@ -94,9 +139,175 @@ fn load(elf: &Path) -> (AvrTester, *mut ffi::avr_t) {
     (tester, avr)
 }
 
-/// One emulated field sensor: its pin's IRQ (the cycle timer's parameter).
+/// One emulated field sensor: its pin's IRQ (the cycle timers' parameter).
 struct RcSensor {
     irq: *mut ffi::avr_irq_t,
+    /// Its pin's bit in its port's PORT register, in data memory.
+    port: usize,
+    mask: u8,
+    /// Times the pull-up was found on while the sensor discharged.
+    pullup_on: Rc<Cell<u32>>,
+}
+
+impl RcSensor {
+    /// Counts a pull-up left on (the real sensor would not discharge).
+    ///
+    /// # Safety
+    /// `avr` must be the live core.
+    unsafe fn check_pullup(&self, avr: *mut ffi::avr_t) -> bool {
+        // SAFETY: the caller's contract; `port` lies in the data space.
+        let on = unsafe { *(*avr).data.add(self.port) } & self.mask != 0;
+        if on {
+            self.pullup_on.set(self.pullup_on.get() + 1);
+        }
+        on
+    }
+}
+
+/// One emulated wheel encoder: its XOR and B pins and its quadrature phase.
+struct Encoder {
+    avr: *mut ffi::avr_t,
+    pins: *mut ExternalPins,
+    xor: Pin,
+    b: Pin,
+    /// Phase 0..4 in the forward order A B = 00, 10, 11, 01: the XOR pin is
+    /// its low bit, B its high bit.
+    phase: u8,
+    /// Cycles between edges and their direction (`None`: standing).
+    every: Option<(u64, bool)>,
+    /// Edges sent, forward minus backward.
+    steps: i64,
+}
+
+impl Encoder {
+    /// Sets the pins to the current phase: B first, so that the XOR pin's
+    /// edge (the interrupt) sees both new levels.
+    ///
+    /// # Safety
+    /// The core must be live, `pins` the `Zumo`'s, with no other reference to it live.
+    unsafe fn drive(&self) {
+        // SAFETY: the caller's contract.
+        unsafe {
+            let pins = &mut *self.pins;
+            pins.drive(self.b, self.phase & 2 != 0);
+            pins.drive(self.xor, self.phase & 1 != 0);
+        }
+    }
+}
+
+unsafe extern "C" fn on_encoder_edge(_: *mut ffi::avr_t, when: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+    // SAFETY: `param` is a boxed `Encoder` of the `Zumo`, which outlives the core's timers.
+    let e = unsafe { &mut *(param as *mut Encoder) };
+    let Some((every, forward)) = e.every else { return 0 };
+    e.phase = if forward { (e.phase + 1) % 4 } else { (e.phase + 3) % 4 };
+    e.steps += if forward { 1 } else { -1 };
+    // SAFETY: the core is live while it runs its timers.
+    unsafe { e.drive() };
+    when + every
+}
+
+unsafe extern "C" fn on_pullup_check(avr: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+    // SAFETY: as in `on_discharged`.
+    let sensor = unsafe { &*(param as *const RcSensor) };
+    // SAFETY: simavr passes its live core.
+    unsafe { sensor.check_pullup(avr) };
+    0
+}
+
+/// The I2C lines: pulled up by the board, SDA possibly held low by a
+/// device until it has seen some SCL clocks.
+struct I2cLines {
+    pins: *mut ExternalPins,
+    scl: *mut ffi::avr_irq_t,
+    /// SDA is held low until this many more falling SCL edges (`Some(u32::MAX)`: for ever).
+    sda_held_for: Option<u32>,
+    last_scl: u32,
+    /// Falling SCL edges seen while SDA was held.
+    clocks_while_held: u32,
+}
+
+impl I2cLines {
+    /// Drives SDA: low while held, else the pull-up's high.
+    ///
+    /// # Safety
+    /// As [`Encoder::drive`].
+    unsafe fn apply(&mut self) {
+        // SAFETY: the caller's contract.
+        unsafe { (*self.pins).drive(pins::I2C_SDA, self.sda_held_for.is_none()) };
+    }
+}
+
+unsafe extern "C" fn on_scl(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_void) {
+    // SAFETY: `param` is the boxed `I2cLines` of the `Zumo`, which outlives the core.
+    let lines = unsafe { &mut *(param as *mut I2cLines) };
+    let falling = lines.last_scl != 0 && value == 0;
+    lines.last_scl = value;
+    if let (true, Some(n)) = (falling, lines.sda_held_for) {
+        lines.clocks_while_held += 1;
+        lines.sda_held_for = match n {
+            u32::MAX => Some(n),
+            0 | 1 => None,
+            n => Some(n - 1),
+        };
+        if lines.sda_held_for.is_none() {
+            // SAFETY: the core is live while it notifies.
+            unsafe { lines.apply() };
+        }
+    }
+}
+
+/// Pins driven from outside the chip (buttons with their pull-ups, encoder
+/// outputs, the I2C lines' pull-ups and a device on them): simavr's
+/// "external" state of each port, so that its emulation of the internal
+/// pull-ups (which raises an input whose PORT bit is set whenever the
+/// firmware writes PORT) never overrides what drives the pin.
+struct ExternalPins {
+    avr: *mut ffi::avr_t,
+    /// Per port (B, C, D, E, F): the pins driven from outside, and their levels.
+    ports: [(u8, u8); 5],
+}
+
+impl ExternalPins {
+    /// Drives `pin` to `high` from outside.
+    ///
+    /// # Safety
+    /// The core must be live.
+    unsafe fn drive(&mut self, pin: Pin, high: bool) {
+        let index = match pin.port {
+            Port::B => 0,
+            Port::C => 1,
+            Port::D => 2,
+            Port::E => 3,
+            Port::F => 4,
+        };
+        let (mask, value) = &mut self.ports[index];
+        *mask |= pin.mask();
+        *value = if high { *value | pin.mask() } else { *value & !pin.mask() };
+        // SAFETY: the caller's contract.
+        unsafe {
+            set_external(self.avr, pin.port, *mask, *value);
+            let irq = ffi::avr_io_getirq(self.avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit));
+            ffi::avr_raise_irq(irq, u32::from(high));
+        }
+    }
+}
+
+/// Sets a port's external state (pins not driven by the firmware read
+/// `value` where `mask` is set).
+///
+/// # Safety
+/// `avr` must be the live core.
+unsafe fn set_external(avr: *mut ffi::avr_t, port: Port, mask: u8, value: u8) {
+    let mut ext = ffi::avr_ioport_external_t {
+        _bitfield_align_1: [],
+        _bitfield_1: Default::default(),
+        __bindgen_padding_0: Default::default(),
+    };
+    ext.set_name(u64::from(port.letter()));
+    ext.set_mask(u64::from(mask));
+    ext.set_value(u64::from(value));
+    // SAFETY: the caller's contract; `ext` is the ioport's external-state record.
+    unsafe { ffi::avr_ioctl(avr, ioctl(b'i', b'o', b'p', port.letter()), &mut ext as *mut _ as *mut c_void) };
 }
 
 /// The emulated Pixy: a byte queue refilled with the current scene once per
@@ -107,7 +318,8 @@ struct RcSensor {
 struct Pixy {
     avr: *mut ffi::avr_t,
     present: bool,
-    scene: Vec<PixyBlock>,
+    /// The bytes of one frame of the current scene.
+    scene: Vec<u8>,
     /// The scene changed since the last frame was queued.
     changed: bool,
     /// The next byte is the first of a read transaction.
@@ -125,9 +337,7 @@ impl Pixy {
         if self.bytes.is_empty() && word_start && due {
             self.changed = false;
             self.last_frame = now;
-            let mut words = [0u16; 128];
-            let n = encode_frame(&self.scene, &mut words);
-            self.bytes.extend(words[..n].iter().flat_map(|w| w.to_le_bytes()));
+            self.bytes.extend(&self.scene);
         }
         self.bytes.pop_front().unwrap_or(0)
     }
@@ -179,11 +389,15 @@ unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v
     }
 }
 
-unsafe extern "C" fn on_discharged(_: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+unsafe extern "C" fn on_discharged(avr: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
     // SAFETY: `param` points into the boxed `State`'s sensors (registered in
     // `on_ddr`); its IRQ is the pin's, valid while the core lives.
     let sensor = unsafe { &*(param as *const RcSensor) };
-    unsafe { ffi::avr_raise_irq(sensor.irq, 0) };
+    // A pull-up left on holds the pin high: it never discharges.
+    // SAFETY: simavr passes its live core.
+    if unsafe { !sensor.check_pullup(avr) } {
+        unsafe { ffi::avr_raise_irq(sensor.irq, 0) };
+    }
     0
 }
 
@@ -208,14 +422,20 @@ unsafe fn on_ddr(port: Port, value: u32, param: *mut c_void) {
         let mask = pin.mask();
         if old & mask != 0 && new & mask == 0 {
             // Charged, now an input: discharge after the sensor's delay.
-            if let Some(delay) = state.delays[i] {
-                // SAFETY: the core is live; the sensor lives in the boxed
-                // state, which outlives every timer of the core.
-                unsafe { ffi::avr_cycle_timer_register(state.avr, delay, Some(on_discharged), sensor as *mut c_void) };
+            // SAFETY: the core is live; the sensor lives in the boxed
+            // state, which outlives every timer of the core.
+            unsafe {
+                ffi::avr_cycle_timer_register(state.avr, PULLUP_CHECK_CYCLES, Some(on_pullup_check), sensor as *mut c_void);
+                if let Some(delay) = state.delays[i] {
+                    ffi::avr_cycle_timer_register(state.avr, delay, Some(on_discharged), sensor as *mut c_void);
+                }
             }
         } else if old & mask == 0 && new & mask != 0 {
             // SAFETY: as above; cancelling an unregistered timer is a no-op.
-            unsafe { ffi::avr_cycle_timer_cancel(state.avr, Some(on_discharged), sensor as *mut c_void) };
+            unsafe {
+                ffi::avr_cycle_timer_cancel(state.avr, Some(on_discharged), sensor as *mut c_void);
+                ffi::avr_cycle_timer_cancel(state.avr, Some(on_pullup_check), sensor as *mut c_void);
+            }
         }
     }
 }
@@ -244,8 +464,11 @@ pub struct Zumo {
     tester: AvrTester,
     state: Box<State>,
     pixy: Rc<RefCell<Pixy>>,
-    buttons: [u8; 2],
+    encoders: [Box<Encoder>; 2],
+    i2c: Box<I2cLines>,
+    external: Box<ExternalPins>,
     decoded: usize,
+    pullup_on: Rc<Cell<u32>>,
 }
 
 impl Zumo {
@@ -258,6 +481,11 @@ impl Zumo {
     /// [`Zumo::boot`] with another build of the firmware.
     pub fn boot_elf(elf: &Path) -> Zumo {
         let (tester, avr) = load(elf);
+        let pullup_on = Rc::new(Cell::new(0));
+        let pin_irq = |pin: Pin| {
+            // SAFETY: `avr` is the core just loaded; null IRQs are checked below.
+            unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit)) }
+        };
         let mut state = Box::new(State {
             avr,
             uart: Vec::new(),
@@ -266,9 +494,27 @@ impl Zumo {
             ddr: [0; 2],
             delays: [Some(CLOCK_HZ / 1000); 3],
             sensors: pins::FIELD_SENSORS.map(|pin| RcSensor {
-                // SAFETY: `avr` is the core just loaded; a null IRQ is checked below.
-                irq: unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit)) },
+                irq: pin_irq(pin),
+                port: if pin.port == Port::F { PORTF } else { PORTD },
+                mask: pin.mask(),
+                pullup_on: pullup_on.clone(),
             }),
+        });
+        let mut external = Box::new(ExternalPins { avr, ports: [(0, 0); 5] });
+        let external_ptr = &mut *external as *mut ExternalPins;
+        let encoder = |xor: Pin, b: Pin| {
+            Box::new(Encoder { avr, pins: external_ptr, xor, b, phase: 0, every: None, steps: 0 })
+        };
+        let encoders = [
+            encoder(pins::ENCODER_LEFT_XOR, pins::ENCODER_LEFT_B),
+            encoder(pins::ENCODER_RIGHT_XOR, pins::ENCODER_RIGHT_B),
+        ];
+        let mut i2c = Box::new(I2cLines {
+            pins: external_ptr,
+            scl: pin_irq(pins::I2C_SCL),
+            sda_held_for: None,
+            last_scl: 1,
+            clocks_while_held: 0,
         });
         let state_ptr = &mut *state as *mut State;
         // SAFETY: `avr` is the live core; the callbacks get the boxed state,
@@ -291,6 +537,13 @@ impl Zumo {
                 ffi::avr_irq_register_notify(irq, Some(f), state_ptr as *mut c_void);
             }
             ffi::avr_register_io_write(avr, GPIOR0, Some(on_gpior0), state_ptr as *mut c_void);
+            for e in &encoders {
+                e.drive();
+            }
+            let lines = &mut *i2c as *mut I2cLines;
+            ffi::avr_irq_register_notify(i2c.scl, Some(on_scl), lines as *mut c_void);
+            (*external_ptr).drive(pins::I2C_SCL, true);
+            i2c.apply();
         }
         let pixy = Rc::new(RefCell::new(Pixy {
             avr,
@@ -301,7 +554,8 @@ impl Zumo {
             bytes: VecDeque::new(),
             last_frame: 0,
         }));
-        let mut zumo = Zumo { tester, state, pixy: pixy.clone(), buttons: [0; 2], decoded: 0 };
+        let mut zumo =
+            Zumo { tester, state, pixy: pixy.clone(), encoders, i2c, external, decoded: 0, pullup_on };
         zumo.tester.twi0().attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
         zumo.set_button(pins::BUTTON_A, false);
         zumo.set_button(pins::BUTTON_B_LED_GREEN, false);
@@ -344,10 +598,55 @@ impl Zumo {
     /// What the Pixy sees from now on: its next frame (served at the next
     /// read) shows it.
     pub fn show(&mut self, blocks: &[PixyBlock]) {
+        self.show_bytes(&pixy_bytes(&pixy_frame_words(blocks)));
+    }
+
+    /// What the Pixy sends per frame from now on, byte for byte (garbage,
+    /// misaligned words, bad checksums: anything).
+    pub fn show_bytes(&mut self, bytes: &[u8]) {
         let mut p = self.pixy.borrow_mut();
-        p.scene = blocks.to_vec();
+        p.scene = bytes.to_vec();
         p.bytes.clear();
         p.changed = true;
+    }
+
+    /// Drives the wheels: each encoder sends `counts_per_second` edges
+    /// (negative: backwards; 0: stands), evenly spaced, from now on.
+    pub fn set_wheel_counts_per_second(&mut self, counts_per_second: [i32; 2]) {
+        for (e, rate) in self.encoders.iter_mut().zip(counts_per_second) {
+            let param = &mut **e as *mut Encoder as *mut c_void;
+            // SAFETY: the core is live; the encoder is boxed in `self`, which outlives the core's timers.
+            unsafe { ffi::avr_cycle_timer_cancel(e.avr, Some(on_encoder_edge), param) };
+            e.every = (rate != 0).then(|| (CLOCK_HZ / u64::from(rate.unsigned_abs()), rate > 0));
+            if let Some((every, _)) = e.every {
+                // SAFETY: as above.
+                unsafe { ffi::avr_cycle_timer_register(e.avr, every, Some(on_encoder_edge), param) };
+            }
+        }
+    }
+
+    /// Encoder edges sent since boot, left and right (forward minus backward).
+    pub fn encoder_steps(&self) -> [i64; 2] {
+        [self.encoders[0].steps, self.encoders[1].steps]
+    }
+
+    /// A device on the I2C bus holds SDA low until it has seen `clocks`
+    /// falling SCL edges (`None`: for ever), as a slave cut off mid-byte does.
+    pub fn hold_sda_low(&mut self, clocks: Option<u32>) {
+        self.i2c.sda_held_for = Some(clocks.unwrap_or(u32::MAX).max(1));
+        self.i2c.clocks_while_held = 0;
+        // SAFETY: the core is live.
+        unsafe { self.i2c.apply() };
+    }
+
+    /// Falling SCL edges the firmware clocked while SDA was held low.
+    pub fn scl_clocks_while_sda_held(&self) -> u32 {
+        self.i2c.clocks_while_held
+    }
+
+    /// Whether SDA is still held low.
+    pub fn sda_held(&self) -> bool {
+        self.i2c.sda_held_for.is_some()
     }
 
     /// Connects or disconnects the Pixy (disconnected: it NACKs its address).
@@ -358,24 +657,9 @@ impl Zumo {
     }
 
     fn set_button(&mut self, pin: Pin, pressed: bool) {
-        let (port, bit) = (pin.port.letter(), pin.bit);
-        let slot = usize::from(pin.port == Port::D);
-        self.buttons[slot] |= pin.mask();
-        let mut ext = ffi::avr_ioport_external_t {
-            _bitfield_align_1: [],
-            _bitfield_1: Default::default(),
-            __bindgen_padding_0: Default::default(),
-        };
-        ext.set_name(u64::from(port));
-        ext.set_mask(u64::from(self.buttons[slot]));
-        // Pull-ups make released buttons read high.
-        ext.set_value(if pressed { u64::from(self.buttons[slot] & !(1 << bit)) } else { u64::from(self.buttons[slot]) });
-        // SAFETY: the core is live; `ext` is the ioport's external-state record.
-        unsafe {
-            ffi::avr_ioctl(self.state.avr, ioctl(b'i', b'o', b'p', port), &mut ext as *mut _ as *mut c_void);
-            let irq = ffi::avr_io_getirq(self.state.avr, ioctl(b'i', b'o', b'g', port), c_int::from(bit));
-            ffi::avr_raise_irq(irq, u32::from(!pressed));
-        }
+        // Released, the pull-up makes it read high.
+        // SAFETY: the core is live; no callback holds the external pins now.
+        unsafe { self.external.drive(pin, !pressed) };
     }
 
     /// Presses button A for 60 ms (three control periods), then releases it.
@@ -392,16 +676,28 @@ impl Zumo {
         self.set_button(pins::BUTTON_B_LED_GREEN, false);
     }
 
-    /// Presses button B and plays the calibration sweep: the robot spins
-    /// over bright (100 ticks) and dark (400 ticks) field, alternating every
-    /// 20 ms period, until the sweep ends (215 periods).
-    pub fn calibrate(&mut self) {
+    /// The calibration procedure (`docs/firmware.md`): button B, then the
+    /// display's white screen for 300 ms and its black screen for 300 ms,
+    /// as RC delays in CPU cycles on the sensor pins (`None`: never
+    /// discharges).
+    pub fn calibrate_cycles(&mut self, white: [Option<u64>; 3], black: [Option<u64>; 3]) {
         self.press_b();
-        for i in 0..215u16 {
-            let t = if i % 2 == 0 { 100 } else { 400 };
-            self.set_sensor_ticks([Some(t), Some(t + 10), Some(t + 20)]);
-            self.run_ms(20);
-        }
+        self.set_sensor_cycles(white);
+        self.run_ms(300);
+        self.set_sensor_cycles(black);
+        self.run_ms(300);
+    }
+
+    /// [`Zumo::calibrate_cycles`] with the times in Timer3 ticks.
+    pub fn calibrate_ticks(&mut self, white: [Option<u16>; 3], black: [Option<u16>; 3]) {
+        let cycles = |t: [Option<u16>; 3]| t.map(|t| t.map(|t| u64::from(t) * CYCLES_PER_TICK));
+        self.calibrate_cycles(cycles(white), cycles(black));
+    }
+
+    /// The procedure with a white screen of 100, 110, 120 ticks and a black
+    /// one of 400, 410, 420 ticks.
+    pub fn calibrate(&mut self) {
+        self.calibrate_ticks([Some(100), Some(110), Some(120)], [Some(400), Some(410), Some(420)]);
     }
 
     /// Runs the firmware for `ms` simulated milliseconds.
@@ -473,7 +769,11 @@ impl Zumo {
     }
 
     /// Log frames received since the last call, decoded with `shared`.
+    /// Panics if the firmware ever left a field sensor's pull-up on while
+    /// it discharged.
     pub fn frames(&mut self) -> Vec<Result<LogFrame, LogError>> {
+        let pullups = self.pullup_on.get();
+        assert_eq!(pullups, 0, "the firmware left a field sensor's pull-up on while it discharged ({pullups} times)");
         let uart = &self.state.uart;
         let mut out = Vec::new();
         let mut start = self.decoded;
@@ -489,6 +789,31 @@ impl Zumo {
 
     /// Cycles from each decision-start marker to its decision-end marker.
     pub fn decision_cycles(&self) -> Vec<u64> {
-        self.state.marks.windows(2).filter(|w| w[0].0 == 1 && w[1].0 == 2).map(|w| w[1].1 - w[0].1).collect()
+        self.marker_spans(1, 2)
+    }
+
+    /// Cycles from each period's start (marker 4) to the end of its log
+    /// frame (marker 3): the period's work, which must fit in 20 ms.
+    pub fn period_work_cycles(&self) -> Vec<u64> {
+        self.marker_spans(4, 3)
+    }
+
+    /// Cycles between consecutive period starts.
+    pub fn period_cycles(&self) -> Vec<u64> {
+        let starts: Vec<u64> = self.state.marks.iter().filter(|m| m.0 == 4).map(|m| m.1).collect();
+        starts.windows(2).map(|w| w[1] - w[0]).collect()
+    }
+
+    fn marker_spans(&self, from: u8, to: u8) -> Vec<u64> {
+        let mut spans = Vec::new();
+        let mut start = None;
+        for &(v, cycle) in &self.state.marks {
+            if v == from {
+                start = Some(cycle);
+            } else if v == to {
+                spans.extend(start.take().map(|s| cycle - s));
+            }
+        }
+        spans
     }
 }

@@ -28,7 +28,11 @@ use tests::equivalence::{
     check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, mirrored, nudge, read_policy, sample_states, Expectation,
     Expected, Sample,
 };
+use tests::figures::{compiler_of, thousands, Figures, Outcome};
 use tests::zumo::{firmware_elf_in, Zumo};
+
+/// The command that regenerates the figures in `docs/equivalence.md`.
+const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test equivalence";
 
 /// States per field; three fields give over 1,000 per hasher.
 const PER_FIELD: usize = 340;
@@ -75,11 +79,21 @@ struct Observed {
     directions: (bool, bool),
 }
 
-/// A calibrated Zumo running `elf`, driving, stopped right after a decision.
-fn driving_zumo(elf: &std::path::Path, model: &RobotSensors) -> Zumo {
+/// A Zumo running `elf`, calibrated by the real procedure (button B, then
+/// the display's white and black screens as RC delays on the sensor pins:
+/// each sensor's model time at field 1.0 and at 0.0, placed mid-tick as in
+/// the exact check), driving, stopped right after a decision. Panics unless
+/// the stored calibration is the simulator's.
+fn driving_zumo(elf: &std::path::Path, model: &RobotSensors, latency_us: f64) -> Zumo {
     let mut z = Zumo::boot_elf(elf);
-    z.write_eeprom(0, &calibration_record::encode(&model.calibration()));
     z.run_ms(40);
+    let cal = model.calibration();
+    let screen = |ticks: [u16; 3]| ticks.map(|t| Some(cycles_of_ticks(t, latency_us)));
+    z.calibrate_cycles(screen(cal.ranges.map(|r| r.bright)), screen(cal.ranges.map(|r| r.dark)));
+    let record: [u8; calibration_record::RECORD_LEN] =
+        z.read_eeprom(0, calibration_record::RECORD_LEN).try_into().expect("a record's bytes");
+    let stored = calibration_record::decode(&record);
+    assert_eq!(stored, Ok(cal), "the procedure must store the simulator's calibration (PhotoSensorConfig::calibration)");
     z.press_a();
     z.run_to_decision();
     z
@@ -203,7 +217,7 @@ fn equivalence(v: &Variant) {
     }
     assert!(histogram.iter().all(|&n| n > 0), "the sample does not exercise all four actions: {histogram:?}");
 
-    let mut z = driving_zumo(&elf, &model);
+    let mut z = driving_zumo(&elf, &model, config.field.poll_latency_us);
     let mut holding = false;
     let stimuli: Vec<Stimulus<'_>> = samples
         .iter()
@@ -312,6 +326,29 @@ fn equivalence(v: &Variant) {
     );
     println!("wall time {:.1} s", started.elapsed().as_secs_f64());
 
+    let pct = |k: usize| format!("{} / {} ({:.1} %)", thousands(k as u64), thousands(n as u64), percent(k, n));
+    let offsets_text = |o: &[(i32, usize)]| {
+        o.iter().map(|(d, c)| format!("{d:+}: {}", thousands(*c as u64))).collect::<Vec<_>>().join(", ").replace("+0", "0")
+    };
+    let mut figures = Figures::new(&compiler_of(&elf));
+    figures.fixed(&["states checked", &thousands(n as u64)]);
+    figures.fixed(&["actions over the sample (0..3)", &histogram.map(|h| thousands(h as u64)).join(", ")]);
+    figures.fixed(&["calibration by the procedure (white, then black) = the simulator's", "yes"]);
+    figures.fixed(&["exact check", &pct(exact)]);
+    figures.fixed(&["stimuli nudged", &pct(nudged_count)]);
+    figures.fixed(&["mirrored expectations mismatch", &pct(mirror_mismatches)]);
+    figures.fixed(&["another policy mismatches", &pct(other_mismatches)]);
+    figures.compiled(&["firmware raw time - stimulus ticks (exact check, per reading)", &offsets_text(&exact_offsets)]);
+    figures.compiled(&["end-to-end state agreement", &pct(agree)]);
+    figures.compiled(&["end-to-end action agreement", &pct(e2e_action_agree)]);
+    figures.compiled(&["disagreements explained by a one-tick move", &thousands(explained.len() as u64)]);
+    figures.compiled(&["unexplained disagreements", &thousands(unexplained.len() as u64)]);
+    figures.compiled(&["firmware raw time - model ticks (end to end, per reading)", &offsets_text(&offsets)]);
+    figures.compiled(&[
+        "cycles per decision (min / mean / max)",
+        &format!("{} / {} / {}", thousands(*cycles.iter().min().unwrap_or(&0)), thousands(mean.round() as u64), thousands(worst)),
+    ]);
+
     assert!(
         mismatches.is_empty(),
         "{} of {n} periods differ, first: {:#?}",
@@ -328,6 +365,13 @@ fn equivalence(v: &Variant) {
     );
     assert!(unexplained.is_empty(), "unexplained end-to-end disagreements: {unexplained:#?}");
     assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles, budget {BUDGET_CYCLES}");
+
+    let header = ["figure", &format!("{} ({})", v.policy, v.hasher.name())];
+    match figures.check("docs/equivalence.md", v.elf_dir, &header, REGENERATE) {
+        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
+        Ok(_) => {}
+        Err(e) => panic!("{e:#}"),
+    }
 }
 
 #[test]

@@ -1,17 +1,17 @@
 //! Smoke tests of the firmware's release ELF in simavr (`scripts/build-firmware`
 //! builds it; these tests fail, never skip, when it is missing).
 //!
-//! The emulated Zumo has RC-timed field sensors, a Pixy on TWI, buttons A
-//! and B; the tests read the motor duties from OCR1A/OCR1B and decode the
-//! USART1 log frames with `shared`, and check every decision against the
-//! same decision computed on the host.
+//! The emulated Zumo has RC-timed field sensors, a Pixy on TWI, wheel
+//! encoders, buttons A and B; the tests read the motor duties from
+//! OCR1A/OCR1B and decode the USART1 log frames with `shared`, and check
+//! every decision against the same decision computed on the host.
 
 use firmware::calibration_record;
-use firmware::config::{CALIBRATION_SPIN, CAMERA, RC_TIMEOUT_TICKS};
+use firmware::config::{CAMERA, PERIOD_TICKS, RC_TIMEOUT_TICKS};
 use firmware::decision::Decider;
 use firmware::embedded;
 use shared::{FieldCalibration, Faults, LogFrame, MotorCommand, PixyBlock, RunMode, SensorRange};
-use tests::zumo::Zumo;
+use tests::zumo::{pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED};
 
 const CALIBRATION: FieldCalibration = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
 /// Left 0.35, mid 0.6 (bin 9 of 16), right 0.725.
@@ -162,26 +162,250 @@ fn a_silent_camera_or_blind_sensors_stop_the_motors_until_readings_return() {
 }
 
 #[test]
-fn button_b_sweeps_stores_the_calibration_in_eeprom_and_enables_driving() {
+fn button_b_then_the_white_and_black_screens_store_each_sensors_readings_standing_still() {
     let mut z = Zumo::boot();
     z.run_ms(40);
-    // The robot spins over bright and dark field: alternate every period.
-    z.calibrate();
+    // The display shows the field, then white, then black (`host display`'s sequence).
+    z.set_sensor_ticks([Some(250), Some(300), Some(200)]);
+    z.press_b();
+    z.run_ms(200);
+    z.calibrate_ticks([Some(38), Some(40), Some(43)], [Some(425), Some(440), Some(455)]);
     let frames = decoded(&mut z);
-    let sweeping: Vec<_> = frames.iter().filter(|f| f.mode == RunMode::Calibrating).collect();
-    assert!(sweeping.len() >= 190, "{} calibrating frames", sweeping.len());
-    assert!(sweeping.iter().all(|f| f.motors == CALIBRATION_SPIN));
+    let calibrating: Vec<_> = frames.iter().filter(|f| f.mode == RunMode::Calibrating).collect();
+    assert!(calibrating.len() >= 2 * firmware::screen_calibration::WINDOW, "{} calibrating frames", calibrating.len());
+    assert!(calibrating.iter().all(|f| f.motors == MotorCommand::default()), "the robot must stand still");
     let last = frames.last().unwrap();
     assert_eq!((last.mode, last.faults), (RunMode::Idle, Faults::NONE));
 
     let stored = calibration_record::decode(&z.read_eeprom(0, 16).try_into().unwrap()).expect("a stored calibration");
-    for (range, offset) in stored.ranges.iter().zip([0, 10, 20]) {
-        assert!(range.bright.abs_diff(100 + offset) <= 2 && range.dark.abs_diff(400 + offset) <= 2, "{stored:?}");
+    // Each reading is the screen's time, to the tick the poll loop reads it in
+    // (`docs/equivalence.md` checks it exactly, from mid-tick stimuli).
+    for (range, want) in stored.ranges.iter().zip([(38, 425), (40, 440), (43, 455)]) {
+        assert!(range.bright.abs_diff(want.0) <= 1 && range.dark.abs_diff(want.1) <= 1, "{stored:?}");
     }
+    // The log carries the new calibration in the frame after it took effect.
+    assert_eq!(frames.iter().rev().find_map(|f| f.calibration), Some(stored));
 
     z.set_sensor_ticks(SENSOR_TICKS);
     z.press_a();
     z.run_ms(40);
     assert_eq!(decoded(&mut z).last().unwrap().mode, RunMode::Driving);
     assert!(z.duties() != (0, 0));
+}
+
+#[test]
+fn a_calibration_that_never_sees_white_then_black_fails_and_keeps_the_old_one() {
+    let mut z = calibrated_zumo();
+    z.run_ms(40);
+    // Armed while black already shows, then the field: no white-then-black.
+    z.set_sensor_ticks([Some(425), Some(440), Some(455)]);
+    z.press_b();
+    z.run_ms(300);
+    z.set_sensor_ticks(SENSOR_TICKS);
+    z.run_ms(300);
+    assert_eq!(decoded(&mut z).last().unwrap().mode, RunMode::Calibrating);
+    z.press_a(); // A aborts
+    z.run_ms(40);
+    let last = *decoded(&mut z).last().unwrap();
+    assert_eq!((last.mode, last.faults), (RunMode::Idle, Faults::NONE));
+    let stored = calibration_record::decode(&z.read_eeprom(0, 16).try_into().unwrap());
+    assert_eq!(stored, Ok(CALIBRATION));
+}
+
+#[test]
+fn encoder_edges_are_counted_per_period_in_the_log_and_the_robot_id_with_them() {
+    let mut z = calibrated_zumo();
+    z.run_ms(40);
+    decoded(&mut z);
+    // Left forward at 3,000 counts/s, right backwards at 1,250 (60 and -25 per period).
+    z.set_wheel_counts_per_second([3_000, -1_250]);
+    z.run_ms(400);
+    z.set_wheel_counts_per_second([0, 0]);
+    z.run_ms(60);
+    let frames = decoded(&mut z);
+    let logged = frames.iter().fold([0i64; 2], |acc, f| [acc[0] + i64::from(f.encoder_counts[0]), acc[1] + i64::from(f.encoder_counts[1])]);
+    let counts: Vec<[i16; 2]> = frames.iter().map(|f| f.encoder_counts).collect();
+    assert_eq!(logged, z.encoder_steps(), "every edge counted once, with its sign: {counts:?}");
+    assert_eq!(z.encoder_steps(), [1_200, -500]);
+    let steady: Vec<[i16; 2]> = frames.iter().map(|f| f.encoder_counts).filter(|c| c[0] != 0).collect();
+    assert!(steady.iter().filter(|c| **c == [60, -25]).count() >= 15, "{steady:?}");
+    assert!(frames.iter().all(|f| f.robot_id == 0), "the default build has robot id 0");
+}
+
+/// 400 ms of the heaviest periods: driving, both wheels at 6,000 counts/s
+/// (about 0.8 m/s on 75:1 motors, faster than a Zumo drives), the sensors
+/// near their timeout, and frames of eight colour-code blocks.
+fn heaviest_periods() -> Zumo {
+    let mut z = calibrated_zumo();
+    z.run_ms(40);
+    z.press_a();
+    z.set_wheel_counts_per_second([6_000, 6_000]);
+    z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
+    let cc = |i: u16| PixyBlock { signature: 0o12, x: 10 + 30 * i, y: 150, width: 20, height: 20, angle: -45 };
+    z.show(&(0..8).map(cc).collect::<Vec<_>>());
+    z.run_ms(400);
+    z
+}
+
+#[test]
+fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period() {
+    let mut z = heaviest_periods();
+    let frames = decoded(&mut z);
+    let last = frames.last().unwrap();
+    assert_eq!(last.blocks, 4);
+    assert!(last.encoder_counts.iter().all(|c| (119..=121).contains(c)), "{:?}", last.encoder_counts);
+    let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
+    let periods = z.period_cycles();
+    assert!(periods.len() >= 20);
+    // Each period starts on time, within the few cycles an encoder interrupt shifts the poll of the timer.
+    assert!(periods.iter().all(|p| p.abs_diff(period) < CYCLES_PER_TICK), "periods (cycles): {periods:?}");
+    let work = *z.period_work_cycles().iter().max().unwrap();
+    println!("period work, odometry at 6,000 counts/s, 8 colour-code blocks, sensors near timeout: {work} of {period} cycles");
+    assert!(work < period, "a period's work took {work} cycles, longer than the period");
+    let worst = *z.decision_cycles().iter().max().unwrap();
+    assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles with the encoders running");
+}
+
+#[test]
+fn colour_codes_garbage_resync_words_and_long_frames_are_read_as_the_pixy_means_them() {
+    let mut z = calibrated_zumo();
+    z.run_ms(40);
+    z.press_a();
+    z.run_ms(60);
+    // A colour-code puck on the left (signature 0o12 is not a puck: it is ignored
+    // unless configured), a normal robot block, more blocks than the firmware reads.
+    let cc_robot = PixyBlock { signature: 0o12, x: 280, y: 170, width: 30, height: 30, angle: 90 };
+    let many: Vec<PixyBlock> = [PUCK_LEFT, cc_robot, ROBOT_RIGHT]
+        .into_iter()
+        .chain((0..5).map(|i| PixyBlock { signature: 1, x: 300, y: 120 + i, width: 5, height: 5, angle: 0 }))
+        .collect();
+    let first_four = &many[..4];
+    // Garbage, then an odd byte: the syncs that follow read one byte off (0x55AA)
+    // until the firmware skips a byte; then the frame.
+    let mut bytes = pixy_bytes(&[0x1234, 0xBEEF, PIXY_SYNC, 0x0042]);
+    bytes.push(0x77);
+    bytes.extend(pixy_bytes(&[PIXY_SYNC, PIXY_SYNC]));
+    bytes.extend(pixy_bytes(&pixy_frame_words(&many)));
+    z.show_bytes(&bytes);
+    z.run_ms(100);
+    let last = *decoded(&mut z).last().unwrap();
+    assert_eq!(last.faults, Faults::NONE);
+    assert_eq!(last.blocks, 4, "the first four blocks of the frame");
+    check_decision(&last, first_four);
+    assert_eq!(u16::from_le_bytes([bytes[10], bytes[11]]), PIXY_SYNC_SWAPPED, "the test serves a misaligned sync");
+
+    // A block with a bad checksum is dropped; the rest of the frame is used.
+    let mut words = pixy_frame_words(&[PUCK_LEFT, ROBOT_RIGHT]);
+    words[2] ^= 1;
+    z.show_bytes(&pixy_bytes(&words));
+    z.run_ms(100);
+    let last = *decoded(&mut z).last().unwrap();
+    check_decision(&last, &[ROBOT_RIGHT]);
+}
+
+#[test]
+fn a_device_holding_sda_low_is_clocked_free_and_the_camera_reads_again() {
+    let mut z = calibrated_zumo();
+    z.show(&[PUCK_LEFT]);
+    z.run_ms(60);
+    z.press_a();
+    z.run_ms(60);
+    // Cut off mid-byte: it lets go after 3 more clocks.
+    z.hold_sda_low(Some(3));
+    z.run_ms(100);
+    assert!(!z.sda_held());
+    assert_eq!(z.scl_clocks_while_sda_held(), 3);
+    let last = *decoded(&mut z).last().unwrap();
+    assert_eq!((last.faults, last.blocks), (Faults::NONE, 1));
+    check_decision(&last, &[PUCK_LEFT]);
+
+    // Held for ever: the camera is silent, the loop keeps its period, the motors stop.
+    z.hold_sda_low(None);
+    z.run_ms(120);
+    let frames = decoded(&mut z);
+    assert_eq!(frames.last().unwrap().faults, Faults::CAMERA_SILENT);
+    assert_eq!(z.duties(), (0, 0));
+    assert!(z.scl_clocks_while_sda_held() >= 9, "the firmware clocks SCL to free the bus");
+    let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
+    assert!(z.period_cycles().iter().rev().take(5).all(|p| p.abs_diff(period) < CYCLES_PER_TICK), "{:?}", z.period_cycles());
+    z.hold_sda_low(Some(1));
+    z.run_ms(60);
+    let last = *decoded(&mut z).last().unwrap();
+    assert_eq!((last.faults, last.blocks), (Faults::NONE, 1));
+}
+
+
+/// Flash (.text + .data) and static RAM (.data + .bss) of an ELF, from `avr-size -B`.
+fn sizes(elf: &std::path::Path) -> (u64, u64) {
+    let out = std::process::Command::new("avr-size")
+        .arg("-B")
+        .arg(elf)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run avr-size ({e}): install binutils-avr (`scripts/setup`)"));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let n: Vec<u64> = text.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|v| v.parse().ok()).collect();
+    assert_eq!(n.len(), 3, "avr-size output: {text}");
+    (n[0] + n[1], n[1] + n[2])
+}
+
+#[test]
+fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
+    use tests::figures::{compiler_of, thousands, Figures, Outcome};
+    use tests::zumo::{firmware_elf, firmware_elf_in};
+    const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
+    let elf = firmware_elf();
+    let mut figures = Figures::new(&compiler_of(&elf));
+    figures.fixed(&["log frame, longest", &format!("{} bytes", LogFrame::MAX_ENCODED_LEN), "-", "`shared::LogFrame::MAX_ENCODED_LEN`"]);
+
+    let build = "scripts/test (or scripts/build-firmware with FIRMWARE_OUT, docs/equivalence.md)";
+    let (flash, ram) = sizes(&elf);
+    let (flash10, _) = sizes(&firmware_elf_in("robot-annulus-10bit", build));
+    figures.compiled(&[
+        "flash (.text + .data)",
+        &format!("{} bytes (10-bit policy: {})", thousands(flash), thousands(flash10)),
+        "16,384",
+        "`scripts/build-firmware` (avr-size -B)",
+    ]);
+    figures.compiled(&["static RAM (.data + .bss)", &format!("{} bytes", thousands(ram)), "1,024", "`scripts/build-firmware`"]);
+
+    // Driving with the camera and sensors busy: decisions and the stack.
+    let mut z = calibrated_zumo();
+    z.show(&[PUCK_LEFT, ROBOT_RIGHT]);
+    z.run_ms(1);
+    z.paint_stack();
+    z.run_ms(40);
+    z.press_a();
+    z.run_ms(300);
+    let cycles = z.decision_cycles();
+    let low = z.stack_low_water();
+    figures.compiled(&[
+        "stack, deepest",
+        &format!("{} bytes (down to {low:#06X})", 0x0B00 - low),
+        "above 0x0801",
+        "this test",
+    ]);
+    figures.compiled(&[
+        "one decision (this test's driving run)",
+        &format!("{} to {} cycles", thousands(*cycles.iter().min().unwrap()), thousands(*cycles.iter().max().unwrap())),
+        "2,000",
+        "this test; over the trained policies: `docs/equivalence.md`",
+    ]);
+
+    // The heaviest period: odometry at 6,000 counts/s per wheel, eight colour-code blocks, sensors near timeout.
+    let mut z = heaviest_periods();
+    decoded(&mut z);
+    let work = *z.period_work_cycles().iter().max().unwrap();
+    let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
+    figures.compiled(&[
+        "a period's work, heaviest (odometry at 6,000 counts/s, 4 colour-code blocks read, sensors near timeout)",
+        &format!("{} cycles ({:.1} ms)", thousands(work), work as f64 / 16_000.0),
+        &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+
+    match figures.check("docs/firmware.md", "firmware", &["figure", "value", "budget", "measured by"], REGENERATE) {
+        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
+        Ok(_) => {}
+        Err(e) => panic!("{e:#}"),
+    }
 }

@@ -4,11 +4,15 @@
 //! Everything that can be checked is checked before anything is built or
 //! written: the policy decodes and fits the hasher, the checkout is found,
 //! a port is given, avrdude is installed. Then `scripts/build-firmware`
-//! runs with `FIRMWARE_POLICY` / `FIRMWARE_HASHER`, the user double-presses
-//! reset, and once the bootloader's port exists avrdude writes the hex.
+//! builds that policy (and robot id) into its own fresh output directory,
+//! `target/flash/<policy CRC>-robot<id>/` (whatever `CARGO_TARGET_DIR` or
+//! `FIRMWARE_OUT` the environment holds), the hex is checked to embed that
+//! policy's CRC and robot id (`shared::FirmwareIdentity`), the user
+//! double-presses reset, and once the bootloader's port *appears* (a port
+//! that was there before the request does not count) avrdude writes the hex.
 
 use anyhow::{bail, Context, Result};
-use shared::StateHasher;
+use shared::{FirmwareIdentity, StateHasher};
 use std::ffi::OsStr;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -17,8 +21,9 @@ use std::time::{Duration, Instant};
 
 /// The build script, relative to the checkout.
 const BUILD_SCRIPT: &str = "scripts/build-firmware";
-/// The hex it writes, relative to the checkout.
-const HEX: &str = "target/avr-none/firmware/firmware.hex";
+/// Where `host flash` builds, relative to the checkout: one directory per
+/// policy and robot.
+const FLASH_BUILDS: &str = "target/flash";
 /// How long to wait for the bootloader's port after asking for the double
 /// press (the bootloader itself waits 8 s for the programmer).
 pub const PORT_WAIT: Duration = Duration::from_secs(20);
@@ -34,6 +39,10 @@ pub struct FlashPlan {
     pub hasher: StateHasher,
     /// The bootloader's serial port, if given.
     pub port: Option<String>,
+    /// The policy blob's CRC-32 (the firmware embeds it).
+    pub policy_crc: u32,
+    /// The robot id built in (0: none given).
+    pub robot_id: u8,
 }
 
 impl FlashPlan {
@@ -63,7 +72,25 @@ impl FlashPlan {
         };
         let repo = repo.canonicalize().with_context(|| format!("cannot resolve {}", repo.display()))?;
         let policy = policy.canonicalize().with_context(|| format!("cannot resolve policy file {}", policy.display()))?;
-        Ok(FlashPlan { repo, policy, hasher: blob.hasher(), port })
+        let bytes = std::fs::read(&policy).with_context(|| format!("cannot read policy file {}", policy.display()))?;
+        let policy_crc = FirmwareIdentity::policy_crc_of(&bytes)
+            .with_context(|| format!("policy file {} is too short", policy.display()))?;
+        Ok(FlashPlan { repo, policy, hasher: blob.hasher(), port, policy_crc, robot_id: 0 })
+    }
+
+    /// The same plan for robot `id`.
+    pub fn for_robot(self, id: u8) -> FlashPlan {
+        FlashPlan { robot_id: id, ..self }
+    }
+
+    /// The identity the hex must embed.
+    pub fn identity(&self) -> FirmwareIdentity {
+        FirmwareIdentity { robot_id: self.robot_id, policy_crc: self.policy_crc }
+    }
+
+    /// This build's own output directory.
+    pub fn out_dir(&self) -> PathBuf {
+        self.repo.join(FLASH_BUILDS).join(format!("{:08x}-robot{}", self.policy_crc, self.robot_id))
     }
 
     /// The build script.
@@ -71,14 +98,44 @@ impl FlashPlan {
         self.repo.join(BUILD_SCRIPT)
     }
 
-    /// The environment the build script gets.
-    pub fn build_env(&self) -> [(&'static str, String); 2] {
-        [("FIRMWARE_POLICY", self.policy.display().to_string()), ("FIRMWARE_HASHER", self.hasher.name().to_string())]
+    /// The environment the build script gets (`CARGO_TARGET_DIR` is
+    /// removed from it: the script picks its own).
+    pub fn build_env(&self) -> [(&'static str, String); 4] {
+        [
+            ("FIRMWARE_POLICY", self.policy.display().to_string()),
+            ("FIRMWARE_HASHER", self.hasher.name().to_string()),
+            ("FIRMWARE_ROBOT_ID", self.robot_id.to_string()),
+            ("FIRMWARE_OUT", self.out_dir().display().to_string()),
+        ]
     }
 
     /// The hex file the build writes.
     pub fn hex(&self) -> PathBuf {
-        self.repo.join(HEX)
+        self.out_dir().join("firmware.hex")
+    }
+
+    /// Fails unless the hex at [`FlashPlan::hex`] embeds this plan's
+    /// identity (policy CRC and robot id), and no other.
+    pub fn check_hex(&self) -> Result<()> {
+        let path = self.hex();
+        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read the built hex {}", path.display()))?;
+        let image = hex_image(&text).with_context(|| format!("the built hex {} is not Intel HEX", path.display()))?;
+        let found: Vec<FirmwareIdentity> = FirmwareIdentity::find_all(&image).collect();
+        if found != [self.identity()] {
+            let what = match found.first() {
+                None => "no firmware identity".to_string(),
+                Some(f) => format!("policy CRC {:08x} and robot id {}", f.policy_crc, f.robot_id),
+            };
+            bail!(
+                "the built hex {} embeds {what}, not policy {} (CRC {:08x}) for robot {}: a stale or foreign build; \
+                 nothing was written to the robot",
+                path.display(),
+                self.policy.display(),
+                self.policy_crc,
+                self.robot_id
+            );
+        }
+        Ok(())
     }
 
     /// avrdude's arguments for `port` (docs/firmware.md: avr109 at 57600,
@@ -97,9 +154,15 @@ impl FlashPlan {
         let port = self.port.as_deref().unwrap_or("PORT");
         let avrdude: Vec<String> = self.avrdude_args(port).iter().map(|a| quote(a)).collect();
         let mut out = String::new();
-        out.push_str(&format!("{} {}\n", env.join(" "), quote(&self.build_script().display().to_string())));
         out.push_str(&format!(
-            "# then double-press the robot's reset button (its bootloader waits 8 s); once {port} exists:\n"
+            "env -u CARGO_TARGET_DIR {} {}\n",
+            env.join(" "),
+            quote(&self.build_script().display().to_string())
+        ));
+        out.push_str(&format!(
+            "# check that the hex embeds policy CRC {:08x} and robot id {}, then double-press the robot's reset button \
+             (its bootloader waits 8 s); once {port} appears:\n",
+            self.policy_crc, self.robot_id
         ));
         out.push_str(&format!("avrdude {}\n", avrdude.join(" ")));
         if self.port.is_none() {
@@ -107,6 +170,43 @@ impl FlashPlan {
         }
         out
     }
+}
+
+/// The bytes of an Intel HEX file (data records at their addresses, gaps
+/// filled with 0xFF); every record's checksum is checked.
+pub fn hex_image(text: &str) -> Result<Vec<u8>> {
+    let mut image = Vec::new();
+    let mut base = 0usize;
+    for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let line = line.trim();
+        let digits = line.strip_prefix(':').with_context(|| format!("line {}: no ':'", n + 1))?;
+        let bytes: Vec<u8> = (0..digits.len() / 2)
+            .map(|i| u8::from_str_radix(digits.get(2 * i..2 * i + 2).unwrap_or("zz"), 16))
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("line {}: not hex digits", n + 1))?;
+        if digits.len() % 2 != 0 || bytes.len() < 5 || bytes.len() != 5 + usize::from(bytes[0]) {
+            bail!("line {}: wrong length", n + 1);
+        }
+        if bytes.iter().fold(0u8, |s, b| s.wrapping_add(*b)) != 0 {
+            bail!("line {}: bad checksum", n + 1);
+        }
+        let (addr, kind, data) = (usize::from(u16::from_be_bytes([bytes[1], bytes[2]])), bytes[3], &bytes[4..bytes.len() - 1]);
+        match kind {
+            0 => {
+                let at = base + addr;
+                if image.len() < at + data.len() {
+                    image.resize(at + data.len(), 0xFF);
+                }
+                image[at..at + data.len()].copy_from_slice(data);
+            }
+            1 => break,
+            2 if data.len() == 2 => base = usize::from(u16::from_be_bytes([data[0], data[1]])) << 4,
+            4 if data.len() == 2 => base = usize::from(u16::from_be_bytes([data[0], data[1]])) << 16,
+            3 | 5 => {}
+            _ => bail!("line {}: record type {kind} not understood", n + 1),
+        }
+    }
+    Ok(image)
 }
 
 /// Quotes a shell word when it needs it.
@@ -153,8 +253,10 @@ fn is_executable(p: &Path) -> bool {
 }
 
 /// Builds and flashes: checks the port and avrdude (`None`: not installed)
-/// first, builds, asks for the double press, waits up to `port_wait` for
-/// the port, runs avrdude. Progress goes to `out`; the build's and
+/// first, builds into the plan's fresh output, checks the hex's identity,
+/// asks for the double press, waits up to `port_wait` for the port to
+/// appear (one there already must go away first: it is not the bootloader
+/// the user just started), runs avrdude. Progress goes to `out`; the build's and
 /// avrdude's own output to this process's.
 pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out: &mut dyn Write) -> Result<()> {
     let Some(port) = plan.port.as_deref() else {
@@ -166,8 +268,18 @@ pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out:
     let Some(avrdude) = avrdude else {
         bail!("avrdude is not installed or not on PATH (Debian/Ubuntu: sudo apt-get install avrdude). Nothing was built or written.");
     };
-    writeln!(out, "flash: building the firmware with {} ({})", plan.policy.display(), plan.hasher)?;
+    writeln!(out, "flash: building the firmware with {} ({}, robot id {})", plan.policy.display(), plan.hasher, plan.robot_id)?;
+    let out_dir = plan.out_dir();
+    for stale in ["firmware.hex", "firmware.elf"] {
+        match std::fs::remove_file(out_dir.join(stale)) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(e).with_context(|| format!("cannot remove the old {}", out_dir.join(stale).display()));
+            }
+            _ => {}
+        }
+    }
     let status = Command::new(plan.build_script())
+        .env_remove("CARGO_TARGET_DIR")
         .envs(plan.build_env())
         .current_dir(&plan.repo)
         .status()
@@ -178,10 +290,21 @@ pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out:
     if !plan.hex().is_file() {
         bail!("the build did not produce {}; nothing was written to the robot", plan.hex().display());
     }
-    writeln!(out, "flash: double-press the robot's reset button now; waiting up to {} s for {port}", port_wait.as_secs())?;
+    plan.check_hex()?;
+    let mut was_there = Path::new(port).exists();
+    writeln!(out, "flash: the hex embeds policy CRC {:08x} and robot id {}", plan.policy_crc, plan.robot_id)?;
+    writeln!(out, "flash: double-press the robot's reset button now; waiting up to {} s for {port} to appear", port_wait.as_secs())?;
+    if was_there {
+        writeln!(out, "flash: {port} exists already: waiting for it to go away and come back (the bootloader you start now)")?;
+    }
     out.flush()?;
     let start = Instant::now();
-    while !Path::new(port).exists() {
+    loop {
+        let there = Path::new(port).exists();
+        if there && !was_there {
+            break;
+        }
+        was_there &= there;
         if start.elapsed() >= port_wait {
             bail!(
                 "port {port} did not appear within {} s: is the robot connected by USB, and was reset pressed twice quickly? \
@@ -189,7 +312,7 @@ pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out:
                 port_wait.as_secs()
             );
         }
-        std::thread::sleep(Duration::from_millis(100));
+        std::thread::sleep(Duration::from_millis(20));
     }
     let status = Command::new(avrdude)
         .args(plan.avrdude_args(port))
@@ -215,38 +338,74 @@ mod tests {
         std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)).unwrap();
     }
 
+    /// An Intel HEX file of `image` at address 0.
+    fn to_hex(image: &[u8]) -> String {
+        let mut out = String::new();
+        for (n, chunk) in image.chunks(16).enumerate() {
+            let addr = (n * 16) as u16;
+            let mut record = vec![chunk.len() as u8, (addr >> 8) as u8, addr as u8, 0];
+            record.extend(chunk);
+            let sum = record.iter().fold(0u8, |s, b| s.wrapping_add(*b));
+            record.push(sum.wrapping_neg());
+            out.push(':');
+            out.extend(record.iter().map(|b| format!("{b:02X}")));
+            out.push('\n');
+        }
+        out + ":00000001FF\n"
+    }
+
     /// A fake checkout whose build script records its environment and
-    /// writes the hex.
+    /// copies `hex` (in the checkout) to `$FIRMWARE_OUT/firmware.hex`.
     fn fake_checkout(dir: &Path) -> PathBuf {
         let repo = dir.join("repo with space");
         std::fs::create_dir_all(repo.join("firmware")).unwrap();
         std::fs::write(repo.join("firmware/Cargo.toml"), "").unwrap();
         script(
             &repo.join(BUILD_SCRIPT),
-            "echo \"$FIRMWARE_POLICY $FIRMWARE_HASHER\" > built; mkdir -p target/avr-none/firmware; echo hex > target/avr-none/firmware/firmware.hex",
+            "echo \"$FIRMWARE_POLICY $FIRMWARE_HASHER $FIRMWARE_ROBOT_ID $FIRMWARE_OUT ${CARGO_TARGET_DIR:-unset}\" > built; \
+             mkdir -p \"$FIRMWARE_OUT\"; cp hex \"$FIRMWARE_OUT/firmware.hex\"",
         );
         repo
     }
 
+    /// The hex a build of `plan` writes: some code around its identity.
+    fn good_hex(plan: &FlashPlan) -> String {
+        let mut image = vec![0x0Cu8; 40];
+        image.extend(plan.identity().to_bytes());
+        image.extend([0x95u8; 7]);
+        to_hex(&image)
+    }
     #[test]
     fn the_plan_names_the_exact_commands() {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
-        let plan = FlashPlan::new(Path::new(POLICY), None, Some("/dev/ttyACM0".into()), None, &repo.join("firmware")).unwrap();
+        let plan = FlashPlan::new(Path::new(POLICY), None, Some("/dev/ttyACM0".into()), None, &repo.join("firmware")).unwrap().for_robot(4);
         let repo = repo.canonicalize().unwrap();
         let policy = Path::new(POLICY).canonicalize().unwrap();
+        let crc = FirmwareIdentity::policy_crc_of(&std::fs::read(&policy).unwrap()).unwrap();
         assert_eq!(plan.hasher, StateHasher::Original);
         assert_eq!(
             plan.describe(),
             format!(
-                "FIRMWARE_POLICY={} FIRMWARE_HASHER=original '{}/scripts/build-firmware'\n\
-                 # then double-press the robot's reset button (its bootloader waits 8 s); once /dev/ttyACM0 exists:\n\
-                 avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U 'flash:w:{}/target/avr-none/firmware/firmware.hex:i'\n",
+                "env -u CARGO_TARGET_DIR FIRMWARE_POLICY={} FIRMWARE_HASHER=original FIRMWARE_ROBOT_ID=4 FIRMWARE_OUT='{}/target/flash/{crc:08x}-robot4' '{}/scripts/build-firmware'\n\
+                 # check that the hex embeds policy CRC {crc:08x} and robot id 4, then double-press the robot's reset button (its bootloader waits 8 s); once /dev/ttyACM0 appears:\n\
+                 avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U 'flash:w:{}/target/flash/{crc:08x}-robot4/firmware.hex:i'\n",
                 policy.display(),
+                repo.display(),
                 repo.display(),
                 repo.display()
             )
         );
+    }
+
+    #[test]
+    fn intel_hex_is_read_with_its_checksums() {
+        let image: Vec<u8> = (0..40).collect();
+        assert_eq!(hex_image(&to_hex(&image)).unwrap(), image);
+        let mut bad = to_hex(&image);
+        bad.replace_range(9..10, if &bad[9..10] == "0" { "1" } else { "0" });
+        assert!(hex_image(&bad).unwrap_err().to_string().contains("checksum"));
+        assert!(hex_image("garbage").is_err());
     }
 
     #[test]
@@ -273,7 +432,27 @@ mod tests {
     }
 
     #[test]
-    fn a_real_run_builds_waits_for_the_port_and_calls_avrdude() {
+    fn a_stale_or_foreign_hex_is_never_flashed() {
+        let dir = tempfile::tempdir().unwrap();
+        let repo = fake_checkout(dir.path());
+        let bin = dir.path().join("bin");
+        script(&bin.join("avrdude"), &format!("echo \"$@\" > '{}/avrdude-args'", dir.path().display()));
+        let port = dir.path().join("ttyACM9");
+        let plan = FlashPlan::new(Path::new(POLICY), None, Some(port.display().to_string()), Some(&repo), dir.path()).unwrap().for_robot(2);
+        // A build of robot 3, or of another policy, or no identity at all.
+        for other in [plan.clone().for_robot(3), FlashPlan { policy_crc: 7, ..plan.clone() }] {
+            std::fs::write(repo.join("hex"), good_hex(&other)).unwrap();
+            let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
+            assert!(e.contains("stale or foreign build") && e.contains("nothing was written"), "{e}");
+        }
+        std::fs::write(repo.join("hex"), to_hex(&[0u8; 64])).unwrap();
+        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("no firmware identity"), "{e}");
+        assert!(!dir.path().join("avrdude-args").exists());
+    }
+
+    #[test]
+    fn a_real_run_builds_fresh_waits_for_the_port_to_appear_and_calls_avrdude() {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
         let bin = dir.path().join("bin");
@@ -281,19 +460,40 @@ mod tests {
         assert_eq!(find_program("avrdude", Some(bin.as_os_str())), Some(bin.join("avrdude")));
         assert_eq!(find_program("avrdude", Some(dir.path().as_os_str())), None);
 
-        let missing = dir.path().join("ttyACM9");
-        let plan = FlashPlan::new(Path::new(POLICY), None, Some(missing.display().to_string()), Some(&repo), dir.path()).unwrap();
+        let port = dir.path().join("ttyACM9");
+        let plan = FlashPlan::new(Path::new(POLICY), None, Some(port.display().to_string()), Some(&repo), dir.path()).unwrap().for_robot(5);
+        std::fs::write(repo.join("hex"), good_hex(&plan)).unwrap();
         let mut out = Vec::new();
         let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut out).unwrap_err().to_string();
         assert!(e.contains("did not appear") && e.contains("Nothing was written"), "{e}");
         assert!(String::from_utf8(out).unwrap().contains("double-press the robot's reset button now"));
         assert!(!dir.path().join("avrdude-args").exists());
 
-        std::fs::write(&missing, b"").unwrap();
-        flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut Vec::new()).unwrap();
+        // A port that is there already does not count: it must go away and come back.
+        std::fs::write(&port, b"").unwrap();
+        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::from_millis(200), &mut Vec::new()).unwrap_err().to_string();
+        assert!(e.contains("did not appear"), "{e}");
+        assert!(!dir.path().join("avrdude-args").exists());
+        let replug = {
+            let port = port.clone();
+            std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_millis(300));
+                std::fs::remove_file(&port).unwrap();
+                std::thread::sleep(Duration::from_millis(300));
+                std::fs::write(&port, b"").unwrap();
+            })
+        };
+        // The environment's target directory and output are not the build's.
+        std::env::set_var("CARGO_TARGET_DIR", dir.path().join("elsewhere"));
+        let mut out = Vec::new();
+        let result = flash(&plan, Some(&bin.join("avrdude")), Duration::from_secs(20), &mut out);
+        std::env::remove_var("CARGO_TARGET_DIR");
+        replug.join().unwrap();
+        result.unwrap();
+        assert!(String::from_utf8(out).unwrap().contains("exists already"));
         let built = std::fs::read_to_string(repo.join("built")).unwrap();
-        assert_eq!(built.trim(), format!("{} original", plan.policy.display()));
+        assert_eq!(built.trim(), format!("{} original 5 {} unset", plan.policy.display(), plan.out_dir().display()));
         let args = std::fs::read_to_string(dir.path().join("avrdude-args")).unwrap();
-        assert_eq!(args.trim(), plan.avrdude_args(&missing.display().to_string()).join(" "));
+        assert_eq!(args.trim(), plan.avrdude_args(&port.display().to_string()).join(" "));
     }
 }

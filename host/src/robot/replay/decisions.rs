@@ -3,7 +3,7 @@
 
 use super::report::{Divergence, Stage, StageCounts, LISTED};
 use shared::{
-    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob, RobotProfile, RunMode,
+    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob, RobotProfile,
     SensorReading, State,
 };
 
@@ -13,8 +13,9 @@ struct Expected {
     values: Option<[FieldValue; 3]>,
     state: State,
     action: ActionId,
-    /// Motor commands (none for the calibration spin, which is not checked).
-    motors: Option<MotorCommand>,
+    /// Motor commands: the action's mix when the policy drove, else a stop
+    /// (idle, calibrating standing still, or stopped by a fault).
+    motors: MotorCommand,
 }
 
 /// Recomputes decisions with a policy and collects the divergences.
@@ -74,10 +75,10 @@ impl<'a> DecisionCheck<'a> {
         let state = self.policy.hasher().hash(&SensorReading::from_parts(f.values, f.blobs));
         let in_range = f.state.index() < self.policy.hasher().num_states();
         let action = if in_range { self.policy.table().action(f.state) } else { ActionId(u8::MAX) };
-        let motors = match f.mode {
-            RunMode::Calibrating => None,
-            _ if f.policy_drove() && f.action.index() < self.policy.actions().len() => Some(self.motors.command(f.action)),
-            _ => Some(MotorCommand::default()),
+        let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
+            self.motors.command(f.action)
+        } else {
+            MotorCommand::default()
         };
         Expected { values, state, action, motors }
     }
@@ -103,7 +104,7 @@ impl<'a> DecisionCheck<'a> {
                 action: f.action.0,
                 expected_action: e.action.0,
                 motors: [f.motors.left, f.motors.right],
-                expected_motors: e.motors.map(|m| [m.left, m.right]),
+                expected_motors: [e.motors.left, e.motors.right],
             });
         }
     }
@@ -111,10 +112,7 @@ impl<'a> DecisionCheck<'a> {
 
 /// The stages whose logged result differs from the expected one, in order.
 fn divergent_stages(f: &LogFrame, e: &Expected) -> Vec<Stage> {
-    let motors_ok = match e.motors {
-        Some(m) => m == f.motors,
-        None => f.mode == RunMode::Calibrating,
-    };
+    let motors_ok = e.motors == f.motors;
     [
         (Stage::Calibration, e.values.is_some_and(|v| v != f.values)),
         (Stage::Hash, e.state != f.state),

@@ -10,18 +10,22 @@
 //! 3. policy: the logged state -> action (the policy's table);
 //! 4. motors: what the frame's mode and faults say was applied: the
 //!    action's mix (`shared::RobotProfile::ZUMO`, as `firmware/build.rs`
-//!    precomputes it) when the policy drove, a stop when idle or stopped by
-//!    a fault; the calibration spin is not checked
+//!    precomputes it) when the policy drove, a stop when idle, calibrating
+//!    (the robot stands still) or stopped by a fault
 //!    ([`decisions`]).
 //!
 //! It also reports state coverage (and, given training visit counts, the
 //! states training never visited), the action histogram, faults and their
-//! episodes ([`faults`]), modes and tick gaps ([`timeline`]), and the
-//! damaged records and frames with their byte offsets (skipped, never
-//! fatal); the report, text or JSON, is [`report`]'s.
+//! episodes ([`faults`]), modes and tick gaps ([`timeline`]), how each
+//! robot moved per action against what the action asked for, from the
+//! wheel encoders, and its wheel speed factor and turn bias
+//! ([`odometry`]), and the damaged records and frames with their byte
+//! offsets (skipped, never fatal unless no frame decodes); the report,
+//! text or JSON, is [`report`]'s.
 
 pub mod decisions;
 pub mod faults;
+pub mod odometry;
 pub mod report;
 pub mod timeline;
 
@@ -34,6 +38,7 @@ use super::visits::TrainingVisits;
 use anyhow::{bail, Result};
 use decisions::DecisionCheck;
 use faults::FaultTracker;
+use odometry::{OdometrySettings, OdometryTracker};
 use shared::{LogFrame, PolicyBlob, State};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -41,8 +46,13 @@ use timeline::Timeline;
 
 /// Recomputes every frame's decision with `policy` and summarises the run.
 /// `visits`, if given, must be for the policy's hasher (the caller checks).
-pub fn replay(recording: &Recording, policy: &PolicyBlob, visits: Option<&TrainingVisits>) -> ReplayReport {
-    let mut r = Replayer::new(policy);
+pub fn replay(
+    recording: &Recording,
+    policy: &PolicyBlob,
+    visits: Option<&TrainingVisits>,
+    odometry: OdometrySettings,
+) -> ReplayReport {
+    let mut r = Replayer::new(policy, odometry);
     for entry in &recording.entries {
         match &entry.frame {
             Err(e) => r.damaged(entry.offset, entry.len, e.to_string()),
@@ -62,7 +72,8 @@ pub fn replay(recording: &Recording, policy: &PolicyBlob, visits: Option<&Traini
 
 /// Reads the files and replays: the log (recorded or raw), the policy blob
 /// and optional training visits, which must be for the policy's hasher.
-pub fn replay_files(log: &Path, policy: &Path, visits: Option<&Path>) -> Result<ReplayReport> {
+/// Fails, naming the log, when no frame in it decodes.
+pub fn replay_files(log: &Path, policy: &Path, visits: Option<&Path>, odometry: OdometrySettings) -> Result<ReplayReport> {
     let blob = sim::policy_file::read(policy)?;
     let training = match visits {
         Some(path) => {
@@ -81,7 +92,22 @@ pub fn replay_files(log: &Path, policy: &Path, visits: Option<&Path>) -> Result<
         None => None,
     };
     let recording = super::log_file::read(log)?;
-    Ok(replay(&recording, &blob, training.as_ref()))
+    let report = replay(&recording, &blob, training.as_ref(), odometry);
+    if report.frames == 0 {
+        let versions = if report.other_version > 0 {
+            format!(", {} of them of another log format version (this host reads version {})", report.other_version, LogFrame::VERSION)
+        } else {
+            String::new()
+        };
+        bail!(
+            "no frame in {} decodes ({}, {} entries, {} damaged{versions}): is it a log of this robot firmware's serial line?",
+            log.display(),
+            report.source,
+            report.entries,
+            report.damaged
+        );
+    }
+    Ok(report)
 }
 
 /// Everything gathered while reading a recording.
@@ -90,6 +116,7 @@ struct Replayer<'a> {
     decisions: DecisionCheck<'a>,
     timeline: Timeline,
     faults: FaultTracker,
+    odometry: OdometryTracker,
     damaged: u64,
     first_damaged: Vec<Damaged>,
     other_version: u64,
@@ -100,12 +127,13 @@ struct Replayer<'a> {
 }
 
 impl<'a> Replayer<'a> {
-    fn new(policy: &'a PolicyBlob) -> Replayer<'a> {
+    fn new(policy: &'a PolicyBlob, odometry: OdometrySettings) -> Replayer<'a> {
         Replayer {
             policy,
             decisions: DecisionCheck::new(policy),
             timeline: Timeline::default(),
             faults: FaultTracker::default(),
+            odometry: OdometryTracker::new(odometry),
             damaged: 0,
             first_damaged: Vec::new(),
             other_version: 0,
@@ -133,6 +161,7 @@ impl<'a> Replayer<'a> {
             }
         }
         self.faults.frame(f);
+        self.odometry.frame(f);
     }
 
     /// States met while the policy drove, most frequent first, and those
@@ -174,6 +203,7 @@ impl<'a> Replayer<'a> {
             fault_frames: f.fault_frames,
             faults: f.faults,
             first_fault_episodes: f.first_episodes,
+            motion: self.odometry.finish(),
         }
     }
 }
@@ -241,7 +271,7 @@ mod tests {
     }
 
     fn report_of(bytes: &[u8], p: &PolicyBlob) -> ReplayReport {
-        replay(&log_file::parse(bytes).unwrap(), p, None)
+        replay(&log_file::parse(bytes).unwrap(), p, None, Default::default())
     }
 
     #[test]
@@ -292,7 +322,7 @@ mod tests {
         assert_eq!(by_tick(41).stages, vec![Stage::Policy, Stage::Motors]);
         assert_eq!(by_tick(51).stages, vec![Stage::Motors]);
         assert_eq!(by_tick(6).stages, vec![Stage::Motors]);
-        assert_eq!(by_tick(6).expected_motors, Some([0, 0]));
+        assert_eq!(by_tick(6).expected_motors, [0, 0]);
         assert!(r.to_string().contains("tick 41 at byte"));
     }
 
@@ -318,7 +348,7 @@ mod tests {
         let mut counts = vec![0u64; 256];
         counts[first.index()] = 9;
         let visits = TrainingVisits::new(StateHasher::Original, counts).unwrap();
-        let r = replay(&log_file::parse(&log_of(&frames)).unwrap(), &p, Some(&visits));
+        let r = replay(&log_file::parse(&log_of(&frames)).unwrap(), &p, Some(&visits), Default::default());
         let untrained = r.coverage.untrained.clone().unwrap();
         assert_eq!(untrained.len(), r.coverage.states - 1);
         assert!(!untrained.iter().any(|(s, _)| *s == first.0));

@@ -1,6 +1,7 @@
 //! What `host replay` reports: divergences by stage, damaged entries,
 //! modes, coverage, actions and faults, as text or JSON.
 
+use super::odometry::RobotMotion;
 use serde::Serialize;
 use shared::{FieldCalibration, RunMode};
 use std::fmt;
@@ -46,7 +47,7 @@ pub struct ModeCounts {
     pub idle: u64,
     /// Driving (by the policy, or stopped by a fault).
     pub driving: u64,
-    /// Spinning for the calibration sweep.
+    /// Standing still, calibrating on the display's white and black screens.
     pub calibrating: u64,
 }
 
@@ -127,9 +128,8 @@ pub struct Divergence {
     pub expected_action: u8,
     /// Logged motor commands, left and right.
     pub motors: [i16; 2],
-    /// Expected motor commands (none for a calibration spin or an action
-    /// outside the policy's table).
-    pub expected_motors: Option<[i16; 2]>,
+    /// Expected motor commands.
+    pub expected_motors: [i16; 2],
 }
 
 /// A damaged record, or a frame that does not decode.
@@ -228,6 +228,8 @@ pub struct ReplayReport {
     pub faults: Vec<FaultCount>,
     /// The first [`LISTED`] fault episodes, in order of their start.
     pub first_fault_episodes: Vec<FaultEpisode>,
+    /// Per robot: measured against intended motion per action, and the fit.
+    pub motion: Vec<RobotMotion>,
 }
 
 fn percent(part: u64, whole: u64) -> f64 {
@@ -244,7 +246,8 @@ impl fmt::Display for ReplayReport {
         self.fmt_calibrations(f)?;
         self.fmt_divergences(f)?;
         self.fmt_coverage(f)?;
-        self.fmt_faults(f)
+        self.fmt_faults(f)?;
+        self.fmt_motion(f)
     }
 }
 
@@ -316,7 +319,7 @@ impl ReplayReport {
                 d.action,
                 d.expected_action,
                 d.motors,
-                d.expected_motors.map_or("no check".to_string(), |m| format!("{m:?}")),
+                format!("{:?}", d.expected_motors),
             )?;
         }
         Ok(())
@@ -348,6 +351,28 @@ impl ReplayReport {
             .map(|(a, n)| format!("{a}: {n} ({:.1}%)", percent(*n, self.policy_drove)))
             .collect();
         writeln!(f, "actions while the policy drove: {}", actions.join(", "))
+    }
+
+    /// Measured and intended motion per robot and action, and the fit.
+    fn fmt_motion(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.motion.is_empty() {
+            return writeln!(f, "motion: no period measured (the policy never drove between two consecutive frames)");
+        }
+        for r in &self.motion {
+            writeln!(f, "motion of robot {} (wheel encoders; forward in units per step, turning in rad per step, + = right):", r.id)?;
+            for a in &r.actions {
+                writeln!(
+                    f,
+                    "  action {}: {} periods, forward {:.3} (intended {:.3}), turning {:+.4} (intended {:+.4})",
+                    a.action, a.periods, a.forward, a.intended_forward, a.turn, a.intended_turn
+                )?;
+            }
+            match r.fit {
+                Some(fit) => writeln!(f, "  fit: wheel_speed_factor {:.4}, turn_bias {:+.5}", fit.wheel_speed_factor, fit.turn_bias)?,
+                None => writeln!(f, "  fit: none (no forward motion asked for)")?,
+            }
+        }
+        Ok(())
     }
 
     /// Fault frames and episodes.
