@@ -179,7 +179,9 @@ impl SensorCurve {
     }
 
     /// Recomputes this curve for a calibration range, in place (the
-    /// firmware has no stack to spare for a copy).
+    /// firmware has no stack to spare for a copy, nor flash for three
+    /// inlined copies of this).
+    #[inline(never)]
     pub fn calibrate(&mut self, range: SensorRange) {
         let bright = u32::from(range.bright.clamp(1, MAX_CURVE_TICKS - 1));
         let dark = u32::from(range.dark.min(MAX_CURVE_TICKS)).max(bright + 1);
@@ -203,8 +205,9 @@ impl SensorCurve {
     }
 
     /// The calibrated field value of a discharge time in whole ticks: 1.0
-    /// at or below the bright time, 0.0 at or above the dark time.
-    #[inline]
+    /// at or below the bright time, 0.0 at or above the dark time. (One
+    /// copy for the three sensors: the robot's flash is nearly full.)
+    #[inline(never)]
     pub fn value(&self, ticks: u16) -> FieldValue {
         let t = ticks.saturating_mul(16);
         let kn = &self.knots;
