@@ -2,7 +2,10 @@
 //! a sensor model by name, `disc`, `disc-thesis` or `robot`
 //! ([`sim::sensor_setup`]), or `robot:FILE`, the robot sensor model with
 //! the settings of a JSON [`RobotSensorConfig`] file (every field
-//! optional; `docs/robot-sensors.md`).
+//! optional; `docs/robot-sensors.md`), or a mix for ablations:
+//! `mix:FIELD+PUCKS+OBSTACLES`, the field values, puck bits and obstacle
+//! bits each of its own model (`mix:robot+disc+disc`), or
+//! `mix:FIELD+OBJECTS` with one model for both kinds of bits.
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -24,19 +27,34 @@ pub enum SensorChoice {
     DiscThesis,
     /// The robot sensor model, with the settings of a JSON file if given.
     Robot(Option<PathBuf>),
+    /// Field values of the first, puck bits of the second, obstacle bits
+    /// of the third.
+    Mixed(Box<[SensorChoice; 3]>),
 }
 
 impl FromStr for SensorChoice {
     type Err = String;
 
     fn from_str(s: &str) -> Result<SensorChoice, String> {
+        if let Some(mix) = s.strip_prefix("mix:") {
+            let parts = mix.split('+').map(str::parse).collect::<Result<Vec<SensorChoice>, String>>()?;
+            return match <[SensorChoice; 2]>::try_from(parts.clone()) {
+                Ok([field, objects]) => Ok(SensorChoice::Mixed(Box::new([field, objects.clone(), objects]))),
+                Err(_) => <[SensorChoice; 3]>::try_from(parts).map(|p| SensorChoice::Mixed(Box::new(p))).map_err(|_| {
+                    format!("sensor model {s:?}: a mix is mix:FIELD+PUCKS+OBSTACLES or mix:FIELD+OBJECTS")
+                }),
+            };
+        }
         match s {
             "disc" => Ok(SensorChoice::Disc),
             "disc-thesis" => Ok(SensorChoice::DiscThesis),
             "robot" => Ok(SensorChoice::Robot(None)),
             _ => match s.strip_prefix("robot:") {
                 Some(path) if !path.is_empty() => Ok(SensorChoice::Robot(Some(PathBuf::from(path)))),
-                _ => Err(format!("unknown sensor model {s:?}: expected {} or robot:CONFIG.json", SensorSetup::NAMES)),
+                _ => Err(format!(
+                    "unknown sensor model {s:?}: expected {}, robot:CONFIG.json or mix:FIELD+OBJECTS",
+                    SensorSetup::NAMES
+                )),
             },
         }
     }
@@ -63,6 +81,7 @@ impl fmt::Display for SensorChoice {
             SensorChoice::DiscThesis => f.write_str("disc-thesis"),
             SensorChoice::Robot(None) => f.write_str("robot"),
             SensorChoice::Robot(Some(p)) => write!(f, "robot:{}", p.display()),
+            SensorChoice::Mixed(parts) => write!(f, "mix:{}+{}+{}", parts[0], parts[1], parts[2]),
         }
     }
 }
@@ -85,12 +104,21 @@ impl SensorChoice {
             SensorChoice::DiscThesis => SensorSetup::DiscThesis,
             SensorChoice::Robot(None) => SensorSetup::Robot(Box::default()),
             SensorChoice::Robot(Some(path)) => SensorSetup::Robot(Box::new(read_robot_config(path)?)),
+            SensorChoice::Mixed(parts) => SensorSetup::Mixed {
+                field: Box::new(parts[0].setup()?),
+                pucks: Box::new(parts[1].setup()?),
+                obstacles: Box::new(parts[2].setup()?),
+            },
         })
     }
 
-    /// Whether this is the robot sensor model.
+    /// Whether the robot sensor model takes part.
     pub fn is_robot(&self) -> bool {
-        matches!(self, SensorChoice::Robot(_))
+        match self {
+            SensorChoice::Robot(_) => true,
+            SensorChoice::Mixed(parts) => parts.iter().any(SensorChoice::is_robot),
+            _ => false,
+        }
     }
 
     /// The sensor model for the robots of `config`.
@@ -105,12 +133,16 @@ mod tests {
 
     #[test]
     fn choices_parse_print_and_errors_name_the_input() {
-        for s in ["disc", "disc-thesis", "robot", "robot:cam.json"] {
+        for s in ["disc", "disc-thesis", "robot", "robot:cam.json", "mix:robot+disc+disc-thesis", "mix:disc+robot:cam.json+disc"] {
             assert_eq!(s.parse::<SensorChoice>().unwrap().to_string(), s);
         }
+        assert_eq!("mix:robot+disc".parse::<SensorChoice>().unwrap().to_string(), "mix:robot+disc+disc");
         let e = "pixy".parse::<SensorChoice>().unwrap_err();
         assert!(e.contains("\"pixy\""), "{e}");
         assert!("robot:".parse::<SensorChoice>().is_err());
+        let e = "mix:robot".parse::<SensorChoice>().unwrap_err();
+        assert!(e.contains("mix:FIELD+PUCKS+OBSTACLES"), "{e}");
+        assert!("mix:robot+sonar".parse::<SensorChoice>().unwrap_err().contains("\"sonar\""));
     }
 
     #[test]
@@ -120,9 +152,9 @@ mod tests {
         std::fs::write(&good, r#"{"camera": {"tilt_deg": 15.0}}"#).unwrap();
         assert_eq!(read_robot_config(&good).unwrap().camera.tilt_deg, 15.0);
         let bad = dir.path().join("bad.json");
-        std::fs::write(&bad, r#"{"camera": {"height": 0}}"#).unwrap();
+        std::fs::write(&bad, r#"{"camera": {"height_mm": 0}}"#).unwrap();
         let e = format!("{:#}", read_robot_config(&bad).unwrap_err());
-        assert!(e.contains("bad.json") && e.contains("camera.height"), "{e}");
+        assert!(e.contains("bad.json") && e.contains("camera.height_mm"), "{e}");
         let e = format!("{:#}", read_robot_config(&dir.path().join("none.json")).unwrap_err());
         assert!(e.contains("none.json"), "{e}");
     }

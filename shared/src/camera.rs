@@ -6,11 +6,13 @@
 //! with [`CameraConfig::classify`], so robot and simulator agree exactly on
 //! what counts as a puck or an obstacle on the left or the right.
 //!
-//! Classification (integer-only): a block counts if its signature is the
-//! puck (or robot) signature and its centre lies in the "near" image
-//! region; it is on the left if its centre's x is below the split column,
-//! otherwise on the right. The camera looks forward and down, so the lower
-//! part of the image (large y) is the ground close to the robot.
+//! Classification (integer-only): a block sets the right puck bit if its
+//! signature is the puck signature and its centre lies in the right puck
+//! region, the left puck bit if it lies in that region's mirror image
+//! (about the image's centre column); likewise for robots and the obstacle
+//! bits. The camera looks forward and down, so the lower part of the image
+//! (large y) is the ground close to the robot, and the sides of the image
+//! are the directions beside the heading.
 
 use serde::{Deserialize, Serialize};
 
@@ -61,19 +63,30 @@ impl ImageRegion {
     pub const fn contains(&self, x: u16, y: u16) -> bool {
         x >= self.x_min && x <= self.x_max && y >= self.y_min && y <= self.y_max
     }
+
+    /// The region's mirror image about the image's centre column.
+    pub const fn mirrored(&self) -> ImageRegion {
+        let last = IMAGE_WIDTH - 1;
+        ImageRegion {
+            x_min: last.saturating_sub(self.x_max),
+            x_max: last.saturating_sub(self.x_min),
+            y_min: self.y_min,
+            y_max: self.y_max,
+        }
+    }
 }
 
 /// What the camera reports as sensor bits: the puck and obstacle sensors
 /// of the thesis, on each side.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct BlobSummary {
-    /// A puck in the near region, left half.
+    /// A puck in the left puck region.
     pub puck_left: bool,
-    /// A puck in the near region, right half.
+    /// A puck in the right puck region.
     pub puck_right: bool,
-    /// A robot in the near region, left half.
+    /// A robot in the left obstacle region.
     pub obstacle_left: bool,
-    /// A robot in the near region, right half.
+    /// A robot in the right obstacle region.
     pub obstacle_right: bool,
 }
 
@@ -85,38 +98,42 @@ pub struct CameraConfig {
     /// Signature taught to the Pixy for robots (obstacles); may be a
     /// colour code.
     pub robot_signature: u16,
-    /// Where a block's centre must be to be sensed.
-    pub near: ImageRegion,
-    /// Blocks with `x < split_x` are on the left, the others on the right.
-    pub split_x: u16,
+    /// Where a puck block's centre sets the right puck bit (its mirror
+    /// image sets the left one).
+    pub puck_right: ImageRegion,
+    /// Where a robot block's centre sets the right obstacle bit (its
+    /// mirror image sets the left one).
+    pub obstacle_right: ImageRegion,
 }
 
 impl CameraConfig {
-    /// The defaults: pucks are signature 1, robots signature 2; "near" is
-    /// the lower half of the image (rows 100..=199) across its full width,
-    /// split in the middle (column 160).
+    /// The lower half of the image (rows 100..=199), its right half
+    /// (columns 160..=319) for the right bits, the left half (0..=159) for
+    /// the left ones.
+    pub const LOWER_HALVES: ImageRegion =
+        ImageRegion { x_min: IMAGE_WIDTH / 2, x_max: IMAGE_WIDTH - 1, y_min: IMAGE_HEIGHT / 2, y_max: IMAGE_HEIGHT - 1 };
+
+    /// The defaults: pucks are signature 1, robots signature 2; both kinds
+    /// of bits from [`CameraConfig::LOWER_HALVES`].
     pub const DEFAULT: CameraConfig = CameraConfig {
         puck_signature: 1,
         robot_signature: 2,
-        near: ImageRegion { x_min: 0, x_max: IMAGE_WIDTH - 1, y_min: IMAGE_HEIGHT / 2, y_max: IMAGE_HEIGHT - 1 },
-        split_x: IMAGE_WIDTH / 2,
+        puck_right: CameraConfig::LOWER_HALVES,
+        obstacle_right: CameraConfig::LOWER_HALVES,
     };
 
     /// The sensor bits of a set of blocks (any number, any order).
     pub fn classify(&self, blocks: &[PixyBlock]) -> BlobSummary {
         let mut summary = BlobSummary::default();
+        let (puck_left, obstacle_left) = (self.puck_right.mirrored(), self.obstacle_right.mirrored());
         for b in blocks {
-            if !self.near.contains(b.x, b.y) {
-                continue;
-            }
-            let left = b.x < self.split_x;
             if b.signature == self.puck_signature {
-                summary.puck_left |= left;
-                summary.puck_right |= !left;
+                summary.puck_left |= puck_left.contains(b.x, b.y);
+                summary.puck_right |= self.puck_right.contains(b.x, b.y);
             }
             if b.signature == self.robot_signature {
-                summary.obstacle_left |= left;
-                summary.obstacle_right |= !left;
+                summary.obstacle_left |= obstacle_left.contains(b.x, b.y);
+                summary.obstacle_right |= self.obstacle_right.contains(b.x, b.y);
             }
         }
         summary
@@ -153,6 +170,20 @@ mod tests {
         // Region edges are inclusive.
         assert!(c.classify(&[block(1, 0, 100)]).puck_left);
         assert!(c.classify(&[block(1, 319, 199)]).puck_right);
+    }
+
+    #[test]
+    fn regions_with_a_gap_in_the_middle_and_their_mirror_images() {
+        let sides = ImageRegion { x_min: 220, x_max: 319, y_min: 0, y_max: 199 };
+        assert_eq!(sides.mirrored(), ImageRegion { x_min: 0, x_max: 99, y_min: 0, y_max: 199 });
+        let c = CameraConfig { puck_right: sides, ..CameraConfig::DEFAULT };
+        assert_eq!(c.classify(&[block(1, 160, 50)]), BlobSummary::default(), "straight ahead is in neither");
+        let s = c.classify(&[block(1, 99, 10), block(1, 220, 190)]);
+        assert!(s.puck_left && s.puck_right && !s.obstacle_left);
+        // Overlapping regions set both bits.
+        let wide = CameraConfig { puck_right: ImageRegion { x_min: 100, ..sides }, ..CameraConfig::DEFAULT };
+        let s = wide.classify(&[block(1, 160, 50)]);
+        assert!(s.puck_left && s.puck_right);
     }
 
     #[test]

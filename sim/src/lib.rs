@@ -35,6 +35,7 @@ pub mod field;
 pub mod field_source;
 pub mod grid;
 pub mod letters;
+pub mod mixed_sensors;
 pub mod photo_sensors;
 pub mod physics;
 pub mod pixy_camera;

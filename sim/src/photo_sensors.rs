@@ -4,9 +4,11 @@
 //!
 //! Chain, per sensor (`docs/robot-sensors.md` gives the physics and how to
 //! measure the parameters):
-//! 1. the field value `v` at the sensor's point (nearest cell, as the disc
-//!    sensors read it);
-//! 2. the projector's light there, `L(v) = v^gamma` of full brightness;
+//! 1. the field value `v` the screen shows at the sensor's point (as the
+//!    arena reads its field: the nearest cell in the thesis' arena,
+//!    bilinear on a screen);
+//! 2. the screen's light there, `L(v) = v^gamma` of full white (the light
+//!    curve, [`shared::calibration::LIGHT_GAMMA`]);
 //! 3. the discharge time: a photo-transistor's current is proportional to
 //!    the light on it and the capacitor discharges at that current, so the
 //!    time is inversely proportional to the light plus a dark current:
@@ -29,17 +31,17 @@ use crate::validate::{check, ConfigError};
 use crate::field::{FieldLayout, ScalarField};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
-use shared::calibration::{RC_TICK_US, RC_TIMEOUT_TICKS};
+use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
 use shared::{FieldCalibration, FieldScales, FieldValue, SensorRange};
 
-/// A point on the robot, in robot radii from its centre.
+/// A point on the robot, millimetres from its centre.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MountPoint {
-    /// Ahead of the centre (negative: behind).
-    pub forward: f64,
-    /// To the right of the centre (negative: left).
-    pub right: f64,
+    /// Ahead of the centre (negative: behind), mm.
+    pub forward_mm: f64,
+    /// To the right of the centre (negative: left), mm.
+    pub right_mm: f64,
 }
 
 /// How one photo-transistor's discharge time depends on the light on it.
@@ -75,24 +77,28 @@ pub struct PhotoSensorConfig {
     pub gamma: f64,
     /// The firmware's mean timing latency, us (see the module docs).
     pub poll_latency_us: f64,
+    /// Ideal sensors, for ablations: the calibrated value is the field
+    /// value shown at the point, exactly (no RC timing, no calibration).
+    pub ideal: bool,
 }
 
 impl Default for PhotoSensorConfig {
     /// Estimates for a Zumo 32U4's front array (to be measured, see
-    /// `docs/robot-sensors.md`): the sensors 0.7 robot radii (35 mm) ahead
-    /// of the centre, DN1 and DN5 0.75 radii (37 mm) to each side; discharge 150 to
-    /// 170 us under full brightness and 1700 to 1820 us in the dark (the
-    /// three sensors differ a little, as real ones do); gamma 2.2; the
-    /// firmware's latency as measured in simavr, 2.8 us
-    /// (`docs/robot-sensors.md`).
+    /// `docs/robot-sensors.md`): the sensors 35 mm ahead of the centre,
+    /// DN1 and DN5 37.5 mm to each side; discharge 150 to 170 us under full
+    /// white and 1700 to 1820 us on black (the three sensors differ a
+    /// little, as real ones do); the light curve's gamma,
+    /// [`shared::calibration::LIGHT_GAMMA`]; the firmware's latency as
+    /// measured in simavr, 2.8 us (`docs/robot-sensors.md`).
     fn default() -> PhotoSensorConfig {
-        let mount = |right| MountPoint { forward: 0.7, right };
+        let mount = |right_mm| MountPoint { forward_mm: 35.0, right_mm };
         let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
         PhotoSensorConfig {
-            mounts: [mount(-0.75), mount(0.0), mount(0.75)],
+            mounts: [mount(-37.5), mount(0.0), mount(37.5)],
             response: [response(150.0, 1700.0), response(160.0, 1760.0), response(170.0, 1820.0)],
-            gamma: 2.2,
+            gamma: f64::from(LIGHT_GAMMA),
             poll_latency_us: 2.8,
+            ideal: false,
         }
     }
 }
@@ -121,8 +127,8 @@ impl PhotoSensorConfig {
         check("field.poll_latency_us", latency, latency >= 0.0, "must not be negative")?;
         for (i, name) in NAMES.iter().enumerate() {
             let m = self.mounts[i];
-            check(&format!("field.mounts[{i}].forward ({name})"), m.forward, true, "must be a finite number")?;
-            check(&format!("field.mounts[{i}].right ({name})"), m.right, true, "must be a finite number")?;
+            check(&format!("field.mounts[{i}].forward_mm ({name})"), m.forward_mm, true, "must be a finite number")?;
+            check(&format!("field.mounts[{i}].right_mm ({name})"), m.right_mm, true, "must be a finite number")?;
             let r = self.response[i];
             check(
                 &format!("field.response[{i}].bright_us ({name})"),
@@ -159,9 +165,12 @@ pub struct PhotoReading {
     pub discharge_us: [f64; 3],
     /// The firmware's raw readings: whole Timer3 ticks, capped at the timeout.
     pub ticks: [u16; 3],
+    /// The calibrated values: the firmware's arithmetic on `ticks` (or,
+    /// with ideal sensors, the field values shown).
+    pub values: [FieldValue; 3],
 }
 
-/// The three sensors of a robot of a given radius, ready to read.
+/// The three sensors of a robot, ready to read.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PhotoSensors {
     /// Left, mid, right points in the robot's frame (x forward, y right), units.
@@ -169,19 +178,21 @@ pub struct PhotoSensors {
     response: [PhotoResponse; 3],
     gamma: f64,
     latency_us: f64,
+    ideal: bool,
     calibration: FieldCalibration,
     scales: FieldScales,
 }
 
 impl PhotoSensors {
-    /// The sensors of `config` on a robot of `robot_radius` units.
-    pub fn new(config: &PhotoSensorConfig, robot_radius: f64) -> PhotoSensors {
+    /// The sensors of `config` in a world of `unit_mm` millimetres per unit.
+    pub fn new(config: &PhotoSensorConfig, unit_mm: f64) -> PhotoSensors {
         let calibration = config.calibration();
         PhotoSensors {
-            points: config.mounts.map(|m| Vec2::new(m.forward * robot_radius, m.right * robot_radius)),
+            points: config.mounts.map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
             response: config.response,
             gamma: config.gamma,
             latency_us: config.poll_latency_us,
+            ideal: config.ideal,
             calibration,
             scales: calibration.scales(),
         }
@@ -205,11 +216,13 @@ impl PhotoSensors {
     /// The reading of a robot at `pos` facing `direction` (unit vector).
     pub fn read(&self, pos: Vec2, direction: Vec2, field: &ScalarField, layout: &FieldLayout) -> PhotoReading {
         let mut r = PhotoReading::default();
+        let mut shown = [0.0; 3];
         for i in 0..3 {
-            let v = field.shown(pos + self.points[i].rotated(direction), layout);
-            r.discharge_us[i] = self.response[i].discharge_us(v, self.gamma);
+            shown[i] = field.shown(pos + self.points[i].rotated(direction), layout);
+            r.discharge_us[i] = self.response[i].discharge_us(shown[i], self.gamma);
             r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
         }
+        r.values = if self.ideal { shown.map(|v| FieldValue::from_f32(v as f32)) } else { self.scales.values(&r.ticks) };
         r
     }
 }
@@ -258,7 +271,7 @@ mod tests {
         let cal = config.calibration();
         // (150 + 2.8) / 4 and (1700 + 2.8) / 4, floored.
         assert_eq!(cal.ranges[0], SensorRange { bright: 38, dark: 425 });
-        let sensors = PhotoSensors::new(&config, 10.0);
+        let sensors = PhotoSensors::new(&config, 5.0);
         let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
         // One cell over the whole arena: every point inside reads it.
@@ -275,7 +288,7 @@ mod tests {
     fn sensors_sit_where_configured_and_turn_with_the_robot() {
         // A field bright in its left column only (2 x 1 cells over 100 units).
         let field = ScalarField::new(2, 1, vec![1.0, 0.0]).unwrap();
-        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 10.0);
+        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 5.0);
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
         let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, &SQUARE_100);

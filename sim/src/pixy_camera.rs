@@ -34,26 +34,26 @@ use shared::{CameraConfig, PixyBlock};
 use std::cmp::Ordering;
 
 /// Where the camera sits, what it sees, and how it forms blocks. Lengths
-/// are in robot radii.
+/// are in millimetres.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PixyCameraConfig {
-    /// Lens position ahead of the robot's centre.
-    pub forward: f64,
-    /// Lens height above the floor.
-    pub height: f64,
+    /// Lens position ahead of the robot's centre, mm.
+    pub forward_mm: f64,
+    /// Lens height above the floor, mm.
+    pub height_mm: f64,
     /// Optical axis below the horizontal, degrees.
     pub tilt_deg: f64,
     /// Horizontal field of view, degrees.
     pub fov_h_deg: f64,
     /// Vertical field of view, degrees.
     pub fov_v_deg: f64,
-    /// Height of a puck's coloured body.
-    pub puck_height: f64,
-    /// Height of a robot's coloured marker (from the floor up).
-    pub robot_height: f64,
-    /// Bodies whose nearest point is farther than this are not seen.
-    pub max_range: f64,
+    /// Height of a puck's coloured body, mm.
+    pub puck_height_mm: f64,
+    /// Height of a robot's coloured marker (from the floor up), mm.
+    pub robot_height_mm: f64,
+    /// Bodies whose nearest point is farther than this are not seen, mm.
+    pub max_range_mm: f64,
     /// Smallest blob the camera reports, pixels.
     pub min_area: u32,
     /// Blobs of one signature this close (pixels) merge into one block.
@@ -68,21 +68,21 @@ pub struct PixyCameraConfig {
 
 impl Default for PixyCameraConfig {
     /// A Pixy on a bracket above the Zumo's centre (estimates, to be
-    /// measured: `docs/robot-sensors.md`): lens 0.3 radii ahead of the
-    /// centre and 1.6 radii (8 cm) high, tilted 20 degrees down; pucks 0.6
-    /// radii (3 cm) and robots' markers 1.2 radii (6 cm) tall; range 25
-    /// radii (1.25 m); the Pixy's own blob settings (20 pixels, merge at
-    /// 5); 2 blocks per signature; the firmware's classification.
+    /// measured: `docs/robot-sensors.md`): lens 15 mm ahead of the centre
+    /// and 80 mm high, tilted 20 degrees down; pucks 30 mm and robots'
+    /// markers 60 mm tall; range 1.25 m; the Pixy's own blob settings (20
+    /// pixels, merge at 5); 2 blocks per signature; the firmware's
+    /// classification.
     fn default() -> PixyCameraConfig {
         PixyCameraConfig {
-            forward: 0.3,
-            height: 1.6,
+            forward_mm: 15.0,
+            height_mm: 80.0,
             tilt_deg: 20.0,
             fov_h_deg: 75.0,
             fov_v_deg: 47.0,
-            puck_height: 0.6,
-            robot_height: 1.2,
-            max_range: 25.0,
+            puck_height_mm: 30.0,
+            robot_height_mm: 60.0,
+            max_range_mm: 1250.0,
             min_area: 20,
             merge_distance: 5,
             max_blocks_per_signature: 2,
@@ -94,8 +94,8 @@ impl Default for PixyCameraConfig {
 impl PixyCameraConfig {
     /// Checks the pose, field of view, heights and range.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check("camera.forward", self.forward, true, "must be a finite number")?;
-        positive("camera.height", self.height)?;
+        check("camera.forward_mm", self.forward_mm, true, "must be a finite number")?;
+        positive("camera.height_mm", self.height_mm)?;
         for (name, fov) in [("camera.fov_h_deg", self.fov_h_deg), ("camera.fov_v_deg", self.fov_v_deg)] {
             check(name, fov, fov > 0.0 && fov < 180.0, "must be between 0 and 180 degrees")?;
         }
@@ -106,9 +106,9 @@ impl PixyCameraConfig {
             self.tilt_deg + half < 90.0 && self.tilt_deg - half > -90.0,
             "with half the vertical field of view must stay within +-90 degrees",
         )?;
-        positive("camera.puck_height", self.puck_height)?;
-        positive("camera.robot_height", self.robot_height)?;
-        positive("camera.max_range", self.max_range)
+        positive("camera.puck_height_mm", self.puck_height_mm)?;
+        positive("camera.robot_height_mm", self.robot_height_mm)?;
+        positive("camera.max_range_mm", self.max_range_mm)
     }
 }
 
@@ -224,23 +224,23 @@ pub struct PixyCamera {
 }
 
 impl PixyCamera {
-    /// The camera of `config` on robots of `robot_radius` units.
-    pub fn new(config: &PixyCameraConfig, robot_radius: f64) -> PixyCamera {
+    /// The camera of `config` in a world of `unit_mm` millimetres per unit.
+    pub fn new(config: &PixyCameraConfig, unit_mm: f64) -> PixyCamera {
         let tilt = config.tilt_deg.to_radians();
         let half_h = (config.fov_h_deg / 2.0).to_radians();
         let half_v = (config.fov_v_deg / 2.0).to_radians();
         PixyCamera {
-            forward: config.forward * robot_radius,
-            height: config.height * robot_radius,
+            forward: config.forward_mm / unit_mm,
+            height: config.height_mm / unit_mm,
             cos_tilt: tilt.cos(),
             sin_tilt: tilt.sin(),
             fx: f64::from(IMAGE_WIDTH) / 2.0 / half_h.tan(),
             fy: f64::from(IMAGE_HEIGHT) / 2.0 / half_v.tan(),
             tan_half_h: half_h.tan(),
-            puck_height: config.puck_height * robot_radius,
-            robot_height: config.robot_height * robot_radius,
-            max_range: config.max_range * robot_radius,
-            near: 0.01 * robot_radius,
+            puck_height: config.puck_height_mm / unit_mm,
+            robot_height: config.robot_height_mm / unit_mm,
+            max_range: config.max_range_mm / unit_mm,
+            near: 0.5 / unit_mm,
             min_area: config.min_area,
             merge_distance: i32::from(config.merge_distance),
             per_signature: usize::from(config.max_blocks_per_signature),
@@ -483,7 +483,7 @@ mod tests {
         scene.extend(robots.iter().map(|&p| (at(p), 0.0, RobotKind::Outie)));
         let pucks: Vec<Vec2> = pucks.iter().map(|&p| at(p)).collect();
         let world = World::scene(&config, &scene, &pucks, 1);
-        let mut camera = PixyCamera::new(camera, R);
+        let mut camera = PixyCamera::new(camera, 5.0);
         let mut out = Vec::new();
         camera.frame(&world, 0, &mut out);
         out
@@ -580,8 +580,8 @@ mod tests {
     fn bad_poses_are_named() {
         let c = PixyCameraConfig { tilt_deg: 70.0, ..PixyCameraConfig::default() };
         assert!(c.validate().unwrap_err().to_string().contains("camera.tilt_deg"));
-        let c = PixyCameraConfig { height: -1.0, ..PixyCameraConfig::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("camera.height"));
+        let c = PixyCameraConfig { height_mm: -1.0, ..PixyCameraConfig::default() };
+        assert!(c.validate().unwrap_err().to_string().contains("camera.height_mm"));
         assert!(PixyCameraConfig::default().validate().is_ok());
     }
 }

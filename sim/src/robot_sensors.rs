@@ -73,12 +73,12 @@ pub struct RobotSensors {
 }
 
 impl RobotSensors {
-    /// The model of `config` for robots of `robot_radius` units (validate
-    /// the config first: [`RobotSensorConfig::validate`]).
-    pub fn new(config: &RobotSensorConfig, robot_radius: f64) -> RobotSensors {
+    /// The model of `config` in a world of `unit_mm` millimetres per unit
+    /// (validate the config first: [`RobotSensorConfig::validate`]).
+    pub fn new(config: &RobotSensorConfig, unit_mm: f64) -> RobotSensors {
         RobotSensors {
-            photo: PhotoSensors::new(&config.field, robot_radius),
-            camera: PixyCamera::new(&config.camera, robot_radius),
+            photo: PhotoSensors::new(&config.field, unit_mm),
+            camera: PixyCamera::new(&config.camera, unit_mm),
             scratch: RobotObservation::default(),
         }
     }
@@ -103,7 +103,8 @@ impl RobotSensors {
         self.camera.frame(world, robot, &mut out.frame);
         out.discharge_us = photo.discharge_us;
         out.ticks = photo.ticks;
-        out.reading = self.reading(&photo.ticks, &out.frame);
+        let read = &out.frame[..out.frame.len().min(MAX_BLOCKS_PER_PERIOD)];
+        out.reading = SensorReading::from_parts(photo.values, self.camera.classify().classify(read));
     }
 }
 
@@ -146,7 +147,7 @@ mod tests {
             (0..5).map(|k| Vec2::new(240.0 + 25.0 * f64::from(k), 385.0 + 10.0 * f64::from(k % 2))).collect();
         let world = World::scene(&config, &robots, &pucks, 1);
         let field = ScalarField::annulus();
-        let mut model = RobotSensors::new(&RobotSensorConfig::default(), 10.0);
+        let mut model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
         let mut obs = RobotObservation::default();
         model.observe(&world, &field, 0, &mut obs);
         assert!(obs.blocks_read().len() <= MAX_BLOCKS_PER_PERIOD);

@@ -189,9 +189,7 @@ impl Scenario {
             }
         };
         config.validate()?;
-        if let SensorSetup::Robot(robot) = &self.sensors {
-            robot.validate()?;
-        }
+        self.sensors.validate()?;
         let sensors = self.sensors.build(&config);
         let sim = Simulation::with_sensors(config, field, sensors, self.seed)?;
         Ok((sim, controller))

@@ -7,14 +7,18 @@
 //! - `robot`: the Zumo's real senses ([`RobotSensors`]: photo-transistors
 //!   through the firmware's RC timing and calibration, the Pixy camera
 //!   through the firmware's blob classification), with a
-//!   [`RobotSensorConfig`].
+//!   [`RobotSensorConfig`];
+//! - a mix, for ablations: the field values, the puck bits and the
+//!   obstacle bits each from its own model ([`crate::mixed_sensors`]).
 
 use crate::config::SimConfig;
 use crate::disc_sensor_config::DiscSensorConfig;
 use crate::disc_sensors::DiscSensors;
 use crate::field::ScalarField;
+use crate::mixed_sensors::MixedSensors;
 use crate::robot_sensors::{RobotSensorConfig, RobotSensors};
 use crate::sensor_model::{Footprint, SensorModel};
+use crate::validate::ConfigError;
 use crate::world::World;
 use shared::SensorReading;
 
@@ -29,6 +33,16 @@ pub enum SensorSetup {
     DiscThesis,
     /// The robot sensor model with these settings.
     Robot(Box<RobotSensorConfig>),
+    /// Field values from `field`'s model, puck bits from `pucks`',
+    /// obstacle bits from `obstacles`'.
+    Mixed {
+        /// The model of the field values.
+        field: Box<SensorSetup>,
+        /// The model of the puck bits.
+        pucks: Box<SensorSetup>,
+        /// The model of the obstacle bits.
+        obstacles: Box<SensorSetup>,
+    },
 }
 
 impl SensorSetup {
@@ -45,8 +59,19 @@ impl SensorSetup {
         }
     }
 
-    /// The sensor model for the robots of `config` (validate a robot
-    /// config first: [`RobotSensorConfig::validate`]).
+    /// Checks a robot sensor config's settings (the others have none).
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        match self {
+            SensorSetup::Disc | SensorSetup::DiscThesis => Ok(()),
+            SensorSetup::Robot(robot) => robot.validate(),
+            SensorSetup::Mixed { field, pucks, obstacles } => {
+                field.validate().and(pucks.validate()).and(obstacles.validate())
+            }
+        }
+    }
+
+    /// The sensor model for the robots of `config` (validate first:
+    /// [`SensorSetup::validate`]).
     pub fn build(&self, config: &SimConfig) -> SelectedSensors {
         let radius = config.world.robot_radius;
         match self {
@@ -60,7 +85,12 @@ impl SensorSetup {
                 };
                 SelectedSensors::Disc(DiscSensors::new(&discs, radius))
             }
-            SensorSetup::Robot(robot) => SelectedSensors::Robot(Box::new(RobotSensors::new(robot, radius))),
+            SensorSetup::Robot(robot) => SelectedSensors::Robot(Box::new(RobotSensors::new(robot, config.world.unit_mm))),
+            SensorSetup::Mixed { field, pucks, obstacles } => SelectedSensors::Mixed(Box::new(MixedSensors::new(
+                field.build(config),
+                pucks.build(config),
+                obstacles.build(config),
+            ))),
         }
     }
 }
@@ -72,6 +102,8 @@ pub enum SelectedSensors {
     Disc(DiscSensors),
     /// The robot's photo-transistors and camera.
     Robot(Box<RobotSensors>),
+    /// Two models' mix.
+    Mixed(Box<MixedSensors<SelectedSensors>>),
 }
 
 impl SensorModel for SelectedSensors {
@@ -79,6 +111,7 @@ impl SensorModel for SelectedSensors {
         match self {
             SelectedSensors::Disc(s) => s.sense(world, field, out),
             SelectedSensors::Robot(s) => s.sense(world, field, out),
+            SelectedSensors::Mixed(s) => s.sense(world, field, out),
         }
     }
 
@@ -86,6 +119,7 @@ impl SensorModel for SelectedSensors {
         match self {
             SelectedSensors::Disc(s) => s.footprints(world, robot, out),
             SelectedSensors::Robot(s) => s.footprints(world, robot, out),
+            SelectedSensors::Mixed(s) => s.footprints(world, robot, out),
         }
     }
 }

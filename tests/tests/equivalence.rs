@@ -190,7 +190,7 @@ fn equivalence(v: &Variant) {
     check_elf_embeds(&elf, &policy, v.build).unwrap_or_else(|e| panic!("{e:#}"));
 
     let config = RobotSensorConfig::default();
-    let model = RobotSensors::new(&config, 10.0);
+    let model = RobotSensors::new(&config, 5.0);
     let expectation = Expectation::new(&model, &policy);
     let samples = samples_of(&path);
     assert!(samples.len() >= 1000, "{} samples", samples.len());
