@@ -8,7 +8,9 @@
 //! same pre-training settings (the transfer experiment's) share its table.
 
 use super::spec::{ArmController, ExperimentSpec};
+use crate::train::format1::TrainConfigV1;
 use crate::train::{OutputConfig, TrainConfig};
+use sim::scenario::{field_config, orbital_innies};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
 
@@ -70,6 +72,36 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
     ((steps as f64 * scale).round() as u64).max(1)
 }
 
+/// The settings as a hash sees them: a stuck limit or innie count equal to
+/// the field's default counts as unset (the same run either way), and
+/// settings that use
+/// nothing newer than format 1 are hashed in its layout
+/// ([`TrainConfigV1`]), so that trials run before the newer settings
+/// existed keep their hashes.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Hashed {
+    V1(TrainConfigV1),
+    Current(TrainConfig),
+}
+
+/// [`Hashed`] settings of `config`.
+fn hashed(config: &TrainConfig) -> Hashed {
+    let mut c = config.clone();
+    if c.stuck_limit == Some(field_config(&c.field, c.robots, c.pucks).episode.stuck_limit) {
+        c.stuck_limit = None;
+    }
+    if c.innies == Some(orbital_innies(&c.field, c.robots)) {
+        c.innies = None;
+    }
+    TrainConfigV1::of(&c).map_or(Hashed::Current(c), Hashed::V1)
+}
+
+/// Whether two settings give the same run (a stored pre-training's).
+pub fn same_run(a: &TrainConfig, b: &TrainConfig) -> bool {
+    hash(&hashed(a)) == hash(&hashed(b))
+}
+
 /// CRC-64 (XZ) of a value's JSON, as 16 hex digits.
 fn hash(value: &impl Serialize) -> String {
     let json = serde_json::to_vec(value).unwrap_or_default();
@@ -92,9 +124,9 @@ pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec
                 pre.steps = scaled(p.steps, scale);
                 pre.seed = trial_seed(seed, "pretrain", trial);
                 pre.output = OutputConfig::default();
-                PretrainPlan { hash: hash(&(RESULT_FORMAT, &pre)), config: pre }
+                PretrainPlan { hash: hash(&(RESULT_FORMAT, hashed(&pre))), config: pre }
             });
-            let hash = hash(&(RESULT_FORMAT, arm.controller, &config, pretrain.as_ref().map(|p| &p.hash)));
+            let hash = hash(&(RESULT_FORMAT, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash)));
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),

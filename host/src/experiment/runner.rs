@@ -218,7 +218,7 @@ fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {
 /// The stored pre-trained table, if it exists and is for this plan.
 fn pretrained_table(dir: &Path, p: &PretrainPlan) -> Result<crate::learn::QTable> {
     let state = checkpoint::load(&pretrained_path(dir, p))?;
-    if state.config != p.config {
+    if !super::plan::same_run(&state.config, &p.config) {
         bail!("pre-trained table {} has other settings", pretrained_path(dir, p).display());
     }
     Ok(state.learner.table().clone())

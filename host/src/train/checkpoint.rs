@@ -12,7 +12,7 @@
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
 //! Format 2's body is the [`TrainingState`]; format 1's is the state
-//! without the settings added since ([`super::checkpoint_v1`]). A state
+//! without the settings added since ([`super::format1`]). A state
 //! that uses none of them is written as format 1, byte for byte what
 //! earlier builds wrote; both formats are read.
 //!
@@ -20,7 +20,7 @@
 //! bit-exactly. Files are written atomically (temporary file, then rename):
 //! a run killed at any moment leaves the old checkpoint or the new one.
 
-use super::checkpoint_v1::StateV1;
+use super::format1::StateV1;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
