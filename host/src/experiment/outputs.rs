@@ -13,14 +13,22 @@ use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Writes every report into `dir`; returns the paths.
+/// Writes every report into `dir`: [`write_reports`] and `trials.json`;
+/// returns the paths.
 pub fn write(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
+    let path = dir.join("trials.json");
+    crate::atomic::write(&path, &serde_json::to_vec_pretty(results).context("cannot encode the trials")?)?;
+    let mut written = vec![path];
+    written.extend(write_reports(spec, dir, results, scale, seed)?);
+    Ok(written)
+}
+
+/// Writes `trials.csv`, `table.md` and the figures into `dir` (what the
+/// published results hold besides the trial files); returns the paths.
+pub fn write_reports(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let path = dir.join("trials.csv");
     crate::atomic::write(&path, csv(spec, results).as_bytes())?;
-    written.push(path);
-    let path = dir.join("trials.json");
-    crate::atomic::write(&path, &serde_json::to_vec_pretty(results).context("cannot encode the trials")?)?;
     written.push(path);
     let path = dir.join("table.md");
     crate::atomic::write(&path, markdown(spec, results, scale, seed).as_bytes())?;

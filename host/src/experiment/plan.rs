@@ -10,7 +10,7 @@
 use super::spec::{ArmController, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
 use crate::train::{OutputConfig, TrainConfig};
-use sim::scenario::{field_config, orbital_innies};
+use sim::scenario::orbital_innies;
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
 
@@ -72,9 +72,8 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
     ((steps as f64 * scale).round() as u64).max(1)
 }
 
-/// The settings as a hash sees them: a stuck limit or innie count equal to
-/// the field's default counts as unset (the same run either way), and
-/// settings that use
+/// The settings as a hash sees them: an innie count equal to the field's
+/// default counts as unset (the same run either way), and settings that use
 /// nothing newer than format 1 are hashed in its layout
 /// ([`TrainConfigV1`]), so that trials run before the newer settings
 /// existed keep their hashes.
@@ -88,9 +87,6 @@ enum Hashed {
 /// [`Hashed`] settings of `config`.
 fn hashed(config: &TrainConfig) -> Hashed {
     let mut c = config.clone();
-    if c.stuck_limit == Some(field_config(&c.field, c.robots, c.pucks).episode.stuck_limit) {
-        c.stuck_limit = None;
-    }
     if c.innies == Some(orbital_innies(&c.field, c.robots)) {
         c.innies = None;
     }
@@ -111,6 +107,12 @@ fn hash(value: &impl Serialize) -> String {
 /// The trials of every arm: `trials` per arm, steps scaled by `scale`,
 /// seeds derived from `seed`.
 pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec<TrialPlan> {
+    plans_of_format(spec, trials, scale, seed, RESULT_FORMAT)
+}
+
+/// [`plans`] with the hashes that result format `format` gave them (to
+/// tell whether a stored trial of an earlier format is of these settings).
+pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64, format: u32) -> Vec<TrialPlan> {
     let mut out = Vec::new();
     for arm in &spec.arms {
         for trial in 0..trials {
@@ -124,9 +126,9 @@ pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec
                 pre.steps = scaled(p.steps, scale);
                 pre.seed = trial_seed(seed, "pretrain", trial);
                 pre.output = OutputConfig::default();
-                PretrainPlan { hash: hash(&(RESULT_FORMAT, hashed(&pre))), config: pre }
+                PretrainPlan { hash: hash(&(format, hashed(&pre))), config: pre }
             });
-            let hash = hash(&(RESULT_FORMAT, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash)));
+            let hash = hash(&(format, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash)));
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),

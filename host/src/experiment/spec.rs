@@ -44,6 +44,8 @@ pub struct ExperimentSpec {
     pub arms: Vec<ArmSpec>,
     /// The charts.
     pub figures: Vec<FigureSpec>,
+    /// The file's text.
+    pub source: String,
 }
 
 /// How the markdown table is laid out: one line per distinct `row`, one
@@ -314,6 +316,7 @@ impl ExperimentSpec {
             table: file.table,
             arms,
             figures,
+            source: text.to_string(),
         })
     }
 
