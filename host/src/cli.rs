@@ -169,7 +169,7 @@ pub struct ScenarioArgs {
     /// oc, random or policy:FILE.
     #[arg(long, default_value = "oc", value_parser = parse_controller)]
     pub controller: ControllerChoice,
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, default_value = "annulus", value_parser = parse_field)]
     pub field: FieldSource,
     /// Number of robots.
@@ -292,7 +292,7 @@ impl TrainArgs {
 /// the config file's value when given.
 #[derive(Clone, Debug, Default, Args)]
 pub struct TrainOverrideArgs {
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, value_parser = parse_field)]
     pub field: Option<FieldSource>,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with

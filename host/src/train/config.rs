@@ -225,7 +225,7 @@ fn truncate(s: &str) -> String {
 /// [`TrainConfig`]; each overrides the config file's value when given.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TrainOverrides {
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     pub field: Option<FieldSource>,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with
     /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
