@@ -363,8 +363,12 @@ pub enum ExperimentAction {
         #[arg(long, default_value = "docs")]
         docs: PathBuf,
         /// Write nothing; fail if <docs>/reproduction.md is not what the trials give.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "scale")]
         check: bool,
+        /// The scale the published trials ran at (another than 1 renders a
+        /// quick run's page).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
     },
 }
 

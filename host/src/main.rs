@@ -103,13 +103,13 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             );
             Ok(())
         }
-        Some(ExperimentAction::Report { docs, check }) => {
+        Some(ExperimentAction::Report { docs, check, scale }) => {
             let log = |line: &str| eprintln!("{line}");
             if check {
                 host::experiment::report::check(&docs, &log)?;
                 println!("{} is what the published trials give", docs.join("reproduction.md").display());
             } else {
-                let written = host::experiment::report::write(&docs, &log)?;
+                let written = host::experiment::report::write(&docs, scale, &log)?;
                 println!("wrote {}", paths(&written));
             }
             Ok(())
