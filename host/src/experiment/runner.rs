@@ -100,14 +100,16 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
         dir.display()
     ));
     let workers = Workers::new(options.threads)?;
+    // a shard's manifest first, so that merge can name an unfinished shard
+    let manifest = match options.shard {
+        Some(shard) => Some(ShardManifest::new(spec, shard, options.trials, options.scale, seed).write(&dir)?),
+        None => None,
+    };
     let finished: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
     let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &finished, &dir, &workers, log)?;
     let (results, trials_run) = run_trials(&plans, finished, &dir, &workers, log)?;
-    let outputs = match options.shard {
-        Some(shard) => {
-            let manifest = ShardManifest::new(spec, shard, options.trials, options.scale, seed);
-            vec![manifest.write(&dir)?]
-        }
+    let outputs = match manifest {
+        Some(path) => vec![path],
         None => outputs::write(spec, &dir, &results, options.scale, seed)?,
     };
     Ok(RunReport {
