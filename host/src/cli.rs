@@ -4,6 +4,7 @@
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use host::arena_choice::ArenaChoice;
+use host::experiment::shard::Shard;
 use host::experiment::RunOptions;
 use host::learn::StateHasherName;
 use host::sensor_choice::SensorChoice;
@@ -195,7 +196,7 @@ pub struct ScenarioArgs {
     /// oc, random or policy:FILE.
     #[arg(long, default_value = "oc", value_parser = parse_controller)]
     pub controller: ControllerChoice,
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, default_value = "annulus", value_parser = parse_field)]
     pub field: FieldSource,
     /// Number of robots [default: the arena's: 8 in the thesis' arena, 5 on tv75].
@@ -324,7 +325,7 @@ impl TrainArgs {
 /// the config file's value when given.
 #[derive(Clone, Debug, Default, Args)]
 pub struct TrainOverrideArgs {
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     #[arg(long, value_parser = parse_field)]
     pub field: Option<FieldSource>,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with
@@ -362,19 +363,64 @@ pub struct TrainOverrideArgs {
 }
 
 
-/// `host experiment`'s options.
+/// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
 #[derive(Clone, Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct ExperimentArgs {
-    /// annulus, transfer, letters, state-bits, obstacle, collisions (the
-    /// files of experiments/, built in), or the path of a TOML file.
-    pub experiment: String,
+    /// `merge` or `report` instead of a run.
+    #[command(subcommand)]
+    pub action: Option<ExperimentAction>,
+    /// The run.
+    #[command(flatten)]
+    pub run: ExperimentRunArgs,
+}
+
+/// What `host experiment` does besides running one.
+#[derive(Clone, Debug, Subcommand)]
+pub enum ExperimentAction {
+    /// Join the output directories of the shards of one run (`--shard K/N`,
+    /// every K from 0 to N-1) into the outputs an unsharded run writes.
+    Merge {
+        /// The shards' output directories.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output directory [default: out/experiments/<name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// From the published trials (<docs>/reproduction/<name>/trials/): every
+    /// experiment's table.md, trials.csv and figures, and
+    /// <docs>/reproduction.md from <docs>/reproduction/template.md.
+    Report {
+        /// The docs directory.
+        #[arg(long, default_value = "docs")]
+        docs: PathBuf,
+        /// Write nothing; fail if <docs>/reproduction.md is not what the trials give.
+        #[arg(long, conflicts_with = "scale")]
+        check: bool,
+        /// The scale the published trials ran at (another than 1 renders a
+        /// quick run's page).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+    },
+}
+
+/// `host experiment NAME`'s options.
+#[derive(Clone, Debug, Args)]
+pub struct ExperimentRunArgs {
+    /// annulus, transfer, letters, letters-generated, state-bits, obstacle,
+    /// collisions (the files of experiments/, built in), or the path of a
+    /// TOML file.
+    #[arg(required = true)]
+    pub experiment: Option<String>,
     /// Trials per arm.
     #[arg(long, default_value_t = 10)]
     pub trials: usize,
     /// Fraction of the thesis' step counts, for quick runs (e.g. 0.001).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
-    /// Output directory [default: out/experiments/<name>].
+    /// Output directory [default: out/experiments/<name>, with --shard
+    /// out/experiments/<name>/shard-K-of-N].
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Experiment seed, from which every trial's seed derives [default: the file's].
@@ -383,9 +429,13 @@ pub struct ExperimentArgs {
     /// Worker threads [default: one per core].
     #[arg(long)]
     pub threads: Option<usize>,
+    /// Run only shard K of N (K from 0): every N-th trial, with the seeds of
+    /// the whole run; `host experiment merge` joins the shards.
+    #[arg(long)]
+    pub shard: Option<Shard>,
 }
 
-impl ExperimentArgs {
+impl ExperimentRunArgs {
     /// The run options these arguments give.
     pub fn options(&self) -> RunOptions {
         RunOptions {
@@ -394,6 +444,7 @@ impl ExperimentArgs {
             out: self.out.clone(),
             seed: self.seed,
             threads: self.threads,
+            shard: self.shard,
         }
     }
 }

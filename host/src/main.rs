@@ -4,7 +4,7 @@ mod cli;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use cli::{Cli, Command, MonitorArgs, PolicyCommand};
+use cli::{Cli, Command, ExperimentAction, ExperimentArgs, MonitorArgs, PolicyCommand};
 use host::bench::BenchVariant;
 use host::run_summary::run_timed;
 use sim::render::RenderOptions;
@@ -59,22 +59,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("{report}");
             Ok(())
         }
-        Command::Experiment(args) => {
-            let spec = host::experiment::ExperimentSpec::load(&args.experiment)?;
-            // progress lines; a closed stdout must not stop the trials
-            let log = |line: &str| {
-                let _ = writeln!(std::io::stdout().lock(), "{line}");
-            };
-            let report = host::experiment::run(&spec, &args.options(), &log)?;
-            println!(
-                "done in {:.0} s: {} trials run, {} skipped; wrote {}",
-                report.seconds,
-                report.trials_run,
-                report.trials_skipped,
-                report.outputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
-            );
-            Ok(())
-        }
+        Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file }) => {
             let blob = sim::policy_file::read(&file)?;
             print!("{}", host::inspect::render(&blob));
@@ -110,6 +95,52 @@ fn run(cli: Cli) -> Result<()> {
             }
             let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
             flash::flash(&plan, avrdude.as_deref(), flash::PORT_WAIT, &mut std::io::stdout())
+        }
+    }
+}
+
+fn experiment(args: ExperimentArgs) -> Result<()> {
+    let paths = |paths: &[std::path::PathBuf]| paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    match args.action {
+        Some(ExperimentAction::Merge { dirs, out }) => {
+            let report = host::experiment::merge::merge(&dirs, out.as_deref())?;
+            println!(
+                "merged {} shards into {}: {} trials, {} pre-trained tables; wrote {}",
+                dirs.len(),
+                report.dir.display(),
+                report.trials,
+                report.pretrained,
+                paths(&report.outputs)
+            );
+            Ok(())
+        }
+        Some(ExperimentAction::Report { docs, check, scale }) => {
+            let log = |line: &str| eprintln!("{line}");
+            if check {
+                host::experiment::report::check(&docs, &log)?;
+                println!("{} is what the published trials give", docs.join("reproduction.md").display());
+            } else {
+                let written = host::experiment::report::write(&docs, scale, &log)?;
+                println!("wrote {}", paths(&written));
+            }
+            Ok(())
+        }
+        None => {
+            let name = args.run.experiment.as_deref().unwrap_or_default();
+            let spec = host::experiment::ExperimentSpec::load(name)?;
+            // progress lines; a closed stdout must not stop the trials
+            let log = |line: &str| {
+                let _ = writeln!(std::io::stdout().lock(), "{line}");
+            };
+            let report = host::experiment::run(&spec, &args.run.options(), &log)?;
+            println!(
+                "done in {:.0} s: {} trials run, {} skipped; wrote {}",
+                report.seconds,
+                report.trials_run,
+                report.trials_skipped,
+                paths(&report.outputs)
+            );
+            Ok(())
         }
     }
 }

@@ -67,19 +67,149 @@ fn quick_runs_of_every_experiment_produce_tables_and_figures() {
 fn a_rerun_skips_finished_trials_and_reuses_pretrained_tables() {
     let out = tempfile::tempdir().unwrap();
     let args = ["experiment", "transfer", "--scale", "0.0002", "--out"];
-    let first = host().args(args).arg(out.path()).args(["--trials", "2"]).output().unwrap();
-    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
-    let first = String::from_utf8(first.stdout).unwrap();
-    assert!(first.contains("pre-training: 2 tables, 0 already done"), "one table per trial, shared by the arms: {first}");
+    let run = |more: &[&str]| {
+        let run = host().args(args).arg(out.path()).args(more).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        String::from_utf8(run.stdout).unwrap()
+    };
+    // one table per trial and column (text, author), shared by the column's six arms
+    let first = run(&["--trials", "2"]);
+    assert!(first.contains("pre-training: 4 tables for the trials to run, 0 already done"), "{first}");
 
-    let again = host().args(args).arg(out.path()).args(["--trials", "3"]).output().unwrap();
-    let again = String::from_utf8(again.stdout).unwrap();
-    assert!(again.contains("pre-training: 3 tables, 2 already done (skipped)"), "{again}");
-    assert!(again.contains("trials: 18, 12 already done (skipped)"), "{again}");
+    // a third trial needs only its own tables
+    let again = run(&["--trials", "3"]);
+    assert!(again.contains("pre-training: 2 tables for the trials to run, 0 already done"), "{again}");
+    assert!(again.contains("trials: 36, 24 already done (skipped)"), "{again}");
+
+    // a lost trial reruns from its stored table
+    std::fs::remove_file(out.path().join("trials/1_robot/trial-00.json")).unwrap();
+    let lost = run(&["--trials", "3"]);
+    assert!(lost.contains("pre-training: 1 tables for the trials to run, 1 already done (skipped)"), "{lost}");
+    assert!(lost.contains("trials: 36, 35 already done (skipped)"), "{lost}");
 
     // another seed changes every trial's config hash: nothing is reused
-    let reseeded = host().args(args).arg(out.path()).args(["--trials", "2", "--seed", "7"]).output().unwrap();
-    assert!(String::from_utf8(reseeded.stdout).unwrap().contains("trials: 12, 0 already done"));
+    let reseeded = run(&["--trials", "2", "--seed", "7"]);
+    assert!(reseeded.contains("trials: 24, 0 already done"), "{reseeded}");
+}
+
+/// A trial file without its timing fields, which differ between runs.
+fn untimed(path: &Path) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap();
+    let t = v.as_object_mut().unwrap();
+    t.remove("seconds");
+    t.remove("steps_per_second");
+    v
+}
+
+/// Every file under `dir`, relative to it, sorted.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut todo = vec![dir.to_path_buf()];
+    while let Some(d) = todo.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                todo.push(p);
+            } else {
+                out.push(p.strip_prefix(dir).unwrap().to_path_buf());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A report without its timing columns (steps per second, seconds).
+fn untimed_table(text: &str) -> String {
+    let mut drop = None;
+    let mut out = String::new();
+    for line in text.lines() {
+        let cells: Vec<&str> = line.split('|').collect();
+        if let Some(i) = cells.iter().position(|c| c.trim() == "Steps/s") {
+            drop = Some(i);
+        }
+        let kept: Vec<&str> = match drop {
+            Some(i) if line.starts_with('|') && cells.len() > i => cells.iter().enumerate().filter(|(k, _)| *k != i).map(|(_, c)| *c).collect(),
+            _ => cells,
+        };
+        out.push_str(&kept.join("|"));
+        out.push('\n');
+    }
+    out
+}
+
+fn untimed_csv(text: &str) -> String {
+    // the last two columns are steps_per_second and seconds
+    text.lines().map(|l| l.rsplitn(3, ',').last().unwrap().to_string() + "\n").collect()
+}
+
+#[test]
+fn three_shards_merged_give_the_unsharded_runs_trials_and_tables() {
+    let out = tempfile::tempdir().unwrap();
+    let common = ["experiment", "transfer", "--trials", "2", "--scale", "0.0002", "--threads", "1", "--out"];
+    let whole = out.path().join("whole");
+    assert!(host().args(common).arg(&whole).output().unwrap().status.success());
+    let shards: Vec<PathBuf> = (0..3).map(|k| out.path().join(format!("shard-{k}"))).collect();
+    for (k, dir) in shards.iter().enumerate() {
+        let run = host().args(common).arg(dir).args(["--shard", &format!("{k}/3")]).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        assert!(String::from_utf8_lossy(&run.stdout).contains(&format!("shard {k}/3: 8 trials")));
+        assert!(!dir.join("table.md").exists(), "a shard leaves the reports to the merge");
+    }
+    let merged = out.path().join("merged");
+    let run = host().args(["experiment", "merge"]).args(&shards).arg("--out").arg(&merged).output().unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+
+    assert_eq!(files(&merged), files(&whole));
+    for f in files(&whole) {
+        let (a, b) = (whole.join(&f), merged.join(&f));
+        let name = f.to_string_lossy().into_owned();
+        if name.starts_with("trials/") {
+            assert_eq!(untimed(&a), untimed(&b), "{name}");
+        } else if name == "table.md" {
+            let read = |p: &Path| untimed_table(&std::fs::read_to_string(p).unwrap());
+            assert_eq!(read(&a), read(&b));
+        } else if name == "trials.csv" {
+            let read = |p: &Path| untimed_csv(&std::fs::read_to_string(p).unwrap());
+            assert_eq!(read(&a), read(&b));
+        } else if name.starts_with("pretrained/") {
+            assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(), "{name}");
+        }
+    }
+}
+
+#[test]
+fn a_merge_refuses_missing_foreign_or_disagreeing_shards() {
+    let out = tempfile::tempdir().unwrap();
+    let shard = |k: usize, n: usize, seed: &str| {
+        let dir = out.path().join(format!("s{k}of{n}-{seed}"));
+        let args = ["experiment", "transfer", "--trials", "1", "--scale", "0.0002", "--seed", seed, "--out"];
+        let run = host().args(args).arg(&dir).args(["--shard", &format!("{k}/{n}")]).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        dir
+    };
+    let merge = |dirs: &[&PathBuf]| {
+        let run = host().args(["experiment", "merge"]).args(dirs).arg("--out").arg(out.path().join("m")).output().unwrap();
+        assert!(!run.status.success());
+        String::from_utf8(run.stderr).unwrap()
+    };
+    let (a, b) = (shard(0, 2, "1"), shard(1, 2, "1"));
+    let e = merge(&[&a]);
+    assert!(e.contains("shard 1/2 is missing") && e.contains("--shard 1/2"), "{e}");
+    let other = shard(1, 2, "5");
+    assert!(merge(&[&a, &other]).contains("shards of different runs"));
+    assert!(merge(&[&a, &a]).contains("shard 0/2 is given twice"));
+    // both shards pre-train the table of trial 0 of each column: the copies must agree
+    let table = std::fs::read_dir(a.join("pretrained")).unwrap().next().unwrap().unwrap().path();
+    let copy = b.join("pretrained").join(table.file_name().unwrap());
+    let mut bytes = std::fs::read(&copy).unwrap();
+    bytes[40] ^= 1;
+    std::fs::write(&copy, bytes).unwrap();
+    assert!(merge(&[&a, &b]).contains("differ, though they are of the same settings and seed"));
+    std::fs::remove_dir_all(b.join("trials")).unwrap();
+    assert!(merge(&[&a, &b]).contains("has not finished"));
+    let e = merge(&[&out.path().join("nowhere")]);
+    assert!(e.contains("is not a shard's directory"), "{e}");
 }
 
 #[test]
@@ -94,6 +224,7 @@ fn bad_experiment_inputs_are_refused() {
     assert!(fails(&["experiment", "/no/such/file.toml"]).contains("/no/such/file.toml"));
     assert!(fails(&["experiment", "annulus", "--trials", "0"]).contains("--trials 0"));
     assert!(fails(&["experiment", "annulus", "--scale=-1"]).contains("--scale -1"));
+    assert!(fails(&["experiment", "annulus", "--shard", "3/3"]).contains("0 <= K < N"));
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "title = \"x\"\n[[arms]]\nname = \"a\"\nhasher = \"bits7\"\n").unwrap();

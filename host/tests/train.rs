@@ -70,6 +70,53 @@ fn train_then_resume_equals_one_long_run() {
 }
 
 #[test]
+fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkpoint() {
+    let authors = || TrainConfig {
+        formation_check: host::train::config::FormationCheck { every: 300, stale: true },
+        success: sim::SuccessSignal::EvalPrime,
+        obstacle_discs: Some(host::train::config::ObstacleDiscs { radius: 2.0, sees: sim::ObstacleTargets::AnyBody }),
+        ..small(11)
+    };
+    let mut straight = trainer(authors());
+    straight.run(2500);
+
+    let mut first = trainer(authors());
+    first.run(1400);
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, &first.state()).unwrap();
+    assert_eq!(u16::from_le_bytes([bytes[8], bytes[9]]), 2, "format 1 cannot hold these settings");
+    let state = checkpoint::decode(&bytes).unwrap();
+    assert_eq!(state.config, authors());
+    assert!(state.sim.checked_signal.is_some());
+    let field = Arc::new(state.config.field.load().unwrap());
+    let sensors = state.config.sensors.build(&state.sim.config).unwrap();
+    let mut resumed = Trainer::resume(state, field, sensors).unwrap();
+    resumed.run(1100);
+    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+}
+
+#[test]
+fn checkpoints_written_before_format_2_load_and_are_written_again_byte_for_byte() {
+    // the published pre-trained tables of docs/reproduction were written by earlier builds
+    let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");
+    let mut files: Vec<_> = std::fs::read_dir(&docs)
+        .unwrap()
+        .flat_map(|e| std::fs::read_dir(e.unwrap().path().join("pretrained")).into_iter().flatten())
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no published checkpoints under {}", docs.display());
+    for path in files.iter().take(2) {
+        let bytes = std::fs::read(path).unwrap();
+        assert_eq!(u16::from_le_bytes([bytes[8], bytes[9]]), 1, "{}", path.display());
+        let state = checkpoint::decode(&bytes).unwrap();
+        let mut again = Vec::new();
+        checkpoint::write_to(&mut again, &state).unwrap();
+        assert!(again == bytes, "{} is written differently", path.display());
+    }
+}
+
+#[test]
 fn a_resume_refuses_a_changed_field() {
     let t = trainer(small(1));
     let letter = Arc::new(sim::Letter::T.field());

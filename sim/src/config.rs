@@ -138,11 +138,24 @@ impl Thresholds {
     pub const LETTERS: Thresholds = Thresholds { outie: 1.0, innie: 1.0 };
 }
 
+/// What a formation check compares with the success threshold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SuccessSignal {
+    /// Eval (the default; the thesis author's loop tests Eval whatever the reward).
+    #[default]
+    Eval,
+    /// Eval' as printed in the thesis' chapter 6 (`eval::EvalPrime::AsWritten`, phi and nu below).
+    EvalPrime,
+    /// Eval' growing with the robots' spread (`eval::EvalPrime::Spread`).
+    EvalPrimeSpread,
+}
+
 /// Episodes: formation checks, the stuck limit, and Eval' weights.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct EpisodeConfig {
-    /// A formation succeeds when Eval exceeds this at a check.
+    /// A formation succeeds when the success signal exceeds this at a check.
     pub success_eval: f64,
     /// Steps between formation checks.
     pub check_interval: u64,
@@ -152,12 +165,28 @@ pub struct EpisodeConfig {
     pub phi: f64,
     /// Eval' weight nu of the robot term.
     pub nu: f64,
+    /// Test, at each check, the signal measured at the previous check (at
+    /// the episode's start for the first) instead of the current one: the
+    /// thesis author's loop measured Eval, ran `check_interval` steps, then
+    /// tested that value. `false` (the default) tests the current world.
+    pub stale_eval: bool,
+    /// What the checks test.
+    pub success_signal: SuccessSignal,
 }
 
 impl Default for EpisodeConfig {
-    /// 0.94 checked every 100 steps, stuck after 150,000 (annulus), phi 0.6, nu 0.4.
+    /// Eval above 0.94 checked every 100 steps on the current world, stuck
+    /// after 150,000 (annulus), phi 0.6, nu 0.4.
     fn default() -> EpisodeConfig {
-        EpisodeConfig { success_eval: 0.94, check_interval: 100, stuck_limit: 150_000, phi: 0.6, nu: 0.4 }
+        EpisodeConfig {
+            success_eval: 0.94,
+            check_interval: 100,
+            stuck_limit: 150_000,
+            phi: 0.6,
+            nu: 0.4,
+            stale_eval: false,
+            success_signal: SuccessSignal::Eval,
+        }
     }
 }
 

@@ -1,5 +1,6 @@
-//! Where a field comes from: the annulus, a generated letter, or an image
-//! file (one cell per pixel, the mean of R, G and B over 255).
+//! Where a field comes from: the annulus, a generated letter, one of the
+//! thesis' own letter images (built in from `experiments/fields/`), or an
+//! image file (one cell per pixel, the mean of R, G and B over 255).
 
 use crate::arena::ArenaSpec;
 use crate::field::ScalarField;
@@ -18,6 +19,10 @@ pub enum FieldSource {
     Annulus,
     /// A generated letter (`letter:T`).
     Letter(Letter),
+    /// The thesis' own image of a letter (`thesis:T`; T, L, V, X and Z, no
+    /// I), built into the binary (`experiments/fields/README.md`: source and
+    /// licence).
+    Thesis(Letter),
     /// A PNG or JPEG image (any other argument: its path).
     Image(PathBuf),
 }
@@ -36,6 +41,8 @@ pub enum FieldError {
     },
     /// The image decodes to no pixels.
     EmptyImage(PathBuf),
+    /// `thesis:` followed by a letter the thesis has no image of.
+    NoThesisImage(String),
 }
 
 impl fmt::Display for FieldError {
@@ -46,6 +53,9 @@ impl fmt::Display for FieldError {
             }
             FieldError::Image { path, reason } => write!(f, "cannot load field image {}: {reason}", path.display()),
             FieldError::EmptyImage(path) => write!(f, "field image {} has no pixels", path.display()),
+            FieldError::NoThesisImage(l) => {
+                write!(f, "the thesis has no letter image {l:?}: expected one of {}", THESIS_LETTERS.join(", "))
+            }
         }
     }
 }
@@ -55,12 +65,17 @@ impl std::error::Error for FieldError {}
 impl FromStr for FieldSource {
     type Err = FieldError;
 
-    /// `annulus`, `letter:X`, or a path.
+    /// `annulus`, `letter:X`, `thesis:X`, or a path.
     fn from_str(s: &str) -> Result<FieldSource, FieldError> {
         if s == "annulus" {
             Ok(FieldSource::Annulus)
         } else if let Some(letter) = s.strip_prefix("letter:") {
             letter.parse().map(FieldSource::Letter).map_err(|_| FieldError::UnknownLetter(letter.to_string()))
+        } else if let Some(letter) = s.strip_prefix("thesis:") {
+            match letter.parse::<Letter>() {
+                Ok(l) if thesis_image(l).is_some() => Ok(FieldSource::Thesis(l)),
+                _ => Err(FieldError::NoThesisImage(letter.to_string())),
+            }
         } else {
             Ok(FieldSource::Image(PathBuf::from(s)))
         }
@@ -85,6 +100,7 @@ impl fmt::Display for FieldSource {
         match self {
             FieldSource::Annulus => f.write_str("annulus"),
             FieldSource::Letter(l) => write!(f, "letter:{l}"),
+            FieldSource::Thesis(l) => write!(f, "thesis:{l}"),
             FieldSource::Image(p) => write!(f, "{}", p.display()),
         }
     }
@@ -96,6 +112,12 @@ impl FieldSource {
         match self {
             FieldSource::Annulus => Ok(ScalarField::annulus()),
             FieldSource::Letter(l) => Ok(l.field()),
+            FieldSource::Thesis(l) => {
+                let bytes = thesis_image(*l).ok_or_else(|| FieldError::NoThesisImage(l.to_string()))?;
+                let name = PathBuf::from(self.to_string());
+                let err = |reason| FieldError::Image { path: name.clone(), reason };
+                field_of(image::load_from_memory(bytes).map_err(err)?, &name)
+            }
             FieldSource::Image(path) => load_image(path),
         }
     }
@@ -119,7 +141,22 @@ impl FieldSource {
     }
 }
 
-/// An image field: mean of R, G, B over 255, one cell per pixel.
+/// The letters the thesis has images of.
+const THESIS_LETTERS: [&str; 5] = ["T", "L", "V", "X", "Z"];
+
+/// The PNG of the thesis' image of `letter`, if it has one.
+fn thesis_image(letter: Letter) -> Option<&'static [u8]> {
+    Some(match letter {
+        Letter::T => include_bytes!("../../experiments/fields/T.png"),
+        Letter::L => include_bytes!("../../experiments/fields/L.png"),
+        Letter::V => include_bytes!("../../experiments/fields/V.png"),
+        Letter::X => include_bytes!("../../experiments/fields/X.png"),
+        Letter::Z => include_bytes!("../../experiments/fields/Z.png"),
+        Letter::I => return None,
+    })
+}
+
+/// An image file's field.
 fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
     let err = |reason| FieldError::Image { path: path.to_path_buf(), reason };
     let img = image::ImageReader::open(path)
@@ -127,8 +164,13 @@ fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
         .with_guessed_format()
         .map_err(|e| err(image::ImageError::IoError(e)))?
         .decode()
-        .map_err(err)?
-        .to_rgb8();
+        .map_err(err)?;
+    field_of(img, path)
+}
+
+/// An image's field: mean of R, G, B over 255, one cell per pixel.
+fn field_of(img: image::DynamicImage, path: &Path) -> Result<ScalarField, FieldError> {
+    let img = img.to_rgb8();
     let values = img.pixels().map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / (3.0 * 255.0)).collect();
     ScalarField::new(img.width() as usize, img.height() as usize, values)
         .ok_or_else(|| FieldError::EmptyImage(path.to_path_buf()))
@@ -144,9 +186,23 @@ mod tests {
         assert_eq!("letter:T".parse::<FieldSource>().unwrap(), FieldSource::Letter(Letter::T));
         let e = "letter:Q".parse::<FieldSource>().unwrap_err().to_string();
         assert!(e.contains("\"Q\""), "{e}");
+        assert_eq!("thesis:X".parse::<FieldSource>().unwrap(), FieldSource::Thesis(Letter::X));
+        let e = "thesis:I".parse::<FieldSource>().unwrap_err().to_string();
+        assert!(e.contains("\"I\"") && e.contains("T, L, V, X, Z"), "{e}");
         let missing = FieldSource::Image(PathBuf::from("/no/such/field.png"));
         let e = missing.load().unwrap_err().to_string();
         assert!(e.contains("/no/such/field.png"), "{e}");
+    }
+
+    #[test]
+    fn the_thesis_images_are_built_in_and_read_like_their_files() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../experiments/fields");
+        for l in THESIS_LETTERS {
+            let built_in = format!("thesis:{l}").parse::<FieldSource>().unwrap().load().unwrap();
+            let file = FieldSource::Image(dir.join(format!("{l}.png"))).load().unwrap();
+            assert_eq!((built_in.width(), built_in.height()), (600, 600));
+            assert!(built_in == file, "{l}");
+        }
     }
 
     #[test]

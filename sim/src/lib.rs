@@ -56,7 +56,7 @@ pub mod world;
 pub use arena::{ArenaSpec, FieldFit};
 pub use body::{Body, Robot, RobotKind};
 pub use broadphase::BroadPhase;
-pub use config::{EpisodeConfig, PhysicsConfig, SimConfig, Thresholds, WorldConfig};
+pub use config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
 pub use control::{Controller, Perception};
 pub use disc_sensor_config::{DiscSensorConfig, ObstacleTargets, SensorDisc};
 pub use disc_sensors::DiscSensors;

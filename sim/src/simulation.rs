@@ -20,9 +20,9 @@
 //! [`Simulation::reset_episode`] when the [`StepReport`] says the episode
 //! ended. Both give the same trajectory for the same turns.
 
-use crate::config::SimConfig;
+use crate::config::{SimConfig, SuccessSignal};
 use crate::validate::ConfigError;
-use crate::eval::{eval, EvalTracker};
+use crate::eval::{eval, eval_prime, EvalPrime, EvalTracker};
 use crate::field::ScalarField;
 use crate::disc_sensors::DiscSensors;
 use crate::sensor_model::SensorModel;
@@ -102,6 +102,10 @@ pub struct SimulationState {
     /// Every robot's current reading, which the next decision uses (sensed
     /// after the last step, or after the last reset).
     pub readings: Vec<SensorReading>,
+    /// With `episode.stale_eval`: the success signal measured at the last
+    /// check (or at the episode's start), which the next check tests.
+    /// `None` otherwise.
+    pub checked_signal: Option<f64>,
 }
 
 /// A running simulation with sensor model `S`.
@@ -131,14 +135,22 @@ impl<S: SensorModel> Simulation<S> {
     pub fn with_sensors(config: SimConfig, field: Arc<ScalarField>, sensors: S, seed: u64) -> Result<Self, ConfigError> {
         let world = World::new(&config, seed)?;
         let controller_rng = SimRng::seed_from_u64(seed.wrapping_add(CONTROLLER_STREAM));
-        let state =
-            SimulationState { config, world, controller_rng, episode_step: 0, totals: Totals::default(), readings: Vec::new() };
+        let state = SimulationState {
+            config,
+            world,
+            controller_rng,
+            episode_step: 0,
+            totals: Totals::default(),
+            readings: Vec::new(),
+            checked_signal: None,
+        };
         Ok(Simulation::resume(state, field, sensors))
     }
 
     /// Continues from a saved state. Its readings are used as saved; a
     /// state without one reading per robot (a fresh or hand-made one) is
-    /// sensed first.
+    /// sensed first, and one that tests stale signals but holds none is
+    /// measured now.
     pub fn resume(mut state: SimulationState, field: Arc<ScalarField>, mut sensors: S) -> Self {
         let robots = state.world.robots().len();
         if state.readings.len() != robots {
@@ -146,6 +158,10 @@ impl<S: SensorModel> Simulation<S> {
             sensors.sense(&state.world, &field, &mut state.readings);
         }
         let evaluation = EvalTracker::new(&state.world, &field, &state.config.thresholds);
+        if state.config.episode.stale_eval && state.checked_signal.is_none() {
+            let e = evaluation.eval(&state.world, &state.config.thresholds);
+            state.checked_signal = Some(success_signal(&state.world, &field, &state.config, e));
+        }
         Simulation { state, field, sensors, evaluation, turns: vec![0.0; robots] }
     }
 
@@ -224,6 +240,9 @@ impl<S: SensorModel> Simulation<S> {
     /// One step with the robots' turns chosen by the caller (radians, one
     /// per robot, positive = right): turn and move, sense, evaluate (every
     /// step if `eval_every_step`, otherwise at formation checks), count.
+    /// A check tests the success signal (`episode.success_signal`) of the
+    /// current world, or with `episode.stale_eval` the one measured at the
+    /// previous check; a formation at a check wins over the stuck limit.
     /// The readings after the step are [`readings`](Self::readings). An
     /// ended episode is not reset here: call
     /// [`reset_episode`](Self::reset_episode) before the next step (a
@@ -244,7 +263,9 @@ impl<S: SensorModel> Simulation<S> {
         if let (true, Some(e)) = (check, eval) {
             s.totals.eval_sum += e;
             s.totals.eval_checks += 1;
-            if e > episode.success_eval {
+            let signal = success_signal(&s.world, &self.field, &s.config, e);
+            let tested = if episode.stale_eval { s.checked_signal.replace(signal).unwrap_or(signal) } else { signal };
+            if tested > episode.success_eval {
                 end = Some(EpisodeEnd::Formed);
             }
         }
@@ -270,6 +291,10 @@ impl<S: SensorModel> Simulation<S> {
         s.episode_step = 0;
         self.evaluation.rebuild(&s.world, &self.field, &s.config.thresholds);
         self.sensors.sense(&s.world, &self.field, &mut s.readings);
+        if s.config.episode.stale_eval {
+            let e = self.evaluation.eval(&s.world, &s.config.thresholds);
+            s.checked_signal = Some(success_signal(&s.world, &self.field, &s.config, e));
+        }
     }
 
     /// Runs `steps` steps.
@@ -278,4 +303,14 @@ impl<S: SensorModel> Simulation<S> {
             self.step(controller);
         }
     }
+}
+
+/// The value a formation check tests: `eval` (the world's Eval), or Eval'.
+fn success_signal(world: &World, field: &ScalarField, config: &SimConfig, eval: f64) -> f64 {
+    let variant = match config.episode.success_signal {
+        SuccessSignal::Eval => return eval,
+        SuccessSignal::EvalPrime => EvalPrime::AsWritten,
+        SuccessSignal::EvalPrimeSpread => EvalPrime::Spread,
+    };
+    eval_prime(world, field, &config.thresholds, variant, config.episode.phi, config.episode.nu)
 }

@@ -159,3 +159,96 @@ fn orbital_construction_forms_the_annulus_and_random_does_not() {
     assert_eq!(random.formations, 0);
     assert!(oc.mean_eval() > random.mean_eval());
 }
+
+/// The annulus with 4 innies, seed 4, checks every `interval` steps against
+/// `threshold`, and `more` episode settings.
+fn checked(interval: u64, threshold: f64, more: impl FnOnce(&mut sim::EpisodeConfig)) -> Simulation {
+    let mut config = SimConfig::default();
+    config.world.innies = 4;
+    config.episode.check_interval = interval;
+    config.episode.success_eval = threshold;
+    more(&mut config.episode);
+    Simulation::new(config, Arc::new(ScalarField::annulus()), 4).unwrap()
+}
+
+/// OC on the annulus with a threshold no Eval reaches: the success signal
+/// (Eval, or Eval' as printed) at each of `checks` checks every `interval`
+/// steps, the first entry being the episode's start.
+fn signals_at_checks(interval: u64, checks: usize) -> Vec<(f64, f64)> {
+    let mut sim = checked(interval, 1.0, |_| {});
+    let mut controller = oc();
+    let measure = |sim: &Simulation| {
+        let c = sim.config();
+        let prime = eval_prime(sim.world(), sim.field(), &c.thresholds, EvalPrime::AsWritten, c.episode.phi, c.episode.nu);
+        (sim.eval(), prime)
+    };
+    let mut out = vec![measure(&sim)];
+    for _ in 0..checks {
+        sim.run(&mut controller, interval);
+        out.push(measure(&sim));
+    }
+    out
+}
+
+/// The step of the first formation with these episode settings, seed 4.
+fn first_formation(interval: u64, threshold: f64, stale: bool, signal: sim::SuccessSignal) -> Option<u64> {
+    let mut sim = checked(interval, threshold, |e| {
+        e.stale_eval = stale;
+        e.success_signal = signal;
+    });
+    let mut controller = oc();
+    (1..=40 * interval).find(|_| sim.step(&mut controller).is_some())
+}
+
+/// The first check (from 1) whose value exceeds every earlier one and the start's.
+fn first_record(values: &[f64]) -> usize {
+    (1..values.len()).find(|&k| values[k] > values[..k].iter().cloned().fold(f64::MIN, f64::max)).unwrap()
+}
+
+#[test]
+fn a_stale_check_forms_one_check_after_the_world_formed() {
+    let signals = signals_at_checks(500, 30);
+    let evals: Vec<f64> = signals.iter().map(|s| s.0).collect();
+    let k = first_record(&evals);
+    // a threshold just below check k's Eval, above every earlier one
+    let threshold = evals[k] - 1e-12;
+    assert_eq!(first_formation(500, threshold, false, sim::SuccessSignal::Eval), Some(500 * k as u64));
+    assert_eq!(first_formation(500, threshold, true, sim::SuccessSignal::Eval), Some(500 * (k as u64 + 1)));
+}
+
+#[test]
+fn checks_can_test_eval_prime_instead_of_eval() {
+    let signals = signals_at_checks(500, 30);
+    let primes: Vec<f64> = signals.iter().map(|s| s.1).collect();
+    let k = first_record(&primes);
+    let threshold = primes[k] - 1e-12;
+    assert_eq!(first_formation(500, threshold, false, sim::SuccessSignal::EvalPrime), Some(500 * k as u64));
+    // Eval crosses that threshold at another check (or never) in this run
+    let by_eval = signals.iter().position(|s| s.0 > threshold);
+    assert_ne!(by_eval, Some(k), "the test needs Eval and Eval' to differ: {signals:?}");
+}
+
+#[test]
+fn a_checkpoint_of_a_stale_checking_run_resumes_bit_exactly() {
+    let stale = || {
+        let mut config = SimConfig::default();
+        config.world.innies = 4;
+        config.episode.check_interval = 1000;
+        config.episode.stale_eval = true;
+        config.episode.success_eval = 0.8;
+        Simulation::new(config, Arc::new(ScalarField::annulus()), 3).unwrap()
+    };
+    let mut controller = oc();
+    let mut straight = stale();
+    straight.run(&mut controller, 9000);
+    assert!(straight.totals().formations > 0, "the run should form: {:?}", straight.totals());
+
+    let mut first = stale();
+    first.run(&mut controller, 4500);
+    assert!(first.state().checked_signal.is_some());
+    let state: SimulationState = serde_json::from_str(&serde_json::to_string(first.state()).unwrap()).unwrap();
+    let sensors = sim::DiscSensors::new(&state.config.sensors, state.config.world.robot_radius);
+    let mut resumed = Simulation::resume(state, Arc::new(ScalarField::annulus()), sensors);
+    resumed.run(&mut controller, 4500);
+    assert!(final_state(&resumed) == final_state(&straight));
+}

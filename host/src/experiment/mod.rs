@@ -1,13 +1,22 @@
 //! `host experiment`: the thesis' experiments from TOML files ([`spec`]),
 //! planned into seeded trials ([`plan`]), run in parallel and resumable
-//! ([`runner`], [`trial`]), and reported ([`metric`], [`figures`], [`outputs`]).
+//! ([`runner`], [`trial`]), in shards over machines ([`shard`], [`merge`]),
+//! and reported ([`metric`], [`figures`], [`outputs`], [`pictures`]); the
+//! published trials ([`published`]) render `docs/reproduction.md`
+//! ([`report`], [`template`]).
 
 pub mod figures;
+pub mod merge;
 pub mod metric;
 pub mod outputs;
+pub mod pictures;
 pub mod plan;
+pub mod published;
+pub mod report;
 pub mod runner;
+pub mod shard;
 pub mod spec;
+pub mod template;
 pub mod trial;
 
 pub use runner::{run, RunOptions, RunReport};

@@ -4,28 +4,40 @@
 
 use super::figures;
 use super::metric::Metric;
-use super::spec::{ArmSpec, ExperimentSpec, FigureKind, FigureSpec};
+use super::pictures;
+use super::plan::{plans, TrialPlan};
+use super::spec::{ArmSpec, BandKind, ExperimentSpec, FigureKind, FigureSpec};
 use super::trial::{TrialResult, BLOCK_STEPS};
-use crate::report::chart::{self, Band, Labels, Scatter};
+use crate::report::chart::{self, Band, Labels, Scatter, Spread};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// Writes every report into `dir`; returns the paths.
+/// Writes every report into `dir`: [`write_reports`] and `trials.json`;
+/// returns the paths.
 pub fn write(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
+    let path = dir.join("trials.json");
+    crate::atomic::write(&path, &serde_json::to_vec_pretty(results).context("cannot encode the trials")?)?;
+    let mut written = vec![path];
+    written.extend(write_reports(spec, dir, results, scale, seed)?);
+    Ok(written)
+}
+
+/// Writes `trials.csv`, `table.md` and the figures into `dir` (what the
+/// published results hold besides the trial files); returns the paths.
+pub fn write_reports(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let path = dir.join("trials.csv");
     crate::atomic::write(&path, csv(spec, results).as_bytes())?;
     written.push(path);
-    let path = dir.join("trials.json");
-    crate::atomic::write(&path, &serde_json::to_vec_pretty(results).context("cannot encode the trials")?)?;
-    written.push(path);
     let path = dir.join("table.md");
     crate::atomic::write(&path, markdown(spec, results, scale, seed).as_bytes())?;
     written.push(path);
+    let trials = results.iter().map(|r| r.trial + 1).max().unwrap_or(0);
+    let plans = plans(spec, trials, scale, seed);
     for figure in &spec.figures {
         let path = dir.join(&figure.file);
-        draw(spec, figure, results, &path)?;
+        draw(spec, figure, results, &plans, &path)?;
         written.push(path);
     }
     Ok(written)
@@ -87,15 +99,14 @@ fn distinct<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
     out
 }
 
+/// One figure of an arm over its trials (ratios over the arm's reference).
+fn arm_value(spec: &ExperimentSpec, results: &[TrialResult], arm: &ArmSpec, m: Metric) -> figures::Value {
+    let reference = spec.ratio_reference(arm).map(|r| of_arm(results, &r.name));
+    figures::value(m, &of_arm(results, &arm.name), reference.as_deref())
+}
+
 /// The results table like the thesis', then every figure per arm.
 pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed: u64) -> String {
-    let t = &spec.table;
-    let reference = t.ratio_to.as_deref().map(|name| of_arm(results, name));
-    let value = |arm: &ArmSpec, m: Metric| figures::value(m, &of_arm(results, &arm.name), reference.as_deref());
-    let rows = distinct(spec.arms.iter().map(|a| a.row.as_str()));
-    let columns = distinct(spec.arms.iter().map(|a| a.column.as_str()));
-    let find = |row: &str, column: &str| spec.arms.iter().find(|a| a.row == row && a.column == column);
-
     let mut md = format!("# {}\n\n", spec.title);
     if !spec.thesis.is_empty() {
         let _ = writeln!(md, "Reproduces the thesis' {}.\n", spec.thesis);
@@ -106,19 +117,38 @@ pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed
         "Ours: mean ± 95 % confidence half-width over {trials} trials per arm, scale {scale} of the thesis' step counts, experiment seed {seed}. Thesis: the published figure where there is one, \"–\" where it gives none.{}\n",
         if scale < 1.0 { " **Quick run: not comparable with the thesis' numbers.**" } else { "" }
     );
+    md.push_str(&table(spec, results));
+    md.push_str("\n## Every figure per arm\n\n");
+    md.push_str(&every_figure(spec, results));
+    md.push_str("\n## Figures\n\n");
+    for f in &spec.figures {
+        let _ = writeln!(md, "![{}]({})\n", title(spec, f), f.file);
+    }
+    md
+}
+
+/// The thesis-layout table (one line per row, one group of columns per
+/// column, the thesis' figure beside each of ours) and its caption.
+pub fn table(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
+    let t = &spec.table;
+    let value = |arm: &ArmSpec, m: Metric| arm_value(spec, results, arm, m);
+    let rows = distinct(spec.arms.iter().map(|a| a.row.as_str()));
+    let columns = distinct(spec.arms.iter().map(|a| a.column.as_str()));
+    let find = |row: &str, column: &str| spec.arms.iter().find(|a| a.row == row && a.column == column);
+    let mut md = String::new();
 
     // header
     let mut header = format!("| {} |", t.row_header);
     let mut rule = String::from("|---|");
     for column in &columns {
         for &m in &t.metrics {
-            let label = match (column.is_empty(), m) {
-                (_, Metric::FormationsRatio) if t.ratio_to.is_some() => {
+            let label = match m {
+                Metric::FormationsRatio if t.ratio_to.is_some() => {
                     format!("Formations / {}", t.ratio_to.as_deref().unwrap_or_default())
                 }
-                (true, _) => m.label().to_string(),
-                (false, _) => format!("{column} {}", m.label()),
+                _ => m.label().to_string(),
             };
+            let label = if column.is_empty() { label } else { format!("{column}: {label}") };
             let _ = write!(header, " {label} |");
             rule.push_str("---:|");
             if spec.arms.iter().any(|a| a.column == *column && a.thesis.contains_key(&m)) {
@@ -146,8 +176,12 @@ pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed
     if !t.caption.is_empty() {
         let _ = writeln!(md, "\n{}", t.caption);
     }
+    md
+}
 
-    md.push_str("\n## Every figure per arm\n\n");
+/// Every figure of every arm, one line per arm.
+pub fn every_figure(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
+    let mut md = String::new();
     let all = [
         Metric::Formations,
         Metric::FirstFormation,
@@ -167,13 +201,9 @@ pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed
         let steps = trials.first().map_or(0, |t| t.steps);
         let _ = write!(md, "| {} | {} | {} | {} |", arm.name, arm.controller.name(), trials.len(), steps);
         for m in all {
-            let _ = write!(md, " {} |", value(arm, m).cell());
+            let _ = write!(md, " {} |", arm_value(spec, results, arm, m).cell());
         }
         md.push('\n');
-    }
-    md.push_str("\n## Figures\n\n");
-    for f in &spec.figures {
-        let _ = writeln!(md, "![{}]({})\n", title(spec, f), f.file);
     }
     md
 }
@@ -182,11 +212,13 @@ fn title(spec: &ExperimentSpec, f: &FigureSpec) -> String {
     f.title.clone().unwrap_or_else(|| match f.kind {
         FigureKind::Formations => format!("{}: formations over time", spec.title),
         FigureKind::Collisions => "Robot-robot collisions per 1000 steps".to_string(),
+        FigureKind::Fields => "The scalar fields".to_string(),
+        FigureKind::Snapshots => "The arena during a trial".to_string(),
     })
 }
 
 /// Draws one figure.
-fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], path: &Path) -> Result<()> {
+fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], plans: &[TrialPlan], path: &Path) -> Result<()> {
     let arms: Vec<&ArmSpec> = if f.arms.is_empty() {
         spec.arms.iter().collect()
     } else {
@@ -209,7 +241,11 @@ fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], path: &P
                     Band { name: arm.name.clone(), x, trials: series }
                 })
                 .collect();
-            chart::mean_with_band(path, Labels { title: &title, x: "step", y: "formations" }, &bands)
+            let spread = match f.band {
+                BandKind::Ci95 => Spread::Ci95,
+                BandKind::MinMax => Spread::MinMax,
+            };
+            chart::mean_with_band(path, Labels { title: &title, x: "step", y: "formations" }, &bands, spread)
         }
         FigureKind::Collisions => {
             let series: Vec<Scatter> = arms
@@ -233,5 +269,7 @@ fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], path: &P
                 &series,
             )
         }
+        FigureKind::Fields => chart::tiles(path, &title, &pictures::fields(spec, f)?),
+        FigureKind::Snapshots => chart::tiles(path, &title, &pictures::snapshots(f, plans, results)?),
     }
 }

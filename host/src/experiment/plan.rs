@@ -8,14 +8,19 @@
 //! same pre-training settings (the transfer experiment's) share its table.
 
 use super::spec::{ArmController, ExperimentSpec};
+use crate::train::format1::TrainConfigV1;
 use crate::train::{OutputConfig, TrainConfig};
+use sim::scenario::orbital_innies;
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
 
 /// Version of `TrialResult`'s layout and meaning, and of the
 /// simulator's results; part of the config hash, so results of another
 /// version are re-run, not mixed in. 2: headings turn through our own
-/// `sin_cos` (`sim::trig`) instead of the platform's.
+/// `sin_cos` (`sim::trig`) instead of the platform's. (The settings of the
+/// thesis author's runs, `formation_check` and the others, left it at 2:
+/// at their defaults every trial runs and means what it did, and keeps its
+/// hash: see `hashed`.)
 pub const RESULT_FORMAT: u32 = 2;
 
 /// Everything one trial needs.
@@ -70,6 +75,32 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
     ((steps as f64 * scale).round() as u64).max(1)
 }
 
+/// The settings as a hash sees them: an innie count equal to the field's
+/// default counts as unset (the same run either way), and settings that use
+/// nothing newer than format 1 are hashed in its layout
+/// ([`TrainConfigV1`]), so that trials run before the newer settings
+/// existed keep their hashes.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Hashed {
+    V1(TrainConfigV1),
+    Current(TrainConfig),
+}
+
+/// [`Hashed`] settings of `config`.
+fn hashed(config: &TrainConfig) -> Hashed {
+    let mut c = config.clone();
+    if c.innies == Some(orbital_innies(&c.field, c.robots)) {
+        c.innies = None;
+    }
+    TrainConfigV1::of(&c).map_or(Hashed::Current(c), Hashed::V1)
+}
+
+/// Whether two settings give the same run (a stored pre-training's).
+pub fn same_run(a: &TrainConfig, b: &TrainConfig) -> bool {
+    hash(&hashed(a)) == hash(&hashed(b))
+}
+
 /// CRC-64 (XZ) of a value's JSON, as 16 hex digits.
 fn hash(value: &impl Serialize) -> String {
     let json = serde_json::to_vec(value).unwrap_or_default();
@@ -79,6 +110,12 @@ fn hash(value: &impl Serialize) -> String {
 /// The trials of every arm: `trials` per arm, steps scaled by `scale`,
 /// seeds derived from `seed`.
 pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec<TrialPlan> {
+    plans_of_format(spec, trials, scale, seed, RESULT_FORMAT)
+}
+
+/// [`plans`] with the hashes that result format `format` gave them (to
+/// tell whether a stored trial of an earlier format is of these settings).
+pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64, format: u32) -> Vec<TrialPlan> {
     let mut out = Vec::new();
     for arm in &spec.arms {
         for trial in 0..trials {
@@ -92,9 +129,9 @@ pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec
                 pre.steps = scaled(p.steps, scale);
                 pre.seed = trial_seed(seed, "pretrain", trial);
                 pre.output = OutputConfig::default();
-                PretrainPlan { hash: hash(&(RESULT_FORMAT, &pre)), config: pre }
+                PretrainPlan { hash: hash(&(format, hashed(&pre))), config: pre }
             });
-            let hash = hash(&(RESULT_FORMAT, arm.controller, &config, pretrain.as_ref().map(|p| &p.hash)));
+            let hash = hash(&(format, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash)));
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),

@@ -1,14 +1,18 @@
-//! Running an experiment: pre-trainings, then trials, in parallel (rayon),
-//! each result written atomically when it finishes and skipped on a rerun
-//! when its stored config hash matches; then the reports.
+//! Running an experiment: the pre-trainings its unfinished trials need, then
+//! those trials, in parallel (rayon), each result written atomically when it
+//! finishes and skipped on a rerun when its stored config hash matches; then
+//! the reports. A shard ([`Shard`]) runs every N-th trial of the plan, with
+//! the seeds of the whole run, and leaves the reports to `merge`.
 //!
 //! Layout of the output directory:
 //! - `pretrained/<hash>.ckpt`: pre-trained tables (checkpoints);
 //! - `trials/<arm>/trial-<NN>.json`: one [`TrialResult`] per trial;
-//! - `trials.csv`, `trials.json`, `table.md` and the PNG figures.
+//! - `trials.csv`, `trials.json`, `table.md` and the PNG figures; or, for a
+//!   shard, `shard.json` ([`ShardManifest`]).
 
 use super::outputs;
 use super::plan::{plans, PretrainPlan, TrialPlan, RESULT_FORMAT};
+use super::shard::{Shard, ShardManifest};
 use super::spec::ExperimentSpec;
 use super::trial::{self, TrialResult};
 use crate::train::checkpoint;
@@ -32,12 +36,14 @@ pub struct RunOptions {
     pub seed: Option<u64>,
     /// Worker threads; `None` for one per core.
     pub threads: Option<usize>,
+    /// Run only this share of the trials; `None` for all.
+    pub shard: Option<Shard>,
 }
 
 impl Default for RunOptions {
-    /// 10 trials at full scale, the default directory, seed and threads.
+    /// 10 trials at full scale, the default directory, seed and threads, unsharded.
     fn default() -> RunOptions {
-        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None }
+        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None, shard: None }
     }
 }
 
@@ -54,7 +60,7 @@ pub struct RunReport {
     pub pretrained_run: usize,
     /// Pre-trainings found finished and skipped.
     pub pretrained_skipped: usize,
-    /// The report files written.
+    /// The report files written (a shard's manifest).
     pub outputs: Vec<PathBuf>,
     /// Wall time of the whole run.
     pub seconds: f64,
@@ -73,21 +79,39 @@ type Log<'a> = &'a (dyn Fn(&str) + Sync);
 pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<RunReport> {
     check_options(spec, options)?;
     let started = Instant::now();
-    let dir = options.out.clone().unwrap_or_else(|| Path::new("out/experiments").join(&spec.name));
+    let default_dir = Path::new("out/experiments").join(&spec.name);
+    let dir = match (&options.out, options.shard) {
+        (Some(dir), _) => dir.clone(),
+        (None, Some(shard)) => default_dir.join(shard.dir_name()),
+        (None, None) => default_dir,
+    };
     let seed = options.seed.unwrap_or(spec.seed);
-    let plans = plans(spec, options.trials, options.scale, seed);
+    let mut plans = plans(spec, options.trials, options.scale, seed);
+    if let Some(shard) = options.shard {
+        plans = shard.share(plans);
+    }
     log(&format!(
-        "experiment {}: {} arms x {} trials, scale {}, seed {seed}, writing to {}",
+        "experiment {}: {} arms x {} trials, scale {}, seed {seed}{}, writing to {}",
         spec.name,
         spec.arms.len(),
         options.trials,
         options.scale,
+        options.shard.map_or_else(String::new, |s| format!(", shard {s}: {} trials", plans.len())),
         dir.display()
     ));
     let workers = Workers::new(options.threads)?;
-    let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &dir, &workers, log)?;
-    let (results, trials_run) = run_trials(&plans, &dir, &workers, log)?;
-    let outputs = outputs::write(spec, &dir, &results, options.scale, seed)?;
+    // a shard's manifest first, so that merge can name an unfinished shard
+    let manifest = match options.shard {
+        Some(shard) => Some(ShardManifest::new(spec, shard, options.trials, options.scale, seed).write(&dir)?),
+        None => None,
+    };
+    let finished: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
+    let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &finished, &dir, &workers, log)?;
+    let (results, trials_run) = run_trials(&plans, finished, &dir, &workers, log)?;
+    let outputs = match manifest {
+        Some(path) => vec![path],
+        None => outputs::write(spec, &dir, &results, options.scale, seed)?,
+    };
     Ok(RunReport {
         dir,
         trials_run,
@@ -138,17 +162,29 @@ impl Workers {
     }
 }
 
-/// Runs each distinct pre-training not yet stored; returns how many ran and
-/// how many were found done.
-fn run_pretrainings(plans: &[TrialPlan], dir: &Path, workers: &Workers, log: Log<'_>) -> Result<(usize, usize)> {
+/// Runs each distinct pre-training that an unfinished trial needs and that
+/// is not yet stored; returns how many ran and how many were found done.
+fn run_pretrainings(
+    plans: &[TrialPlan],
+    finished: &[Option<TrialResult>],
+    dir: &Path,
+    workers: &Workers,
+    log: Log<'_>,
+) -> Result<(usize, usize)> {
     let mut distinct: BTreeMap<&str, &PretrainPlan> = BTreeMap::new();
-    for p in plans.iter().filter_map(|p| p.pretrain.as_ref()) {
-        distinct.insert(&p.hash, p);
+    for (plan, _) in plans.iter().zip(finished).filter(|(_, f)| f.is_none()) {
+        if let Some(p) = &plan.pretrain {
+            distinct.insert(&p.hash, p);
+        }
     }
     let (done, todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) =
         distinct.values().partition(|p| pretrained_table(dir, p).is_ok());
     if !distinct.is_empty() {
-        log(&format!("pre-training: {} tables, {} already done (skipped)", distinct.len(), done.len()));
+        log(&format!(
+            "pre-training: {} tables for the trials to run, {} already done (skipped)",
+            distinct.len(),
+            done.len()
+        ));
     }
     let count = AtomicUsize::new(0);
     workers.run(&|| {
@@ -163,10 +199,17 @@ fn run_pretrainings(plans: &[TrialPlan], dir: &Path, workers: &Workers, log: Log
     Ok((todo.len(), done.len()))
 }
 
-/// Runs every trial not yet stored, each written atomically when it ends;
-/// returns every trial's result in plan order and how many ran.
-fn run_trials(plans: &[TrialPlan], dir: &Path, workers: &Workers, log: Log<'_>) -> Result<(Vec<TrialResult>, usize)> {
-    let mut results: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(dir, p)).collect();
+/// Runs every trial not yet stored (`finished`: the stored results, by
+/// plan), each written atomically when it ends; returns every trial's result
+/// in plan order and how many ran.
+fn run_trials(
+    plans: &[TrialPlan],
+    finished: Vec<Option<TrialResult>>,
+    dir: &Path,
+    workers: &Workers,
+    log: Log<'_>,
+) -> Result<(Vec<TrialResult>, usize)> {
+    let mut results = finished;
     let todo: Vec<usize> = (0..plans.len()).filter(|&i| results[i].is_none()).collect();
     log(&format!("trials: {}, {} already done (skipped)", plans.len(), plans.len() - todo.len()));
     let count = AtomicUsize::new(0);
@@ -211,25 +254,27 @@ fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
     Ok(result)
 }
 
-fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {
+/// Where a pre-trained table is stored in an output directory.
+pub fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {
     dir.join("pretrained").join(format!("{}.ckpt", p.hash))
 }
 
 /// The stored pre-trained table, if it exists and is for this plan.
 fn pretrained_table(dir: &Path, p: &PretrainPlan) -> Result<crate::learn::QTable> {
     let state = checkpoint::load(&pretrained_path(dir, p))?;
-    if state.config != p.config {
+    if !super::plan::same_run(&state.config, &p.config) {
         bail!("pre-trained table {} has other settings", pretrained_path(dir, p).display());
     }
     Ok(state.learner.table().clone())
 }
 
-fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
+/// Where a trial's result is stored in an output directory.
+pub fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
     dir.join("trials").join(slug(&plan.arm)).join(format!("trial-{:02}.json", plan.trial))
 }
 
 /// The stored result of a trial, if it exists and its hash matches.
-fn finished(dir: &Path, plan: &TrialPlan) -> Option<TrialResult> {
+pub fn finished(dir: &Path, plan: &TrialPlan) -> Option<TrialResult> {
     let bytes = std::fs::read(trial_path(dir, plan)).ok()?;
     let r: TrialResult = serde_json::from_slice(&bytes).ok()?;
     (r.format == RESULT_FORMAT && r.config_hash == plan.hash).then_some(r)

@@ -15,10 +15,11 @@ use std::path::Path;
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 6] = [
+pub const BUILT_IN: [(&str, &str); 7] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     ("transfer", include_str!("../../../experiments/transfer.toml")),
     ("letters", include_str!("../../../experiments/letters.toml")),
+    ("letters-generated", include_str!("../../../experiments/letters-generated.toml")),
     ("state-bits", include_str!("../../../experiments/state-bits.toml")),
     ("obstacle", include_str!("../../../experiments/obstacle.toml")),
     ("collisions", include_str!("../../../experiments/collisions.toml")),
@@ -43,6 +44,8 @@ pub struct ExperimentSpec {
     pub arms: Vec<ArmSpec>,
     /// The charts.
     pub figures: Vec<FigureSpec>,
+    /// The file's text.
+    pub source: String,
 }
 
 /// How the markdown table is laid out: one line per distinct `row`, one
@@ -57,7 +60,8 @@ pub struct TableSpec {
     pub row_header: String,
     /// The metrics shown.
     pub metrics: Vec<Metric>,
-    /// The arm that `formations_ratio` divides by.
+    /// The row whose arm in the same column `formations_ratio` divides by
+    /// (or, when no arm of the column has that row, the arm of that name).
     pub ratio_to: Option<String>,
 }
 
@@ -125,10 +129,40 @@ pub struct ArmSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FigureKind {
-    /// Formations over time: mean and 95 % band per arm (Figure 15).
+    /// Formations over time: mean and a band per arm (Figure 15).
     Formations,
     /// Robot-robot collisions per 1000 steps with least-squares lines (Figure 24).
     Collisions,
+    /// The scalar field of each distinct field of the arms (Figure 17).
+    Fields,
+    /// Pictures of the arena during a trial of each arm (Figures 11, 18).
+    Snapshots,
+}
+
+/// The band around a formations curve.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BandKind {
+    /// The 95 % confidence interval of the mean (the default).
+    #[default]
+    Ci95,
+    /// From the least to the greatest trial (the thesis' Figures 15 and 16:
+    /// "the maximum and minimum values of each trial").
+    MinMax,
+}
+
+/// A moment of a trial that a snapshot shows. The trial is the arm's one
+/// with the earliest first formation (the first if none formed), re-run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Moment {
+    /// The random start.
+    Start,
+    /// Half-way to the first formation (to the end if none).
+    Midway,
+    /// The formed shape: the world the first formation check tested (the
+    /// end of the run if none formed).
+    Formed,
 }
 
 /// One chart.
@@ -145,6 +179,16 @@ pub struct FigureSpec {
     /// Arms drawn, by name; empty for all.
     #[serde(default)]
     pub arms: Vec<String>,
+    /// Formations: the band around each mean.
+    #[serde(default)]
+    pub band: BandKind,
+    /// Snapshots: the moments shown of each arm's trial.
+    #[serde(default = "default_moments")]
+    pub moments: Vec<Moment>,
+}
+
+fn default_moments() -> Vec<Moment> {
+    vec![Moment::Formed]
 }
 
 /// The file as written, before arms are merged with the defaults.
@@ -234,19 +278,32 @@ impl ExperimentSpec {
             arms.push(arm);
         }
         let known = |n: &String| arms.iter().any(|a| &a.name == n);
-        if let Some(r) = file.table.ratio_to.as_ref().filter(|r| !known(r)) {
-            bail!("[table] ratio_to = {r:?} is not an arm");
+        if let Some(r) = file.table.ratio_to.as_ref().filter(|r| !known(r) && !arms.iter().any(|a| &a.row == *r)) {
+            bail!("[table] ratio_to = {r:?} is neither a row nor an arm");
         }
         for f in &file.figures {
             if let Some(n) = f.arms.iter().find(|n| !known(n)) {
                 bail!("figure {}: {n:?} is not an arm", f.file);
             }
+            if f.kind == FigureKind::Snapshots {
+                if f.arms.is_empty() || f.moments.is_empty() {
+                    bail!("figure {}: snapshots need arms and moments", f.file);
+                }
+                if let Some(a) = arms.iter().find(|a| f.arms.contains(&a.name) && a.pretrain.is_some()) {
+                    bail!("figure {}: arm {:?} is pre-trained; snapshots re-run trials without pre-training", f.file, a.name);
+                }
+            }
         }
+        let figure = |file: &str, kind| FigureSpec {
+            file: file.into(),
+            kind,
+            title: None,
+            arms: vec![],
+            band: BandKind::default(),
+            moments: default_moments(),
+        };
         let figures = if file.figures.is_empty() {
-            vec![
-                FigureSpec { file: "formations.png".into(), kind: FigureKind::Formations, title: None, arms: vec![] },
-                FigureSpec { file: "collisions.png".into(), kind: FigureKind::Collisions, title: None, arms: vec![] },
-            ]
+            vec![figure("formations.png", FigureKind::Formations), figure("collisions.png", FigureKind::Collisions)]
         } else {
             file.figures
         };
@@ -259,12 +316,20 @@ impl ExperimentSpec {
             table: file.table,
             arms,
             figures,
+            source: text.to_string(),
         })
     }
 
     /// The arm of that name.
     pub fn arm(&self, name: &str) -> Option<&ArmSpec> {
         self.arms.iter().find(|a| a.name == name)
+    }
+
+    /// The arm `formations_ratio` divides `arm`'s formations by: the one of
+    /// the `ratio_to` row in `arm`'s column, else the arm named `ratio_to`.
+    pub fn ratio_reference(&self, arm: &ArmSpec) -> Option<&ArmSpec> {
+        let r = self.table.ratio_to.as_deref()?;
+        self.arms.iter().find(|a| a.row == r && a.column == arm.column).or_else(|| self.arm(r))
     }
 }
 
@@ -287,6 +352,9 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     config.validate().with_context(context)?;
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
+    }
+    if let Some(n) = config.innies.filter(|_| keys.controller != ArmController::Oc) {
+        bail!("{}: innies = {n}: only orbital construction has innies", context());
     }
     Ok(ArmSpec {
         row: keys.row.unwrap_or_else(|| keys.name.clone()),
@@ -355,7 +423,9 @@ alpha = 0.1
         let typo = FILE.replace("robots = 2", "robts = 2");
         assert!(e(&typo).contains("arm \"B\"") && e(&typo).contains("robts"), "{}", e(&typo));
         let bad = FILE.replace("ratio_to = \"A\"", "ratio_to = \"Z\"");
-        assert!(e(&bad).contains("\"Z\" is not an arm"));
+        assert!(e(&bad).contains("\"Z\" is neither a row nor an arm"), "{}", e(&bad));
+        let innies = FILE.replace("row = \"b\"", "row = \"b\"\ninnies = 1");
+        assert!(e(&innies).contains("only orbital construction has innies"), "{}", e(&innies));
         let syntax = FILE.replace("[table]", "[table");
         assert!(e(&syntax).contains("line 3"), "{}", e(&syntax));
         let metric = FILE.replace("\"formations_ratio\"", "\"speed\"");

@@ -5,7 +5,7 @@ use super::plan::{TrialPlan, RESULT_FORMAT};
 use super::spec::ArmController;
 use sim::controllers::{OrbitalConfig, OrbitalConstruction};
 use crate::learn::QTable;
-use sim::scenario::orbital_innies;
+use sim::sensor_setup::SelectedSensors;
 use sim::{EpisodeEnd, Simulation, Totals};
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
@@ -74,35 +74,76 @@ impl Recorder {
     }
 }
 
+/// A trial's run, stepped by its caller: orbital construction on its own
+/// simulation, or a learner's training run.
+pub enum Running {
+    /// Orbital construction.
+    Oc(Box<Simulation<SelectedSensors>>, OrbitalConstruction),
+    /// Q-learning.
+    Learn(Box<Trainer<SelectedSensors>>),
+}
+
+impl Running {
+    /// The run of `plan` at its start; `seed_table` is the pre-trained table
+    /// of a pre-trained arm.
+    pub fn start(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<Running> {
+        let c = &plan.config;
+        let field = Arc::new(c.field.load()?);
+        Ok(match plan.controller {
+            ArmController::Oc => {
+                let mut config = c.sim_config();
+                config.world.innies = c.oc_innies();
+                let oc = OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds);
+                let sensors = c.sensors.build(&config)?;
+                let sim = Simulation::with_sensors(config, field, sensors, c.seed).context("invalid settings")?;
+                Running::Oc(Box::new(sim), oc)
+            }
+            ArmController::Learn => {
+                let sensors = c.sensors.build(&c.sim_config())?;
+                Running::Learn(Box::new(Trainer::new(c.clone(), field, sensors, seed_table)?))
+            }
+        })
+    }
+
+    /// One step; how the episode ended, if it did.
+    pub fn step(&mut self) -> Option<EpisodeEnd> {
+        match self {
+            Running::Oc(sim, oc) => sim.step(oc),
+            Running::Learn(trainer) => trainer.step(),
+        }
+    }
+
+    /// The simulation.
+    pub fn simulation(&self) -> &Simulation<SelectedSensors> {
+        match self {
+            Running::Oc(sim, _) => sim,
+            Running::Learn(trainer) => trainer.simulation(),
+        }
+    }
+
+    /// The learner's states visited and states in all, for a learning run.
+    fn states(&self) -> Option<(usize, usize)> {
+        match self {
+            Running::Oc(..) => None,
+            Running::Learn(trainer) => {
+                let q = trainer.learner().table();
+                Some((q.states_visited(), q.hasher().num_states()))
+            }
+        }
+    }
+}
+
 /// Runs a trial; `seed_table` is the pre-trained table of a pre-trained arm.
 pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> {
-    let c = &plan.config;
-    let field = Arc::new(c.field.load()?);
+    let mut running = Running::start(plan, seed_table)?;
     let mut recorder = Recorder::default();
     let start = Instant::now();
-    let (totals, states) = match plan.controller {
-        ArmController::Oc => {
-            let mut config = c.sim_config();
-            config.world.innies = orbital_innies(&c.field, c.robots);
-            let mut oc = OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds);
-            let sensors = c.sensors.build(&config)?;
-            let mut sim = Simulation::with_sensors(config, field, sensors, c.seed).context("invalid settings")?;
-            for _ in 0..c.steps {
-                let end = sim.step(&mut oc);
-                recorder.after_step(end, sim.totals());
-            }
-            (sim.totals().clone(), None)
-        }
-        ArmController::Learn => {
-            let mut trainer = Trainer::new(c.clone(), field.clone(), c.sensors.build(&c.sim_config())?, seed_table)?;
-            for _ in 0..c.steps {
-                let end = trainer.step();
-                recorder.after_step(end, trainer.totals());
-            }
-            let q = trainer.learner().table();
-            (trainer.totals().clone(), Some((q.states_visited(), q.hasher().num_states())))
-        }
-    };
+    for _ in 0..plan.config.steps {
+        let end = running.step();
+        recorder.after_step(end, running.simulation().totals());
+    }
+    let (totals, states) = (running.simulation().totals().clone(), running.states());
+    let c = &plan.config;
     let seconds = start.elapsed().as_secs_f64();
     Ok(TrialResult {
         format: RESULT_FORMAT,

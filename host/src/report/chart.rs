@@ -64,32 +64,50 @@ pub struct Labels<'a> {
     pub y: &'a str,
 }
 
-/// Mean over trials with its 95 % confidence band, one line per arm (like
-/// the thesis' Figure 15).
-pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band]) -> Result<()> {
-    let summaries: Vec<Vec<(f64, MeanCi)>> = bands
+/// What the band around a mean spans.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Spread {
+    /// The 95 % confidence interval of the mean.
+    Ci95,
+    /// The least to the greatest trial.
+    MinMax,
+}
+
+/// Mean over trials with a band (95 % confidence or min to max), one line
+/// per arm (like the thesis' Figure 15).
+pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: Spread) -> Result<()> {
+    // (x, mean, low, high) per sample point
+    let summaries: Vec<Vec<(f64, f64, f64, f64)>> = bands
         .iter()
         .map(|b| {
             b.x.iter()
                 .enumerate()
                 .map(|(i, &x)| {
                     let column: Vec<f64> = b.trials.iter().filter_map(|t| t.get(i).copied()).collect();
-                    (x, MeanCi::of(&column))
+                    let ci = MeanCi::of(&column);
+                    match spread {
+                        Spread::Ci95 => (x, ci.mean, ci.low().max(0.0), ci.high()),
+                        Spread::MinMax => {
+                            let low = column.iter().copied().fold(f64::INFINITY, f64::min);
+                            let high = column.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                            (x, ci.mean, low.min(ci.mean), high.max(ci.mean))
+                        }
+                    }
                 })
                 .collect()
         })
         .collect();
     let x_max = bands.iter().flat_map(|b| b.x.iter().copied()).fold(1.0, f64::max);
-    let y_max = summaries.iter().flatten().map(|(_, ci)| ci.high()).fold(1.0, f64::max) * 1.05;
-    render(path, |root| {
+    let y_max = summaries.iter().flatten().map(|p| p.3).fold(1.0, f64::max) * 1.05;
+    render(path, WIDTH, HEIGHT, |root| {
         let mut chart = frame(root, labels, x_max, y_max)?;
         for (k, (band, summary)) in bands.iter().zip(&summaries).enumerate() {
             let color = PALETTE[k % PALETTE.len()];
-            let mut outline: Vec<(f64, f64)> = summary.iter().map(|(x, ci)| (*x, ci.high())).collect();
-            outline.extend(summary.iter().rev().map(|(x, ci)| (*x, ci.low().max(0.0))));
+            let mut outline: Vec<(f64, f64)> = summary.iter().map(|p| (p.0, p.3)).collect();
+            outline.extend(summary.iter().rev().map(|p| (p.0, p.2)));
             chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.2).filled())))?;
             chart
-                .draw_series(LineSeries::new(summary.iter().map(|(x, ci)| (*x, ci.mean)), color.stroke_width(2)))?
+                .draw_series(LineSeries::new(summary.iter().map(|p| (p.0, p.1)), color.stroke_width(2)))?
                 .label(band.name.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         }
@@ -102,7 +120,7 @@ pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band]) -> Result
 pub fn points_with_trend(path: &Path, labels: Labels<'_>, series: &[Scatter]) -> Result<()> {
     let x_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(1.0, f64::max);
     let y_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(1.0, f64::max) * 1.05;
-    render(path, |root| {
+    render(path, WIDTH, HEIGHT, |root| {
         let mut chart = frame(root, labels, x_max, y_max)?;
         for (k, s) in series.iter().enumerate() {
             let color = PALETTE[k % PALETTE.len()];
@@ -123,6 +141,34 @@ pub fn points_with_trend(path: &Path, labels: Labels<'_>, series: &[Scatter]) ->
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
         }
         legend(&mut chart)
+    })
+}
+
+/// Side of each picture of [`tiles`], pixels.
+pub const TILE: u32 = 360;
+const TILE_GAP: u32 = 12;
+const TILE_TITLE: u32 = 44;
+const TILE_CAPTION: u32 = 28;
+
+/// Pictures side by side in a row, each with a caption below, under a
+/// title (the thesis' Figures 11, 17 and 18). Pictures are scaled to
+/// [`TILE`] pixels square.
+pub fn tiles(path: &Path, title: &str, pictures: &[(String, image::RgbImage)]) -> Result<()> {
+    let n = pictures.len().max(1) as u32;
+    let width = n * TILE + (n + 1) * TILE_GAP;
+    let height = TILE_TITLE + TILE + TILE_CAPTION + TILE_GAP;
+    render(path, width, height, |root| {
+        root.draw(&Text::new(title.to_string(), (TILE_GAP as i32, 10), (FONT, 22).into_font()))?;
+        for (k, (caption, picture)) in pictures.iter().enumerate() {
+            let x0 = TILE_GAP + k as u32 * (TILE + TILE_GAP);
+            let scaled = image::imageops::resize(picture, TILE, TILE, image::imageops::FilterType::Triangle);
+            for (x, y, p) in scaled.enumerate_pixels() {
+                root.draw_pixel(((x0 + x) as i32, (TILE_TITLE + y) as i32), &RGBColor(p[0], p[1], p[2]))?;
+            }
+            let at = (x0 as i32, (TILE_TITLE + TILE + 6) as i32);
+            root.draw(&Text::new(caption.clone(), at, (FONT, 16).into_font()))?;
+        }
+        Ok(())
     })
 }
 
@@ -174,20 +220,23 @@ fn format_count(x: f64) -> String {
     }
 }
 
-/// Draws into an RGB buffer, then encodes a PNG and writes it atomically.
+/// Draws into an RGB buffer of `width` x `height`, then encodes a PNG and
+/// writes it atomically.
 fn render(
     path: &Path,
+    width: u32,
+    height: u32,
     draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<()>,
 ) -> Result<()> {
     ensure_font()?;
-    let mut buffer = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    let mut buffer = vec![0u8; (width * height * 3) as usize];
     {
-        let root = BitMapBackend::with_buffer(&mut buffer, (WIDTH, HEIGHT)).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut buffer, (width, height)).into_drawing_area();
         root.fill(&WHITE)?;
         draw(&root).with_context(|| format!("cannot draw chart {}", path.display()))?;
         root.present()?;
     }
-    let image = image::RgbImage::from_raw(WIDTH, HEIGHT, buffer).context("chart buffer has the wrong size")?;
+    let image = image::RgbImage::from_raw(width, height, buffer).context("chart buffer has the wrong size")?;
     let mut png = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
@@ -213,12 +262,19 @@ mod tests {
         ];
         let labels = Labels { title: "Formations", x: "step", y: "formations" };
         let path = dir.path().join("f.png");
-        mean_with_band(&path, labels, &bands).unwrap();
+        mean_with_band(&path, labels, &bands, Spread::Ci95).unwrap();
         let png = image::open(&path).unwrap();
         assert_eq!((png.width(), png.height()), (WIDTH, HEIGHT));
+        mean_with_band(&path, labels, &bands, Spread::MinMax).unwrap();
         let scatter = vec![Scatter { name: "A".into(), points: x.iter().map(|&v| (v, 100.0 + v / 100.0)).collect() }];
         let path = dir.path().join("c.png");
         points_with_trend(&path, labels, &scatter).unwrap();
         assert!(image::open(&path).is_ok());
+        let red = image::RgbImage::from_pixel(60, 60, image::Rgb([255, 0, 0]));
+        let path = dir.path().join("t.png");
+        tiles(&path, "Two", &[("a".into(), red.clone()), ("b".into(), red)]).unwrap();
+        let png = image::open(&path).unwrap().to_rgb8();
+        assert_eq!(png.width(), 2 * TILE + 3 * TILE_GAP);
+        assert_eq!(png.get_pixel(TILE_GAP + TILE / 2, TILE_TITLE + TILE / 2), &image::Rgb([255, 0, 0]));
     }
 }

@@ -43,6 +43,19 @@ impl MeanCi {
     }
 }
 
+/// The median of a sample (the mean of the middle two of an even count);
+/// `None` when empty.
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(v[n / 2]),
+        _ => Some((v[n / 2 - 1] + v[n / 2]) / 2.0),
+    }
+}
+
 /// A straight line `y = slope x + intercept`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Line {
@@ -87,6 +100,13 @@ mod tests {
         assert!((ci.half_width - expected).abs() < 1e-12);
         assert_eq!(MeanCi::of(&[3.0]).half_width, 0.0);
         assert_eq!(MeanCi::of(&[]).mean, 0.0);
+    }
+
+    #[test]
+    fn medians_take_the_middle_or_the_mean_of_the_middle_two() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), Some(2.5));
+        assert_eq!(median(&[]), None);
     }
 
     #[test]

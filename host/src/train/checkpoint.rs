@@ -1,20 +1,26 @@
 //! The checkpoint file: a complete [`TrainingState`], from which training
 //! resumes bit for bit.
 //!
-//! Layout, format version 1 (integers little-endian):
+//! Layout (integers little-endian):
 //!
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1), u16                              |
+//! | 8      | 2    | format version (1 or 2), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
+//!
+//! Format 2's body is the [`TrainingState`]; format 1's is the state
+//! without the settings added since ([`super::format1`]). A state
+//! that uses none of them is written as format 1, byte for byte what
+//! earlier builds wrote; both formats are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
 //! a run killed at any moment leaves the old checkpoint or the new one.
 
+use super::format1::StateV1;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
@@ -24,9 +30,10 @@ use std::path::Path;
 
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
-/// The format version this build writes and reads.
-/// 2: the world config of a rectangular arena (width, height, the
-/// field's frame and sampling, puck mass, millimetres per unit).
+/// The newest format version, which this build writes when format 1 cannot
+/// hold the state; it reads both. 2: the settings of how the thesis was run
+/// and the world config of a rectangular arena (width, height, the field's
+/// frame and sampling, puck mass, millimetres per unit).
 pub const VERSION: u16 = 2;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
@@ -75,7 +82,7 @@ impl fmt::Display for CheckpointError {
             CheckpointError::PolicyBlob => f.write_str("this is a policy blob, not a checkpoint (it holds no Q-values)"),
             CheckpointError::WrongMagic => f.write_str("not a checkpoint: the file does not start with ZSWMCKPT"),
             CheckpointError::UnsupportedVersion(v) => {
-                write!(f, "checkpoint format version {v} is not supported (this build reads version {VERSION})")
+                write!(f, "checkpoint format version {v} is not supported (this build reads versions 1 to {VERSION})")
             }
             CheckpointError::TrailingBytes { expected, found } => {
                 write!(f, "checkpoint has {found} bytes, {} more than its header declares", found - expected)
@@ -92,10 +99,14 @@ impl std::error::Error for CheckpointError {}
 
 /// Encodes a training state into `w`.
 pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
-    let body = postcard::to_stdvec(state).map_err(std::io::Error::other)?;
+    let (version, body) = match StateV1::of(state) {
+        Some(v1) => (1u16, postcard::to_stdvec(&v1)),
+        None => (VERSION, postcard::to_stdvec(state)),
+    };
+    let body = body.map_err(std::io::Error::other)?;
     let mut head = Vec::with_capacity(HEADER_LEN);
     head.extend_from_slice(&MAGIC);
-    head.extend_from_slice(&VERSION.to_le_bytes());
+    head.extend_from_slice(&version.to_le_bytes());
     head.extend_from_slice(&(body.len() as u64).to_le_bytes());
     let mut digest = CRC32.digest();
     digest.update(&head);
@@ -123,7 +134,7 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
         return Err(CheckpointError::WrongMagic);
     }
     let version = u16::from_le_bytes([bytes[8], bytes[9]]);
-    if version != VERSION {
+    if !(1..=VERSION).contains(&version) {
         return Err(CheckpointError::UnsupportedVersion(version));
     }
     let mut len = [0u8; 8];
@@ -141,7 +152,12 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
     if stored != computed {
         return Err(CheckpointError::CrcMismatch { stored, computed });
     }
-    postcard::from_bytes(&bytes[HEADER_LEN..crc_at]).map_err(|e| CheckpointError::Malformed(e.to_string()))
+    let body = &bytes[HEADER_LEN..crc_at];
+    let malformed = |e: postcard::Error| CheckpointError::Malformed(e.to_string());
+    match version {
+        1 => postcard::from_bytes::<StateV1>(body).map(StateV1::into_state).map_err(malformed),
+        _ => postcard::from_bytes(body).map_err(malformed),
+    }
 }
 
 /// Writes a checkpoint atomically.

@@ -3,9 +3,9 @@
 
 use crate::learn::{LearnConfig, StateHasherName};
 use sim::reward::Reward;
-use sim::scenario::field_config;
+use sim::scenario::{field_config, orbital_innies};
 use crate::sensor_choice::SensorChoice;
-use sim::{FieldSource, SimConfig};
+use sim::{FieldSource, ObstacleTargets, SimConfig, SuccessSignal};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -42,6 +42,49 @@ pub struct TrainConfig {
     pub learn: LearnConfig,
     /// Where results go.
     pub output: OutputConfig,
+    /// How often formations are checked, and on which world.
+    pub formation_check: FormationCheck,
+    /// What a check tests: `eval` (default), `eval-prime` (Eval' as
+    /// printed) or `eval-prime-spread`.
+    pub success: SuccessSignal,
+    /// Innies among the robots of an orbital-construction run; `None` for
+    /// half the robots on the annulus and none on letters and images
+    /// ([`orbital_innies`]). Learning runs have none.
+    pub innies: Option<usize>,
+    /// The disc sensor model's obstacle discs; `None` for the model's own
+    /// (`disc`: radius r/4 seeing any body).
+    pub obstacle_discs: Option<ObstacleDiscs>,
+}
+
+/// When an episode's formation is checked (`[formation_check]`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FormationCheck {
+    /// Steps between checks (100, the simulator's default).
+    pub every: u64,
+    /// Test the Eval measured at the previous check (at the episode's
+    /// start for the first) instead of the current one, as the thesis
+    /// author's loop did with `every = 1000` (reference model, "What the
+    /// thesis author's own runs did").
+    pub stale: bool,
+}
+
+impl Default for FormationCheck {
+    /// Every 100 steps, on the current world.
+    fn default() -> FormationCheck {
+        FormationCheck { every: 100, stale: false }
+    }
+}
+
+/// The obstacle discs of the disc sensor model (`obstacle_discs = { radius
+/// = 2.0, sees = "any-body" }`), at (+-45 deg, r) as in the original code.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ObstacleDiscs {
+    /// Disc radius, robot radii (the original code 0.25, the thesis' text 2).
+    pub radius: f64,
+    /// `robots` (the thesis' text) or `any-body` (the original code).
+    pub sees: ObstacleTargets,
 }
 
 /// Where a training run writes, and how often it checkpoints.
@@ -78,6 +121,10 @@ impl Default for TrainConfig {
             stuck_limit: None,
             learn: LearnConfig::default(),
             output: OutputConfig::default(),
+            formation_check: FormationCheck::default(),
+            success: SuccessSignal::Eval,
+            innies: None,
+            obstacle_discs: None,
         }
     }
 }
@@ -95,13 +142,26 @@ impl TrainConfig {
     }
 
     /// The simulation settings: the field's defaults ([`field_config`])
-    /// with this run's counts and stuck limit; every robot an outie.
+    /// with this run's counts, stuck limit, formation checks and obstacle
+    /// discs; every robot an outie.
     pub fn sim_config(&self) -> SimConfig {
         let mut c = field_config(&self.field, self.robots, self.pucks);
         if let Some(limit) = self.stuck_limit {
             c.episode.stuck_limit = limit;
         }
+        c.episode.check_interval = self.formation_check.every;
+        c.episode.stale_eval = self.formation_check.stale;
+        c.episode.success_signal = self.success;
+        if let Some(discs) = self.obstacle_discs {
+            c.sensors.obstacle.radius = discs.radius;
+            c.sensors.obstacle_targets = discs.sees;
+        }
         c
+    }
+
+    /// The innies of an orbital-construction run of these settings.
+    pub fn oc_innies(&self) -> usize {
+        self.innies.unwrap_or_else(|| orbital_innies(&self.field, self.robots))
     }
 
     /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
@@ -114,10 +174,22 @@ impl TrainConfig {
 
     /// Checks every setting before a run; errors name the setting.
     pub fn validate(&self) -> Result<()> {
+        if self.formation_check.every == 0 {
+            bail!("formation_check.every = 0: must be positive");
+        }
+        if let Some(r) = self.obstacle_discs.map(|d| d.radius).filter(|r| !(r.is_finite() && *r > 0.0)) {
+            bail!("obstacle_discs.radius = {r}: must be positive");
+        }
         self.sim_config().validate().context("invalid simulation settings")?;
         self.learn.validate()?;
         if self.steps == 0 {
             bail!("steps = 0: must be positive");
+        }
+        if let Some(n) = self.innies.filter(|&n| n > self.robots) {
+            bail!("innies = {n}: cannot exceed robots = {}", self.robots);
+        }
+        if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
+            bail!("obstacle_discs: only the disc sensor model takes them (sensors = {:?})", self.sensors.to_string());
         }
         let name = self.name();
         if name.is_empty() || name.len() > MAX_NAME_LEN || name.contains(['/', '\\']) || name.starts_with('.') {
@@ -153,7 +225,7 @@ fn truncate(s: &str) -> String {
 /// [`TrainConfig`]; each overrides the config file's value when given.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TrainOverrides {
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
     pub field: Option<FieldSource>,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with
     /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's

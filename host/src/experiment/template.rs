@@ -1,0 +1,485 @@
+//! The template of `docs/reproduction.md`: markdown with `{{ ... }}`
+//! expressions, each rendered from an experiment's published trials, so
+//! that every figure the document states comes from the trials (or is
+//! checked against them).
+//!
+//! An expression is one of (`EXP` is an experiment's name, or several
+//! joined by `+` for their sum where that makes sense):
+//! - `{{EXP table}}`: its thesis-layout table with the caption;
+//! - `{{EXP version}}`: the result formats of its trials (the simulator
+//!   versions, `plan::RESULT_FORMAT`), e.g. `2`;
+//! - `{{EXP trials}}`, `{{EXP runs}}` (trials and the pre-trainings they
+//!   started from), `{{EXP steps}}` (steps simulated, pre-trainings
+//!   included), `{{EXP wall}}` (the last sitting's wall time in its
+//!   `wall-time.txt`);
+//! - `{{EXP | ARM | QUANTITY | STAT}}`: a statistic over an arm's trials of
+//!   a per-trial QUANTITY: `formations`, `stuck`, `first_formation`,
+//!   `collisions_per_1000`, `states_visited`, `collision_trend` (the slope,
+//!   per step, of the least-squares line through the trial's collisions per
+//!   1000-step block), or `steps_per_formation` (steps over the mean
+//!   formations, STAT `value`). `ARM` may be `A / B`: each trial of A over
+//!   the mean of B's. STAT: `mean`, `median`, `min`, `max`, `ci` (the 95 %
+//!   half-width), `mean±ci`, `n`, `ratio` (the mean, as a ratio), `percent`,
+//!   `times`, `count OP X` (trials with QUANTITY OP X; OP one of `<`, `<=`,
+//!   `>`, `>=`, `=`), `thesis` (the thesis' figure from the experiment
+//!   file; for `A / B` A's formations ratio, or the ratio of the two arms'
+//!   figures), `over_thesis` (the mean over the thesis' figure), `verdict`
+//!   or `verdict X` (the thesis' figure, or X, against our trials: in our
+//!   95 % interval, within their range, or outside it);
+//! - a fifth part `OP X` checks the number: rendering fails when it does
+//!   not hold, since the prose around it says it does.
+//!
+//! An arm without trials renders `(not run)` and checks nothing.
+
+use super::metric::Metric;
+use super::outputs;
+use super::published::Published;
+use super::spec::ExperimentSpec;
+use super::trial::{TrialResult, BLOCK_STEPS};
+use crate::report::stats::{median, Line, MeanCi};
+use anyhow::{anyhow, bail, Context, Result};
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+/// One experiment as the template sees it.
+pub struct Source {
+    /// The experiment file.
+    pub spec: ExperimentSpec,
+    /// Its published trials.
+    pub published: Published,
+    /// Its published directory (`docs/reproduction/<name>`).
+    pub dir: PathBuf,
+}
+
+/// What an arm without trials renders as.
+pub const NOT_RUN: &str = "(not run)";
+
+/// Renders a template; errors name the line and the expression.
+pub fn render(template: &str, sources: &[Source]) -> Result<String> {
+    let mut out = String::with_capacity(template.len() * 2);
+    for (n, line) in template.split_inclusive('\n').enumerate() {
+        let mut rest = line;
+        while let Some(open) = rest.find("{{") {
+            out.push_str(&rest[..open]);
+            let after = &rest[open + 2..];
+            let close = after.find("}}").ok_or_else(|| anyhow!("template line {}: `{{{{` is not closed", n + 1))?;
+            let expr = &after[..close];
+            let value = expression(expr.trim(), sources).with_context(|| format!("template line {}: {{{{{expr}}}}}", n + 1))?;
+            out.push_str(&value);
+            rest = &after[close + 2..];
+        }
+        out.push_str(rest);
+    }
+    Ok(out)
+}
+
+fn expression(expr: &str, sources: &[Source]) -> Result<String> {
+    let parts: Vec<&str> = expr.split('|').map(str::trim).collect();
+    if parts.len() == 1 {
+        let (names, what) = expr.rsplit_once(' ').ok_or_else(|| anyhow!("expected `EXP table`, `EXP trials`, ... or `EXP | ARM | QUANTITY | STAT`"))?;
+        let experiments = experiments(names.trim(), sources)?;
+        return whole(&experiments, what);
+    }
+    if !(4..=5).contains(&parts.len()) {
+        bail!("expected EXP | ARM | QUANTITY | STAT, and optionally | OP X");
+    }
+    let source = experiments(parts[0], sources)?.into_iter().next().ok_or_else(|| anyhow!("no experiment"))?;
+    let stat = statistic(source, parts[1], parts[2], parts[3])?;
+    let Some(value) = stat.value else {
+        return Ok(stat.text);
+    };
+    if let Some(check) = parts.get(4) {
+        let (op, x) = comparison(check)?;
+        if !op.holds(value, x) {
+            bail!("the trials give {}, which is not {check}: the text around it needs rewriting", stat.text);
+        }
+    }
+    Ok(stat.text)
+}
+
+/// The experiments named `a+b+...`.
+fn experiments<'a>(names: &str, sources: &'a [Source]) -> Result<Vec<&'a Source>> {
+    names
+        .split('+')
+        .map(|n| {
+            let n = n.trim();
+            sources.iter().find(|s| s.spec.name == n).ok_or_else(|| anyhow!("no experiment {n:?}"))
+        })
+        .collect()
+}
+
+/// A figure of whole experiments.
+fn whole(experiments: &[&Source], what: &str) -> Result<String> {
+    let trials: Vec<&TrialResult> = experiments.iter().flat_map(|s| &s.published.results).collect();
+    match what {
+        "table" => match experiments {
+            [s] => Ok(outputs::table(&s.spec, &s.published.results).trim_end().to_string()),
+            _ => bail!("`table` takes one experiment"),
+        },
+        "version" => {
+            let formats: BTreeSet<u32> = trials.iter().map(|r| r.format).collect();
+            let formats: Vec<String> = formats.iter().map(u32::to_string).collect();
+            Ok(match formats.as_slice() {
+                [] => NOT_RUN.to_string(),
+                [one] => one.clone(),
+                [init @ .., last] => format!("{} and {last}", init.join(", ")),
+            })
+        }
+        "trials" => Ok(prose(trials.len() as f64)),
+        "runs" => Ok(prose((trials.len() + pretrainings(experiments).len()) as f64)),
+        "steps" => {
+            let steps = trials.iter().map(|r| r.steps).sum::<u64>()
+                + pretrainings(experiments).iter().map(|(_, steps)| steps).sum::<u64>();
+            Ok(format!("{} million", prose((steps as f64 / 1e6).round())))
+        }
+        "wall" => {
+            let seconds: Option<u64> = experiments.iter().map(|s| last_sitting(s)).sum();
+            Ok(seconds.map_or_else(|| "(not recorded)".to_string(), |s| format!("{} s ({} min)", prose(s as f64), prose((s as f64 / 60.0).round()))))
+        }
+        _ => bail!("unknown figure {what:?}: expected table, version, trials, runs, steps or wall"),
+    }
+}
+
+/// The distinct pre-trainings (hash, steps) the published trials started from.
+fn pretrainings(experiments: &[&Source]) -> BTreeSet<(String, u64)> {
+    let mut out = BTreeSet::new();
+    for s in experiments {
+        let trials = s.published.results.iter().map(|r| r.trial + 1).max().unwrap_or(0);
+        for plan in super::plan::plans(&s.spec, trials, 1.0, s.spec.seed) {
+            let published = s.published.results.iter().any(|r| r.arm == plan.arm && r.trial == plan.trial);
+            if let (true, Some(p)) = (published, plan.pretrain) {
+                out.insert((p.hash, p.config.steps));
+            }
+        }
+    }
+    out
+}
+
+/// Seconds of the last line of the experiment's `wall-time.txt`
+/// (`NAME: S s wall time ...`).
+fn last_sitting(s: &Source) -> Option<u64> {
+    let text = std::fs::read_to_string(s.dir.join("wall-time.txt")).ok()?;
+    let line = text.lines().rev().find(|l| !l.trim().is_empty())?;
+    line.split_once(": ")?.1.split_whitespace().next()?.parse().ok()
+}
+
+/// A rendered statistic and the number it stands for (none for text).
+struct Stat {
+    text: String,
+    value: Option<f64>,
+}
+
+impl Stat {
+    fn number(v: f64, text: String) -> Stat {
+        Stat { text, value: Some(v) }
+    }
+
+    fn text(text: &str) -> Stat {
+        Stat { text: text.to_string(), value: None }
+    }
+}
+
+/// A per-trial figure.
+#[derive(Clone, Copy, PartialEq)]
+enum Quantity {
+    Formations,
+    Stuck,
+    FirstFormation,
+    Collisions,
+    StatesVisited,
+    CollisionTrend,
+    StepsPerFormation,
+}
+
+impl Quantity {
+    fn parse(s: &str) -> Result<Quantity> {
+        Ok(match s {
+            "formations" => Quantity::Formations,
+            "stuck" => Quantity::Stuck,
+            "first_formation" => Quantity::FirstFormation,
+            "collisions_per_1000" => Quantity::Collisions,
+            "states_visited" => Quantity::StatesVisited,
+            "collision_trend" => Quantity::CollisionTrend,
+            "steps_per_formation" => Quantity::StepsPerFormation,
+            _ => bail!("unknown quantity {s:?}: expected formations, stuck, first_formation, collisions_per_1000, states_visited, collision_trend or steps_per_formation"),
+        })
+    }
+
+    fn of(self, r: &TrialResult) -> Option<f64> {
+        match self {
+            Quantity::Formations | Quantity::StepsPerFormation => Some(r.formations as f64),
+            Quantity::Stuck => Some(r.stuck as f64),
+            Quantity::FirstFormation => r.formation_steps.first().map(|&s| s as f64),
+            Quantity::Collisions => Some(r.collisions_per_1000),
+            Quantity::StatesVisited => r.states_visited.map(|v| v as f64),
+            Quantity::CollisionTrend => {
+                let points: Vec<(f64, f64)> = r
+                    .collisions_per_block
+                    .iter()
+                    .enumerate()
+                    .map(|(b, &c)| (((b as u64 + 1) * BLOCK_STEPS) as f64, c as f64))
+                    .collect();
+                Line::fit(&points).map(|l| l.slope)
+            }
+        }
+    }
+
+    /// The experiment files' figure of this quantity.
+    fn metric(self) -> Option<Metric> {
+        match self {
+            Quantity::Formations => Some(Metric::Formations),
+            Quantity::Stuck => Some(Metric::Stuck),
+            Quantity::FirstFormation => Some(Metric::FirstFormation),
+            Quantity::Collisions => Some(Metric::CollisionsPer1000),
+            Quantity::StatesVisited => Some(Metric::StatesVisited),
+            Quantity::StepsPerFormation => Some(Metric::StepsPerFormation),
+            Quantity::CollisionTrend => None,
+        }
+    }
+}
+
+/// The thesis' figure of `q` for arm `a`, or for `a / b`: `a`'s
+/// formations ratio if the file gives one, else the ratio of the two arms'.
+fn thesis(spec: &ExperimentSpec, a: &str, b: Option<&str>, q: Quantity) -> Result<f64> {
+    let m = q.metric().ok_or_else(|| anyhow!("the thesis gives no such figure"))?;
+    let of = |name: &str, m: Metric| -> Result<f64> {
+        let arm = spec.arm(name).ok_or_else(|| anyhow!("{} has no arm {name:?}", spec.name))?;
+        arm.thesis.get(&m).copied().ok_or_else(|| anyhow!("{}: arm {name:?} has no thesis figure for {}", spec.name, m.label()))
+    };
+    match b {
+        None => of(a, m),
+        Some(b) => match of(a, Metric::FormationsRatio) {
+            Ok(ratio) if q == Quantity::Formations => Ok(ratio),
+            _ => Ok(of(a, m)? / of(b, m)?),
+        },
+    }
+}
+
+fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<Stat> {
+    let spec = &source.spec;
+    let q = Quantity::parse(quantity)?;
+    let (a, b) = match arms.split_once(" / ") {
+        Some((a, b)) => (a.trim(), Some(b.trim())),
+        None => (arms, None),
+    };
+    spec.arm(a).ok_or_else(|| anyhow!("{} has no arm {a:?}", spec.name))?;
+    let of_arm = |name: &str| -> Vec<&TrialResult> { source.published.results.iter().filter(|r| r.arm == name).collect() };
+    if stat == "thesis" {
+        let v = thesis(spec, a, b, q)?;
+        return Ok(Stat::number(v, if b.is_some() { format!("{v:.2}") } else { prose(v) }));
+    }
+    let trials = of_arm(a);
+    if trials.is_empty() {
+        return Ok(Stat::text(NOT_RUN));
+    }
+    if q == Quantity::StepsPerFormation {
+        let mean = trials.iter().map(|r| r.formations as f64).sum::<f64>() / trials.len() as f64;
+        let v = trials[0].steps as f64 / mean;
+        return Ok(if mean > 0.0 { Stat::number(v, prose(v)) } else { Stat::text("–") });
+    }
+    let mut values: Vec<f64> = trials.iter().filter_map(|r| q.of(r)).collect();
+    if let Some(b) = b {
+        spec.arm(b).ok_or_else(|| anyhow!("{} has no arm {b:?}", spec.name))?;
+        let reference: Vec<f64> = of_arm(b).iter().filter_map(|r| q.of(r)).collect();
+        if reference.is_empty() {
+            return Ok(Stat::text(NOT_RUN));
+        }
+        let mean = reference.iter().sum::<f64>() / reference.len() as f64;
+        values.iter_mut().for_each(|v| *v /= mean);
+    }
+    if values.is_empty() {
+        return Ok(Stat::text("–"));
+    }
+    let show = |v: f64| match (q, b.is_some()) {
+        (Quantity::CollisionTrend, _) => format!("{v:+.1e}"),
+        (_, true) => format!("{v:.2}"),
+        _ => prose(v),
+    };
+    let ci = MeanCi::of(&values);
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let number = |v: f64| Ok(Stat::number(v, show(v)));
+    match stat {
+        "mean" | "ratio" => number(ci.mean),
+        "median" => number(median(&values).unwrap_or(f64::NAN)),
+        "min" => number(min),
+        "max" => number(max),
+        "ci" => number(ci.half_width),
+        "mean±ci" => Ok(Stat::number(ci.mean, format!("{} ± {}", show(ci.mean), show(ci.half_width)))),
+        "n" => Ok(Stat::number(values.len() as f64, prose(values.len() as f64))),
+        "percent" => Ok(Stat::number(ci.mean * 100.0, format!("{:.0} %", ci.mean * 100.0))),
+        "times" => Ok(Stat::number(ci.mean, format!("{:.1}x", ci.mean))),
+        "over_thesis" => {
+            let v = ci.mean / thesis(spec, a, b, q)?;
+            Ok(Stat::number(v, format!("{v:.2}")))
+        }
+        _ => {
+            if let Some(cond) = stat.strip_prefix("count") {
+                let (op, x) = comparison(cond.trim())?;
+                let n = values.iter().filter(|&&v| op.holds(v, x)).count() as f64;
+                return Ok(Stat::number(n, prose(n)));
+            }
+            if let Some(given) = stat.strip_prefix("verdict") {
+                let figure = match given.trim() {
+                    "" => thesis(spec, a, b, q)?,
+                    x => x.parse().map_err(|_| anyhow!("verdict {x:?}: expected a number"))?,
+                };
+                return Ok(Stat::text(&verdict(&values, figure)));
+            }
+            bail!("unknown statistic {stat:?}: expected mean, median, min, max, ci, mean±ci, n, ratio, percent, times, over_thesis, count OP X, thesis or verdict")
+        }
+    }
+}
+
+/// The thesis' figure against our trials' values: `reproduced` when it lies
+/// in the 95 % interval of our mean, `partly` within the range of our
+/// trials, `not reproduced` outside every trial (with the side ours is on).
+pub fn verdict(values: &[f64], thesis: f64) -> String {
+    let ci = MeanCi::of(values);
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let side = if ci.mean > thesis { "ours higher" } else { "ours lower" };
+    if values.len() > 1 && ci.low() <= thesis && thesis <= ci.high() {
+        "reproduced".to_string()
+    } else if min <= thesis && thesis <= max {
+        format!("partly ({side})")
+    } else {
+        format!("not reproduced ({side})")
+    }
+}
+
+/// A comparison operator.
+#[derive(Clone, Copy)]
+enum Op {
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+}
+
+impl Op {
+    fn holds(self, v: f64, x: f64) -> bool {
+        match self {
+            Op::Lt => v < x,
+            Op::Le => v <= x,
+            Op::Gt => v > x,
+            Op::Ge => v >= x,
+            Op::Eq => v == x,
+        }
+    }
+}
+
+/// `OP X`, e.g. `<= 10`.
+fn comparison(s: &str) -> Result<(Op, f64)> {
+    let s = s.trim();
+    let (op, rest) = [("<=", Op::Le), (">=", Op::Ge), ("<", Op::Lt), (">", Op::Gt), ("=", Op::Eq)]
+        .into_iter()
+        .find_map(|(token, op)| s.strip_prefix(token).map(|rest| (op, rest)))
+        .ok_or_else(|| anyhow!("{s:?}: expected OP X with OP one of <, <=, >, >=, ="))?;
+    let x = rest.trim().replace(',', "").parse().map_err(|_| anyhow!("{s:?}: {:?} is not a number", rest.trim()))?;
+    Ok((op, x))
+}
+
+/// A number as prose writes it: whole numbers and numbers from 1,000 up
+/// with thousands separators, others with 1 decimal from 10 up, else 2.
+pub fn prose(v: f64) -> String {
+    if !v.is_finite() {
+        return "–".to_string();
+    }
+    let a = v.abs();
+    if v.fract() == 0.0 || a >= 1000.0 {
+        let digits = format!("{:.0}", a);
+        let mut grouped = String::new();
+        for (i, c) in digits.chars().enumerate() {
+            if i > 0 && (digits.len() - i) % 3 == 0 {
+                grouped.push(',');
+            }
+            grouped.push(c);
+        }
+        format!("{}{grouped}", if v < 0.0 && v.round() != 0.0 { "-" } else { "" })
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn prose_numbers_group_thousands_and_round_by_size() {
+        assert_eq!(prose(31700.0), "31,700");
+        assert_eq!(prose(1234567.4), "1,234,567");
+        assert_eq!(prose(703.34), "703.3");
+        assert_eq!(prose(731.0), "731");
+        assert_eq!(prose(0.456), "0.46");
+        assert_eq!(prose(-1500.0), "-1,500");
+        assert_eq!(prose(f64::NAN), "–");
+    }
+
+    /// One experiment with two arms whose trials formed `a` and `b` shapes.
+    fn sources(a: &[u64], b: &[u64]) -> Vec<Source> {
+        let text = "title = \"t\"\n[[arms]]\nname = \"A\"\nthesis = { formations = 10 }\n[[arms]]\nname = \"B\"\n";
+        let spec = ExperimentSpec::parse("x", text).unwrap();
+        let trial = |arm: &str, i: usize, formations: u64| TrialResult {
+            format: 2,
+            config_hash: String::new(),
+            experiment: "x".into(),
+            arm: arm.into(),
+            trial: i,
+            seed: 0,
+            steps: 1000,
+            formations,
+            stuck: 0,
+            formation_steps: (1..=formations).map(|s| s * 10).collect(),
+            collisions_per_1000: 0.0,
+            collisions_per_block: vec![],
+            states_visited: None,
+            states_total: None,
+            steps_per_second: 0.0,
+            seconds: 0.0,
+        };
+        let mut results: Vec<TrialResult> = a.iter().enumerate().map(|(i, &f)| trial("A", i, f)).collect();
+        results.extend(b.iter().enumerate().map(|(i, &f)| trial("B", i, f)));
+        vec![Source { spec, published: Published { results, stale: vec![] }, dir: PathBuf::from("/nonexistent") }]
+    }
+
+    #[test]
+    fn expressions_render_statistics_ratios_counts_and_checks() {
+        let s = sources(&[8, 12, 13], &[4, 6]);
+        let r = |t: &str| render(t, &s);
+        assert_eq!(r("{{x | A | formations | mean}} of {{x | A | formations | thesis}}").unwrap(), "11 of 10");
+        assert_eq!(r("{{x | A | formations | median}} {{x | A | formations | count > 9}}").unwrap(), "12 2");
+        assert_eq!(r("{{x | A / B | formations | ratio}} {{x | A / B | formations | times}}").unwrap(), "2.20 2.2x");
+        assert_eq!(r("{{x | A | first_formation | max}} {{x trials}} {{x version}}").unwrap(), "10 5 2");
+        assert_eq!(r("{{x | A | formations | over_thesis | > 1}}").unwrap(), "1.10");
+        let broken = r("line\n{{x | A | formations | mean | < 11}}").unwrap_err();
+        assert!(format!("{broken:#}").contains("line 2") && format!("{broken:#}").contains("not < 11"), "{broken:#}");
+        let none = sources(&[], &[]);
+        assert_eq!(render("{{x | A | formations | mean | > 5}}", &none).unwrap(), NOT_RUN, "no trials: nothing to check");
+    }
+
+    #[test]
+    fn bad_expressions_are_named() {
+        let s = sources(&[1], &[1]);
+        let e = |t: &str| format!("{:#}", render(t, &s).unwrap_err());
+        assert!(e("{{x | C | formations | mean}}").contains("no arm \"C\""));
+        assert!(e("{{y | A | formations | mean}}").contains("no experiment \"y\""));
+        assert!(e("{{x | A | speed | mean}}").contains("unknown quantity \"speed\""));
+        assert!(e("{{x | A | formations | mode}}").contains("unknown statistic \"mode\""));
+        assert!(e("{{x | B | formations | thesis}}").contains("no thesis figure"));
+        assert!(e("{{x | A | formations | mean").contains("not closed"));
+        assert!(e("{{x | A | formations | mean | ~ 3}}").contains("expected OP X"));
+    }
+
+    #[test]
+    fn verdicts_place_the_thesis_figure_against_the_trials() {
+        let values = [10.0, 11.0, 12.0, 13.0, 30.0];
+        assert!(verdict(&values, 16.0).starts_with("reproduced"));
+        assert_eq!(verdict(&values, 29.0), "partly (ours lower)");
+        assert_eq!(verdict(&values, 4.0), "not reproduced (ours higher)");
+    }
+}

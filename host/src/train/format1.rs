@@ -1,0 +1,266 @@
+//! Format 1: the training settings and state as they were laid out before
+//! the settings of the thesis author's runs existed (formation checks every
+//! N steps on a stale Eval, the success signal, innies, obstacle discs; the
+//! simulation's stale signal) and before rectangular and screen arenas
+//! (a square arena's side only). Settings and states that use none of them
+//! keep this layout: a checkpoint is byte for byte what earlier builds
+//! wrote (format-1 files keep loading), and an experiment trial's hash is
+//! the one earlier builds gave it (`experiment::plan`).
+//!
+//! postcard is positional: these structs list the fields of format 1 in
+//! their order, the types they share with format 2 unchanged.
+
+use super::config::{FormationCheck, OutputConfig, TrainConfig};
+use super::trainer::TrainingState;
+use crate::learn::{LearnConfig, QLearner};
+use crate::sensor_choice::SensorChoice;
+use serde::{Deserialize, Serialize};
+use shared::SensorReading;
+use sim::config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
+use sim::field::FieldSampling;
+use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World, WorldState};
+
+/// A training state in format 1's layout.
+#[derive(Serialize, Deserialize)]
+pub struct StateV1 {
+    config: TrainConfigV1,
+    field_crc: u32,
+    sim: SimulationV1,
+    learner: QLearner,
+}
+
+/// A [`TrainConfig`] without the settings added since format 1.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrainConfigV1 {
+    field: FieldSource,
+    sensors: SensorChoice,
+    robots: usize,
+    pucks: usize,
+    steps: u64,
+    seed: u64,
+    stuck_limit: Option<u64>,
+    learn: LearnConfig,
+    output: OutputConfig,
+}
+
+#[derive(Serialize, Deserialize)]
+struct SimulationV1 {
+    config: SimConfigV1,
+    world: WorldV1,
+    controller_rng: SimRng,
+    episode_step: u64,
+    totals: Totals,
+    readings: Vec<SensorReading>,
+}
+
+/// A square arena's world settings.
+#[derive(Clone, Serialize, Deserialize)]
+struct WorldConfigV1 {
+    arena_size: f64,
+    robots: usize,
+    innies: usize,
+    pucks: usize,
+    robot_radius: f64,
+    puck_radius: f64,
+    forward_speed: f64,
+    broad_phase: BroadPhase,
+}
+
+impl WorldConfigV1 {
+    /// The settings in format 1, if the arena is the reference model's kind:
+    /// square, 5 mm per unit, pucks of the default mass, the field over the
+    /// whole arena read at the nearest cell.
+    fn of(w: &WorldConfig) -> Option<WorldConfigV1> {
+        let plain = w.arena_width == w.arena_height
+            && w.unit_mm == WorldConfig::default().unit_mm
+            && w.puck_mass.is_none()
+            && w.field_frame.is_none()
+            && w.field_sampling == FieldSampling::Nearest;
+        plain.then(|| WorldConfigV1 {
+            arena_size: w.arena_width,
+            robots: w.robots,
+            innies: w.innies,
+            pucks: w.pucks,
+            robot_radius: w.robot_radius,
+            puck_radius: w.puck_radius,
+            forward_speed: w.forward_speed,
+            broad_phase: w.broad_phase,
+        })
+    }
+
+    fn into_config(self) -> WorldConfig {
+        WorldConfig {
+            arena_width: self.arena_size,
+            arena_height: self.arena_size,
+            robots: self.robots,
+            innies: self.innies,
+            pucks: self.pucks,
+            robot_radius: self.robot_radius,
+            puck_radius: self.puck_radius,
+            forward_speed: self.forward_speed,
+            broad_phase: self.broad_phase,
+            ..WorldConfig::default()
+        }
+    }
+}
+
+/// A world's state in format 1's layout.
+#[derive(Serialize, Deserialize)]
+struct WorldV1 {
+    config: WorldConfigV1,
+    physics: PhysicsConfig,
+    bodies: Vec<Body>,
+    robots: Vec<Robot>,
+    steps: u64,
+    rng: SimRng,
+}
+
+impl WorldV1 {
+    fn of(world: &World) -> Option<WorldV1> {
+        let s = world.state();
+        Some(WorldV1 {
+            config: WorldConfigV1::of(&s.config)?,
+            physics: s.physics.clone(),
+            bodies: s.bodies.clone(),
+            robots: s.robots.clone(),
+            steps: s.steps,
+            rng: s.rng.clone(),
+        })
+    }
+
+    fn into_world(self) -> World {
+        World::from_state(WorldState {
+            config: self.config.into_config(),
+            physics: self.physics,
+            bodies: self.bodies,
+            robots: self.robots,
+            steps: self.steps,
+            rng: self.rng,
+        })
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct SimConfigV1 {
+    world: WorldConfigV1,
+    physics: PhysicsConfig,
+    sensors: DiscSensorConfig,
+    thresholds: Thresholds,
+    episode: EpisodeV1,
+}
+
+#[derive(Serialize, Deserialize)]
+struct EpisodeV1 {
+    success_eval: f64,
+    check_interval: u64,
+    stuck_limit: u64,
+    phi: f64,
+    nu: f64,
+}
+
+impl TrainConfigV1 {
+    /// The settings in format 1, if they use nothing format 1 cannot hold.
+    pub fn of(c: &TrainConfig) -> Option<TrainConfigV1> {
+        let plain = c.formation_check == FormationCheck::default()
+            && c.success == SuccessSignal::Eval
+            && c.innies.is_none()
+            && c.obstacle_discs.is_none();
+        plain.then(|| TrainConfigV1 {
+            field: c.field.clone(),
+            sensors: c.sensors.clone(),
+            robots: c.robots,
+            pucks: c.pucks,
+            steps: c.steps,
+            seed: c.seed,
+            stuck_limit: c.stuck_limit,
+            learn: c.learn.clone(),
+            output: c.output.clone(),
+        })
+    }
+}
+
+impl From<TrainConfigV1> for TrainConfig {
+    /// The settings, with every one format 1 lacks at its default.
+    fn from(c: TrainConfigV1) -> TrainConfig {
+        TrainConfig {
+            field: c.field,
+            sensors: c.sensors,
+            robots: c.robots,
+            pucks: c.pucks,
+            steps: c.steps,
+            seed: c.seed,
+            stuck_limit: c.stuck_limit,
+            learn: c.learn,
+            output: c.output,
+            ..TrainConfig::default()
+        }
+    }
+}
+
+impl StateV1 {
+    /// The state in format 1, if it uses nothing format 1 cannot hold.
+    pub fn of(state: &TrainingState) -> Option<StateV1> {
+        let s = &state.sim;
+        let e = &s.config.episode;
+        let plain_sim = !e.stale_eval && e.success_signal == SuccessSignal::Eval && s.checked_signal.is_none();
+        let config = TrainConfigV1::of(&state.config).filter(|_| plain_sim)?;
+        Some(StateV1 {
+            config,
+            field_crc: state.field_crc,
+            sim: SimulationV1 {
+                config: SimConfigV1 {
+                    world: WorldConfigV1::of(&s.config.world)?,
+                    physics: s.config.physics.clone(),
+                    sensors: s.config.sensors.clone(),
+                    thresholds: s.config.thresholds.clone(),
+                    episode: EpisodeV1 {
+                        success_eval: e.success_eval,
+                        check_interval: e.check_interval,
+                        stuck_limit: e.stuck_limit,
+                        phi: e.phi,
+                        nu: e.nu,
+                    },
+                },
+                world: WorldV1::of(&s.world)?,
+                controller_rng: s.controller_rng.clone(),
+                episode_step: s.episode_step,
+                totals: s.totals.clone(),
+                readings: s.readings.clone(),
+            },
+            learner: state.learner.clone(),
+        })
+    }
+
+    /// The state, with every setting format 1 lacks at its default.
+    pub fn into_state(self) -> TrainingState {
+        let (c, s) = (self.config, self.sim);
+        let e = s.config.episode;
+        TrainingState {
+            config: c.into(),
+            field_crc: self.field_crc,
+            sim: SimulationState {
+                config: SimConfig {
+                    world: s.config.world.into_config(),
+                    physics: s.config.physics,
+                    sensors: s.config.sensors,
+                    thresholds: s.config.thresholds,
+                    episode: EpisodeConfig {
+                        success_eval: e.success_eval,
+                        check_interval: e.check_interval,
+                        stuck_limit: e.stuck_limit,
+                        phi: e.phi,
+                        nu: e.nu,
+                        ..EpisodeConfig::default()
+                    },
+                },
+                world: s.world.into_world(),
+                controller_rng: s.controller_rng,
+                episode_step: s.episode_step,
+                totals: s.totals,
+                readings: s.readings,
+                checked_signal: None,
+            },
+            learner: self.learner,
+        }
+    }
+}
