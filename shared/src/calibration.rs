@@ -15,19 +15,18 @@
 //! (1 / LIGHT_GAMMA)`.
 //!
 //! The firmware runs this on every decision, so it is integer-only with no
-//! division per reading: [`SensorCurve::new`] computes, once per
-//! calibration, the time of each of the 17 field values `k / 16` (in 1/16
-//! of a tick, from the integer light table [`LIGHT_AT_KNOT`]) and each
-//! piece's reciprocal; [`SensorCurve::value`] finds the piece with four
-//! comparisons and interpolates it with a subtraction, a 16 x 16 -> 32-bit
-//! multiply and shifts ([`SensorScale`]). The knots are exact, so `t_bright`
-//! reads 1.0 and `t_dark` reads 0.0; between knots the straight pieces
-//! stay within 0.002 of the curve above field 1/8, 0.005 between 1/16 and
-//! 1/8, and 0.018 below 1/16, where the light curve is steepest. With
-//! whole-tick readings and calibrations the result is within
+//! division or multiplication per reading: [`SensorCurve::calibrate`]
+//! computes, once per calibration, the field value at every 8th tick from
+//! the bright time on ([`CURVE_STEP_TICKS`]; the light curve inverted
+//! through the integer table [`LIGHT_AT`]), and [`SensorCurve::value`]
+//! interpolates between the two knots around a reading with a subtraction,
+//! shifts and three conditional additions. The knots are exact to the
+//! light table, `t_bright` reads exactly 1.0 and `t_dark` (and longer)
+//! 0.0; between knots the straight pieces stay within 0.017 of the curve,
+//! the most at field values below 0.05 where the light curve is steepest.
+//! With whole-tick readings and calibrations the result is within
 //! [`CURVE_TOLERANCE`] of the field value for the default responses
-//! (`tests` below). The simulator models the
-//! photo-transistors with this same code.
+//! (`tests` below).
 //!
 //! Times are in the robot's timer ticks (`docs/firmware.md` gives the tick
 //! length); nothing here depends on the unit.
@@ -135,43 +134,62 @@ impl SensorScale {
 /// The display's light curve: light is `v ^ LIGHT_GAMMA` of full white.
 pub const LIGHT_GAMMA: f32 = 2.2;
 
-/// Pieces of a sensor's curve: field values `k / 16` are its knots.
-pub const CURVE_SEGMENTS: usize = 16;
+/// Ticks between a curve's knots (a power of two).
+pub const CURVE_STEP_TICKS: u16 = 8;
 
-/// The light at each knot, `(k / 16) ^ LIGHT_GAMMA` of full white, in
-/// units of 2^-14 (rounded).
-pub const LIGHT_AT_KNOT: [u16; CURVE_SEGMENTS + 1] =
-    [0, 37, 169, 412, 776, 1268, 1894, 2658, 3566, 4621, 5826, 7185, 8701, 10376, 12213, 14215, 16384];
+/// Knots of a curve: enough for times from `bright` to the RC timeout.
+pub const CURVE_KNOTS: usize = 64;
 
-/// The longest calibration time a curve takes, ticks (the RC timeout is 500).
-pub const MAX_CURVE_TICKS: u16 = 1023;
+/// The light at field values `k / 32`, `(k / 32) ^ LIGHT_GAMMA` of full
+/// white, in units of 2^-14 (rounded): the light curve the calibration inverts.
+pub const LIGHT_AT: [u16; 33] = [
+    0, 8, 37, 90, 169, 276, 412, 579, 776, 1006, 1268, 1564, 1894, 2258, 2658, 3094, 3566, 4075, 4621, 5204, 5826, 6486,
+    7185, 7923, 8701, 9518, 10376, 11274, 12213, 13194, 14215, 15279, 16384,
+];
 
 /// How far a calibrated value may lie from the field value shown, for the
 /// simulator's default responses with whole-tick readings and calibrations
-/// (the largest error is near full white, where a tick spans the most field).
+/// (0.021 at worst, near black, where the light curve is steepest).
 pub const CURVE_TOLERANCE: f32 = 0.025;
 
-/// One sensor's calibrated curve: times of the 17 knots and each piece's
-/// reciprocal (82 bytes, so that the firmware keeps three of them in RAM).
+/// One sensor's calibrated curve: the field value at every
+/// [`CURVE_STEP_TICKS`]th tick from its bright time, up to its dark time
+/// (132 bytes, so that the firmware keeps three of them in RAM).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct SensorCurve {
-    /// Time of field value `k / 16`, in 1/16 tick; non-increasing in `k`
-    /// (`knots[0]` is the dark time, `knots[16]` the bright one).
-    knots: [u16; CURVE_SEGMENTS + 1],
-    /// Piece `k`'s `ceil(2^(15 + shift) / span)`, `span = max(1, knots[k] - knots[k + 1])`.
-    recips: [u16; CURVE_SEGMENTS],
-    /// Piece `k`'s `floor(log2(span))`.
-    shifts: [u8; CURVE_SEGMENTS],
+    /// The bright time, ticks: reads 1.0, and so does anything shorter.
+    bright: u16,
+    /// The dark time, ticks: reads 0.0, and so does anything longer.
+    dark: u16,
+    /// `knots[j]`: the field value at `bright + 8 j` ticks, raw Q15;
+    /// non-increasing; the knot after the last one before `dark` is 0 and
+    /// stands for `dark` itself.
+    knots: [u16; CURVE_KNOTS],
 }
+
+/// `EIGHTHS[m - 1][r]`: `r` ticks into a last piece of `m` ticks, in
+/// eighths of it (rounded down), for the piece that ends at the dark time.
+const EIGHTHS: [[u8; 8]; 8] = {
+    let mut table = [[0u8; 8]; 8];
+    let mut m = 1;
+    while m <= 8 {
+        let mut r = 0;
+        while r < m {
+            table[m - 1][r] = (r * 8 / m) as u8;
+            r += 1;
+        }
+        m += 1;
+    }
+    table
+};
 
 impl SensorCurve {
     /// A curve that reads every time as 0.0, to be calibrated.
-    pub const UNSET: SensorCurve =
-        SensorCurve { knots: [0; CURVE_SEGMENTS + 1], recips: [0; CURVE_SEGMENTS], shifts: [0; CURVE_SEGMENTS] };
+    pub const UNSET: SensorCurve = SensorCurve { bright: 0, dark: 0, knots: [0; CURVE_KNOTS] };
 
     /// The curve of a calibration range (a `bright` of 0 counts as 1 tick,
-    /// a `dark` at or below `bright` as one tick above it; times beyond
-    /// [`MAX_CURVE_TICKS`], twice the RC timeout and more, as that).
+    /// a `dark` at or below `bright` as one tick above it; times beyond the
+    /// RC timeout as the timeout).
     pub fn new(range: SensorRange) -> SensorCurve {
         let mut curve = SensorCurve::UNSET;
         curve.calibrate(range);
@@ -183,53 +201,79 @@ impl SensorCurve {
     /// inlined copies of this).
     #[inline(never)]
     pub fn calibrate(&mut self, range: SensorRange) {
-        let bright = u32::from(range.bright.clamp(1, MAX_CURVE_TICKS - 1));
-        let dark = u32::from(range.dark.min(MAX_CURVE_TICKS)).max(bright + 1);
-        let product = bright * dark;
-        for k in 0..=CURVE_SEGMENTS {
-            // t = t_b t_d / (t_b + L (t_d - t_b)), L in 2^-14, t in 1/16 tick,
-            // rounded: 2^18 t_b t_d / den in two 32-bit divisions (the AVR
-            // has no cheap 64-bit one; t_b t_d < 2^20, so every step fits).
-            let light = u32::from(LIGHT_AT_KNOT[k]);
-            let den = bright * 16_384 + light * (dark - bright);
-            let high = (product << 12) / den;
-            let rest = (product << 12) % den;
-            let t16 = high * 64 + (rest * 64 + den / 2) / den;
-            self.knots[k] = u16::try_from(t16).unwrap_or(u16::MAX);
-        }
-        for k in 0..CURVE_SEGMENTS {
-            let scale = SensorScale::new(SensorRange { bright: self.knots[k + 1], dark: self.knots[k] });
-            self.recips[k] = scale.recip;
-            self.shifts[k] = scale.shift;
+        let bright = range.bright.clamp(1, RC_TIMEOUT_TICKS - 1);
+        let dark = range.dark.min(RC_TIMEOUT_TICKS).max(bright + 1);
+        self.bright = bright;
+        self.dark = dark;
+        let (bright, dark) = (u32::from(bright), u32::from(dark));
+        for (j, knot) in self.knots.iter_mut().enumerate() {
+            let t = bright + j as u32 * u32::from(CURVE_STEP_TICKS);
+            *knot = if t >= dark {
+                0
+            } else {
+                // The light of time t, 2^-14 of full white: (t_d - t) t_b /
+                // (t (t_d - t_b)); t_b t_d < 2^18, so the shifted numerator fits.
+                let light = (((dark - t) * bright) << 14) / (t * (dark - bright));
+                field_of_light(light.min(16_384) as u16)
+            };
         }
     }
 
     /// The calibrated field value of a discharge time in whole ticks: 1.0
-    /// at or below the bright time, 0.0 at or above the dark time. (One
-    /// copy for the three sensors: the robot's flash is nearly full.)
+    /// at or below the bright time, 0.0 at or above the dark time.
     #[inline(never)]
     pub fn value(&self, ticks: u16) -> FieldValue {
-        let t = ticks.saturating_mul(16);
-        let kn = &self.knots;
-        // The last piece whose darker knot is at or above t (piece 0 if t
-        // is darker than every knot, piece 15 if brighter): a binary search
-        // written out, the masks telling the compiler every index is in range.
-        let mut k = if kn[8] >= t { 8 } else { 0 };
-        if kn[(k + 4) & 15] >= t {
-            k += 4;
+        if ticks <= self.bright {
+            return FieldValue::ONE;
         }
-        if kn[(k + 2) & 15] >= t {
-            k += 2;
+        if ticks >= self.dark {
+            return FieldValue::ZERO;
         }
-        if kn[(k + 1) & 15] >= t {
-            k += 1;
+        let past = ticks - self.bright;
+        let j = usize::from(past >> 3).min(CURVE_KNOTS - 2);
+        // Linear between knots j and j + 1, in eighths of the piece; the
+        // last piece ends at the dark time, fewer than 8 ticks on.
+        let start = past & !7;
+        let left = self.dark - self.bright - start;
+        let eighths = if left < CURVE_STEP_TICKS {
+            EIGHTHS[usize::from(left - 1) & 7][usize::from(past & 7)]
+        } else {
+            (past & 7) as u8
+        };
+        let (upper, lower) = (self.knots[j], self.knots[j + 1]);
+        let drop = u32::from(upper.saturating_sub(lower));
+        let mut fall = 0u32;
+        if eighths & 1 != 0 {
+            fall += drop;
         }
-        let k = k & 15;
-        let (dark, bright) = (kn[k], kn[k + 1]);
-        let span = if dark > bright { dark - bright } else { 1 };
-        let within = SensorScale { dark, span, recip: self.recips[k], shift: self.shifts[k] }.value(t).raw();
-        FieldValue::from_raw(((k as u16) << 11) + (within >> 4))
+        if eighths & 2 != 0 {
+            fall += drop << 1;
+        }
+        if eighths & 4 != 0 {
+            fall += drop << 2;
+        }
+        FieldValue::from_raw(upper - (fall >> 3) as u16)
     }
+}
+
+/// The field value (raw Q15) whose light is `light` (2^-14 of full white):
+/// [`LIGHT_AT`] inverted, linear between its entries.
+fn field_of_light(light: u16) -> u16 {
+    // The last entry at or below the light (a binary search of 33 entries).
+    let mut k = 0;
+    let mut step = 16;
+    while step > 0 {
+        if LIGHT_AT[k + step] <= light {
+            k += step;
+        }
+        step /= 2;
+    }
+    if k == 32 {
+        return FieldValue::ONE.raw();
+    }
+    let (low, high) = (u32::from(LIGHT_AT[k]), u32::from(LIGHT_AT[k + 1]));
+    let within = (u32::from(light) - low) * 1024 / (high - low);
+    (k as u32 * 1024 + within) as u16
 }
 
 /// Calibration of the three field sensors, indexed by [`LEFT`], [`MID`],
@@ -332,10 +376,23 @@ mod tests {
     }
 
     #[test]
-    fn the_light_table_is_the_light_curve_at_the_knots() {
-        for (k, &l) in LIGHT_AT_KNOT.iter().enumerate() {
-            let exact = (k as f64 / CURVE_SEGMENTS as f64).powf(f64::from(LIGHT_GAMMA)) * 16_384.0;
-            assert_eq!(f64::from(l), exact.round(), "knot {k}");
+    fn the_light_table_is_the_light_curve_and_inverts_to_its_field_values() {
+        for (k, &l) in LIGHT_AT.iter().enumerate() {
+            let exact = (k as f64 / 32.0).powf(f64::from(LIGHT_GAMMA)) * 16_384.0;
+            assert_eq!(f64::from(l), exact.round(), "entry {k}");
+            assert_eq!(field_of_light(l), (k as u16 * 1024).min(32768), "entry {k}");
+        }
+        // Linear between entries: within 0.009 below field 1/32 (light 8),
+        // where the curve is steepest, 0.0035 up to 1/16, 0.0025 above.
+        for l in 0..=16_384u16 {
+            let exact = (f64::from(l) / 16_384.0).powf(1.0 / f64::from(LIGHT_GAMMA));
+            let got = f64::from(field_of_light(l)) / 32_768.0;
+            let tolerance = match l {
+                l if l < LIGHT_AT[1] => 0.009,
+                l if l < LIGHT_AT[2] => 0.0035,
+                _ => 0.0025,
+            };
+            assert!((got - exact).abs() < tolerance, "light {l}: {got} vs {exact}");
         }
     }
 

@@ -64,6 +64,17 @@ impl ImageRegion {
         x >= self.x_min && x <= self.x_max && y >= self.y_min && y <= self.y_max
     }
 
+    /// Whether a point at row `y`, column `x` (whose mirror image about the
+    /// centre column is `mirrored_x`) lies in this region's mirror image and
+    /// in this region.
+    #[inline]
+    const fn sides(&self, mirrored_x: u16, x: u16, y: u16) -> (bool, bool) {
+        if y < self.y_min || y > self.y_max {
+            return (false, false);
+        }
+        (mirrored_x >= self.x_min && mirrored_x <= self.x_max, x >= self.x_min && x <= self.x_max)
+    }
+
     /// The region's mirror image about the image's centre column.
     pub const fn mirrored(&self) -> ImageRegion {
         let last = IMAGE_WIDTH - 1;
@@ -124,19 +135,23 @@ impl CameraConfig {
 
     /// The sensor bits of a set of blocks (any number, any order).
     pub fn classify(&self, blocks: &[PixyBlock]) -> BlobSummary {
-        let mut summary = BlobSummary::default();
-        let (puck_left, obstacle_left) = (self.puck_right.mirrored(), self.obstacle_right.mirrored());
+        let mut s = BlobSummary::default();
         for b in blocks {
+            // A block is in the left region when its mirror image is in the
+            // right one: one row test and two column tests per region.
+            let mirrored_x = (IMAGE_WIDTH - 1).saturating_sub(b.x);
             if b.signature == self.puck_signature {
-                summary.puck_left |= puck_left.contains(b.x, b.y);
-                summary.puck_right |= self.puck_right.contains(b.x, b.y);
+                let (left, right) = self.puck_right.sides(mirrored_x, b.x, b.y);
+                s.puck_left |= left;
+                s.puck_right |= right;
             }
             if b.signature == self.robot_signature {
-                summary.obstacle_left |= obstacle_left.contains(b.x, b.y);
-                summary.obstacle_right |= self.obstacle_right.contains(b.x, b.y);
+                let (left, right) = self.obstacle_right.sides(mirrored_x, b.x, b.y);
+                s.obstacle_left |= left;
+                s.obstacle_right |= right;
             }
         }
-        summary
+        s
     }
 }
 

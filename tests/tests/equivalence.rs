@@ -105,6 +105,9 @@ fn driving_zumo(elf: &std::path::Path, model: &RobotSensors, latency_us: f64) ->
 /// two periods and the Pixy sends nothing when it sees nothing.
 fn play(z: &mut Zumo, stimuli: &[Stimulus<'_>], holding: &mut bool) -> Vec<Observed> {
     let mut periods = Vec::with_capacity(stimuli.len());
+    // A period may be under way (after an earlier play's closing run), its
+    // sensors read with the earlier stimulus: finish it first.
+    z.run_to_decision();
     for s in stimuli {
         z.set_sensor_cycles(s.cycles.map(Some));
         z.show(s.frame);
