@@ -118,19 +118,19 @@ pub struct CameraConfig {
 }
 
 impl CameraConfig {
-    /// The lower half of the image (rows 100..=199), its right half
-    /// (columns 160..=319) for the right bits, the left half (0..=159) for
-    /// the left ones.
-    pub const LOWER_HALVES: ImageRegion =
-        ImageRegion { x_min: IMAGE_WIDTH / 2, x_max: IMAGE_WIDTH - 1, y_min: IMAGE_HEIGHT / 2, y_max: IMAGE_HEIGHT - 1 };
-
-    /// The defaults: pucks are signature 1, robots signature 2; both kinds
-    /// of bits from [`CameraConfig::LOWER_HALVES`].
+    /// The defaults: pucks are signature 1, robots signature 2; a puck
+    /// anywhere in the image's columns 80..=319 sets the right puck bit,
+    /// one in columns 0..=239 the left one (so one ahead, in 80..=239, sets
+    /// both, as the thesis' two puck discs both cover the ground ahead);
+    /// a robot in the bottom quarter (rows 150..=199: close) of columns
+    /// 100..=319 sets the right obstacle bit, of 0..=219 the left one.
+    /// Chosen by a sweep with the robot sensor model on the TV
+    /// (`docs/robot-sensors.md`).
     pub const DEFAULT: CameraConfig = CameraConfig {
         puck_signature: 1,
         robot_signature: 2,
-        puck_right: CameraConfig::LOWER_HALVES,
-        obstacle_right: CameraConfig::LOWER_HALVES,
+        puck_right: ImageRegion { x_min: 80, x_max: IMAGE_WIDTH - 1, y_min: 0, y_max: IMAGE_HEIGHT - 1 },
+        obstacle_right: ImageRegion { x_min: 100, x_max: IMAGE_WIDTH - 1, y_min: 150, y_max: IMAGE_HEIGHT - 1 },
     };
 
     /// The sensor bits of a set of blocks (any number, any order).
@@ -176,15 +176,18 @@ mod tests {
     }
 
     #[test]
-    fn sides_signatures_and_the_near_region() {
+    fn sides_signatures_and_the_regions() {
         let c = CameraConfig::DEFAULT;
-        let s = c.classify(&[block(1, 159, 150), block(2, 160, 199)]);
+        let s = c.classify(&[block(1, 79, 20), block(2, 250, 199)]);
         assert_eq!(s, BlobSummary { puck_left: true, puck_right: false, obstacle_left: false, obstacle_right: true });
-        // Far (upper half) and unknown signatures are ignored.
-        assert_eq!(c.classify(&[block(1, 10, 99), block(3, 10, 150), block(2, 300, 0)]), BlobSummary::default());
+        // A puck ahead is on both sides; a far robot and unknown signatures are ignored.
+        let s = c.classify(&[block(1, 160, 5)]);
+        assert!(s.puck_left && s.puck_right);
+        assert_eq!(c.classify(&[block(3, 10, 150), block(2, 300, 149)]), BlobSummary::default());
         // Region edges are inclusive.
-        assert!(c.classify(&[block(1, 0, 100)]).puck_left);
-        assert!(c.classify(&[block(1, 319, 199)]).puck_right);
+        assert!(c.classify(&[block(1, 0, 199)]).puck_left && !c.classify(&[block(1, 0, 199)]).puck_right);
+        assert!(c.classify(&[block(1, 80, 0)]).puck_right);
+        assert!(c.classify(&[block(2, 219, 150)]).obstacle_left);
     }
 
     #[test]

@@ -83,18 +83,22 @@ pub struct PhotoSensorConfig {
 }
 
 impl Default for PhotoSensorConfig {
-    /// Estimates for a Zumo 32U4's front array (to be measured, see
-    /// `docs/robot-sensors.md`): the sensors 35 mm ahead of the centre,
-    /// DN1 and DN5 37.5 mm to each side; discharge 150 to 170 us under full
+    /// Photo-transistors on the skirt's edge (65 mm from the centre), wired
+    /// to the front array's DN1, DN3 and DN5 pins: left and right 45
+    /// degrees off the heading, mid straight ahead (chosen by the
+    /// ablation and sweep in `docs/robot-sensors.md`: the front array's own
+    /// spacing, 37.5 mm to each side, reads too little of the gradient);
+    /// estimates, to be measured: discharge 150 to 170 us under full
     /// white and 1700 to 1820 us on black (the three sensors differ a
     /// little, as real ones do); the light curve's gamma,
     /// [`shared::calibration::LIGHT_GAMMA`]; the firmware's latency as
     /// measured in simavr, 2.8 us (`docs/robot-sensors.md`).
     fn default() -> PhotoSensorConfig {
-        let mount = |right_mm| MountPoint { forward_mm: 35.0, right_mm };
+        let side = 65.0 * std::f64::consts::FRAC_1_SQRT_2;
+        let mount = |forward_mm, right_mm| MountPoint { forward_mm, right_mm };
         let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
         PhotoSensorConfig {
-            mounts: [mount(-37.5), mount(0.0), mount(37.5)],
+            mounts: [mount(side, -side), mount(65.0, 0.0), mount(side, side)],
             response: [response(150.0, 1700.0), response(160.0, 1760.0), response(170.0, 1820.0)],
             gamma: f64::from(LIGHT_GAMMA),
             poll_latency_us: 2.8,

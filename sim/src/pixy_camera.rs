@@ -465,6 +465,7 @@ mod tests {
     use super::*;
     use crate::body::RobotKind;
     use crate::config::SimConfig;
+    use shared::ImageRegion;
 
     const R: f64 = 10.0;
 
@@ -498,7 +499,7 @@ mod tests {
         assert!(b.x.abs_diff(160) <= 1, "{b:?}");
         assert!(b.y >= 100, "a puck 3 radii ahead is in the lower half: {b:?}");
         let s = CameraConfig::DEFAULT.classify(&blocks);
-        assert!(s.puck_left != s.puck_right);
+        assert!(s.puck_left && s.puck_right, "ahead is on both sides");
     }
 
     #[test]
@@ -528,7 +529,8 @@ mod tests {
         let sigs: Vec<u16> = blocks.iter().map(|b| b.signature).collect();
         assert_eq!(sigs, [1, 1, 2], "{blocks:?}");
         assert!(blocks[0].width * blocks[0].height > blocks[1].width * blocks[1].height);
-        let s = CameraConfig::DEFAULT.classify(&blocks);
+        let halves = ImageRegion { x_min: 160, x_max: 319, y_min: 100, y_max: 199 };
+        let s = CameraConfig { obstacle_right: halves, ..CameraConfig::DEFAULT }.classify(&blocks);
         assert!(s.obstacle_right && !s.obstacle_left);
     }
 
