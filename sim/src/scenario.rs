@@ -6,6 +6,7 @@ use crate::broadphase::BroadPhase;
 use crate::config::{SimConfig, Thresholds};
 use crate::control::Controller;
 use crate::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction, RandomTurns};
+use crate::field::ScalarField;
 use crate::field_source::{FieldError, FieldSource};
 use crate::policy_file::{self, PolicyFileError};
 use crate::sensor_setup::{SelectedSensors, SensorSetup};
@@ -144,14 +145,46 @@ impl Scenario {
                 Box::new(GreedyPolicy::new(blob))
             }
         };
+        let sim = self.prepare(config)?.simulation(self.seed)?;
+        Ok((sim, controller))
+    }
+
+    /// Validates `config` (this scenario's [`config`](Self::config),
+    /// perhaps adjusted: thresholds, stuck limit, forward speed) and the
+    /// sensor settings, and loads the field once: what any number of
+    /// simulations of this scenario share. For callers that choose the
+    /// turns themselves (the Python environments, one world per seed).
+    pub fn prepare(&self, config: SimConfig) -> Result<PreparedScenario, ScenarioError> {
         config.validate()?;
         if let SensorSetup::Robot(robot) = &self.sensors {
             robot.validate()?;
         }
         let field = Arc::new(self.field.load()?);
-        let sensors = self.sensors.build(&config);
-        let sim = Simulation::with_sensors(config, field, sensors, self.seed)?;
-        Ok((sim, controller))
+        Ok(PreparedScenario { config, field, sensors: self.sensors.clone() })
+    }
+}
+
+/// A scenario's validated settings, loaded field and sensor settings,
+/// from [`Scenario::prepare`]: builds fresh simulations without loading
+/// the field again.
+#[derive(Clone, Debug)]
+pub struct PreparedScenario {
+    config: SimConfig,
+    field: Arc<ScalarField>,
+    sensors: SensorSetup,
+}
+
+impl PreparedScenario {
+    /// The settings every simulation gets.
+    pub fn config(&self) -> &SimConfig {
+        &self.config
+    }
+
+    /// A fresh simulation whose world is seeded with `seed`, exactly as
+    /// [`Scenario::build`] builds it for that seed.
+    pub fn simulation(&self, seed: u64) -> Result<Simulation<SelectedSensors>, ScenarioError> {
+        let sensors = self.sensors.build(&self.config);
+        Ok(Simulation::with_sensors(self.config.clone(), self.field.clone(), sensors, seed)?)
     }
 }
 
