@@ -301,7 +301,7 @@ impl PyBatch {
             "collisions_per_1000",
             PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().collisions_per_1000()).collect()),
         )?;
-        info.set_item("reset", out.steps.iter().map(|s| s.reset).collect::<Vec<bool>>())?;
+        info.set_item("reset", PyArray1::from_vec(py, out.steps.iter().map(|s| s.reset).collect::<Vec<bool>>()))?;
         if let Some(finals) = out.final_observations {
             info.set_item("final_obs", observations_array(py, finals, &shape)?)?;
             info.set_item("_final_obs", PyArray1::from_vec(py, out.final_mask))?;
