@@ -76,6 +76,9 @@ class SwarmVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._action_shape = (self.num_envs, self._batch.robots)
+        # Every info entry is for every world: one read-only mask for all.
+        self._every_world = np.ones(self.num_envs, dtype=bool)
+        self._every_world.flags.writeable = False
 
     @property
     def batch(self):
@@ -99,7 +102,7 @@ class SwarmVectorEnv(VectorEnv):
         flat = flat_actions(self._batch, actions, self._action_shape)
         obs, rewards, terminated, truncated, info = self._batch.step(flat)
         for key in [k for k in info if not k.startswith("_") and k != "final_obs"]:
-            info["_" + key] = np.ones(self.num_envs, dtype=bool)
+            info["_" + key] = self._every_world
         return obs, np.repeat(rewards[:, None], self._batch.robots, axis=1), terminated, truncated, info
 
     def render(self):
