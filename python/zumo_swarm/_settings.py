@@ -99,3 +99,18 @@ def flat_actions(batch: Batch, actions: Any, shape: tuple[int, ...]) -> np.ndarr
 def world_info(info: dict[str, np.ndarray], world: int) -> dict[str, Any]:
     """One world's entries of a batch's info, as Python scalars."""
     return {key: value[world].item() for key, value in info.items() if not key.startswith("_") and key != "final_obs"}
+
+
+class OneWorld:
+    """What the environments of one world share: drawing it and its bodies
+    (the class has ``_batch``, ``render_mode`` and ``render_size``)."""
+
+    def render(self):
+        """The world as ``host render`` draws it (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            return None
+        return self._batch.render(0, self.render_size)
+
+    def positions(self):
+        """Bodies' positions (robots first, then pucks) and the robots' headings."""
+        return self._batch.positions(0)

@@ -8,6 +8,7 @@ import numpy as np
 from pettingzoo import ParallelEnv
 
 from zumo_swarm._settings import (
+    OneWorld,
     check_render_mode,
     flat_actions,
     make_batch,
@@ -17,7 +18,7 @@ from zumo_swarm._settings import (
 )
 
 
-class SwarmParallelEnv(ParallelEnv):
+class SwarmParallelEnv(OneWorld, ParallelEnv):
     """The swarm as a PettingZoo ``ParallelEnv``: agents ``robot_0`` ...
     ``robot_{n-1}``, each observing its own sensors and choosing its own
     action; every agent receives the same global reward (the thesis').
@@ -95,16 +96,6 @@ class SwarmParallelEnv(ParallelEnv):
     def state(self) -> np.ndarray:
         """Every robot's current observation, stacked."""
         return self._last_obs
-
-    def render(self):
-        """The world as ``host render`` draws it (``render_mode="rgb_array"``)."""
-        if self.render_mode is None:
-            return None
-        return self._batch.render(0, self.render_size)
-
-    def positions(self):
-        """Bodies' positions (robots first, then pucks) and the robots' headings."""
-        return self._batch.positions(0)
 
     def close(self) -> None:
         pass

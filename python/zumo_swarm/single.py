@@ -8,6 +8,7 @@ from typing import Any
 import gymnasium as gym
 
 from zumo_swarm._settings import (
+    OneWorld,
     check_render_mode,
     flat_actions,
     make_batch,
@@ -17,7 +18,7 @@ from zumo_swarm._settings import (
 )
 
 
-class SwarmEnv(gym.Env):
+class SwarmEnv(OneWorld, gym.Env):
     """One world as a Gymnasium ``Env``: the observation stacks every
     robot's (``(robots, 7)`` floats, or ``robots`` hashed states), the
     action is ``MultiDiscrete`` over the robots (or angular speeds), the
@@ -55,12 +56,3 @@ class SwarmEnv(gym.Env):
         obs, rewards, terminated, truncated, info = self._batch.step(flat)
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), world_info(info, 0)
 
-    def render(self):
-        """The world as ``host render`` draws it (``render_mode="rgb_array"``)."""
-        if self.render_mode is None:
-            return None
-        return self._batch.render(0, self.render_size)
-
-    def positions(self):
-        """Bodies' positions (robots first, then pucks) and the robots' headings."""
-        return self._batch.positions(0)
