@@ -148,7 +148,30 @@ def render(results: dict) -> str:
             f"| {row['name']} | {runs} | {median:,.0f} | {median / base:.3g} | {cpu:,.0f} | {cpu / base_cpu:.3g} "
             f"| {cpu / random_cpu:.3g} |"
         )
+    lines.append("")
+    lines.extend(verdicts(rows, base_cpu, random_cpu))
     return "\n".join(lines) + "\n"
+
+
+def verdicts(rows: list[dict], base_cpu: float, random_cpu: float) -> list[str]:
+    """The issue's target at 64 worlds, and the ratios to every VMAS run."""
+    by_name = {row["name"]: row for row in rows}
+    ours = next(row for name, row in by_name.items() if name.startswith("vector_env, 64 worlds") and "threads" in name)
+    wall, cpu = statistics.median(ours["runs"]), statistics.median(ours["cpu_runs"])
+    worst = min(cpu / base_cpu, cpu / random_cpu)
+    out = [
+        f"- Target (64 worlds: at least 50 % of native single-thread throughput per core): {ours['name'].split(', random')[0]} "
+        f"does {cpu / base_cpu:.2f}x `host bench`'s steps per CPU-second and {cpu / random_cpu:.2f}x those of `host run "
+        f"--controller random` on the same workload: {'met' if worst >= 0.5 else 'NOT met'}."
+    ]
+    for row in rows:
+        if row["name"].startswith("VMAS"):
+            out.append(
+                f"- {ours['name'].split(', random')[0]} against {row['name']}: "
+                f"{wall / statistics.median(row['runs']):,.0f}x the steps per second, "
+                f"{cpu / statistics.median(row['cpu_runs']):,.0f}x per CPU-second."
+            )
+    return out
 
 
 def main() -> None:
