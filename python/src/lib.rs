@@ -249,13 +249,17 @@ impl PyBatch {
     /// one per world, each world starts afresh from its seed. Returns the
     /// observations.
     #[pyo3(signature = (seeds = None))]
-    fn reset<'py>(&mut self, py: Python<'py>, seeds: Option<Vec<u64>>) -> PyResult<Bound<'py, PyAny>> {
+    fn reset<'py>(&mut self, py: Python<'py>, seeds: Option<Vec<i64>>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.batch.worlds().len();
-        if let Some(s) = &seeds {
-            if s.len() != n {
-                return Err(value_error(format!("seed: got {} seeds for {n} worlds", s.len())));
-            }
-        }
+        let seeds = match seeds {
+            Some(s) if s.len() != n => return Err(value_error(format!("seed: got {} seeds for {n} worlds", s.len()))),
+            Some(s) => Some(
+                s.iter()
+                    .map(|&x| u64::try_from(x).map_err(|_| value_error(format!("seed = {x}: must be a whole number of at least 0"))))
+                    .collect::<PyResult<Vec<u64>>>()?,
+            ),
+            None => None,
+        };
         let batch = &mut self.batch;
         let obs = py.detach(|| batch.reset(seeds.as_deref())).map_err(value_error)?;
         observations_array(py, obs, &self.observation_shape(n))

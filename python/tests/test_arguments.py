@@ -37,6 +37,7 @@ BAD_SETTINGS = [
     ({"actions": [0.1, float("nan")]}, ValueError, r"actions = .*not a finite number"),
     ({"forward_speed": -2.0}, ValueError, r"forward_speed = -2"),
     ({"render_mode": "human"}, ValueError, r"render_mode = 'human'"),
+    ({"render_mode": "rgb_array", "render_size": 5}, ValueError, r"render_size = 5: must be a whole number of pixels"),
     ({"robots": "eight"}, TypeError, r"robots"),
     ({"robts": 8}, TypeError, r"robts"),
 ]
@@ -61,6 +62,10 @@ def test_bad_vector_env_arguments_are_named():
     env = zumo_swarm.vector_env(2, robots=2, pucks=5)
     with pytest.raises(ValueError, match="seed: got 3 seeds for 2 worlds"):
         env.reset(seed=[1, 2, 3])
+    with pytest.raises(ValueError, match="seed = -4: must be a whole number of at least 0"):
+        env.reset(seed=[1, -4])
+    with pytest.raises(ValueError, match="seed = -1"):
+        zumo_swarm.parallel_env(robots=2, pucks=5).reset(seed=-1)
 
 
 @pytest.mark.parametrize(

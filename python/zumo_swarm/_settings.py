@@ -47,11 +47,14 @@ def make_batch(num_worlds: int, autoreset: str, threads: int | None, settings: d
     return Batch(num_worlds, autoreset=autoreset, threads=threads, **settings)
 
 
-def check_render_mode(render_mode: str | None) -> str | None:
-    """``None`` or ``"rgb_array"``; anything else is refused by name."""
+def check_render(render_mode: str | None, render_size: int) -> tuple[str | None, int]:
+    """``render_mode`` ``None`` or ``"rgb_array"``, ``render_size`` 16 to 4096
+    pixels; anything else is refused by name."""
     if render_mode is not None and render_mode not in RENDER_MODES:
         raise ValueError(f"render_mode = {render_mode!r}: expected None or 'rgb_array'")
-    return render_mode
+    if not isinstance(render_size, (int, np.integer)) or not 16 <= render_size <= 4096:
+        raise ValueError(f"render_size = {render_size!r}: must be a whole number of pixels from 16 to 4096")
+    return render_mode, int(render_size)
 
 
 def robot_observation_space(batch: Batch) -> spaces.Space:

@@ -9,7 +9,7 @@ from pettingzoo import ParallelEnv
 
 from zumo_swarm._settings import (
     OneWorld,
-    check_render_mode,
+    check_render,
     flat_actions,
     make_batch,
     robot_action_space,
@@ -40,8 +40,7 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
     metadata = {"name": "zumo_swarm_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
 
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
-        self.render_mode = check_render_mode(render_mode)
-        self.render_size = render_size
+        self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
         self._batch = make_batch(1, "off", 1, settings)
         self.possible_agents = [f"robot_{i}" for i in range(self._batch.robots)]

@@ -9,7 +9,7 @@ import gymnasium as gym
 
 from zumo_swarm._settings import (
     OneWorld,
-    check_render_mode,
+    check_render,
     flat_actions,
     make_batch,
     world_action_space,
@@ -34,8 +34,7 @@ class SwarmEnv(OneWorld, gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
 
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
-        self.render_mode = check_render_mode(render_mode)
-        self.render_size = render_size
+        self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
         self._batch = make_batch(1, "off", 1, settings)
         self.observation_space = world_observation_space(self._batch)

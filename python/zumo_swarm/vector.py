@@ -10,7 +10,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from gymnasium.vector.utils import batch_space
 
 from zumo_swarm._settings import (
-    check_render_mode,
+    check_render,
     flat_actions,
     make_batch,
     world_action_space,
@@ -65,8 +65,7 @@ class SwarmVectorEnv(VectorEnv):
         mode = {name: m for m, name in _AUTORESET.items()}.get(autoreset_mode, autoreset_mode)
         if mode not in _AUTORESET:
             raise ValueError(f"autoreset_mode = {autoreset_mode!r}: expected 'next-step' or 'same-step'")
-        self.render_mode = check_render_mode(render_mode)
-        self.render_size = render_size
+        self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
         self._batch = make_batch(num_worlds, _AUTORESET[mode], threads, settings)
         self.num_envs = self._batch.num_worlds
