@@ -37,7 +37,7 @@ impl WorldStep {
     }
 }
 
-/// One robot's actions in one step, as the caller gave them (checked by
+/// One world's actions in one step, one per robot, as the caller gave them (checked by
 /// the batch before any world steps).
 #[derive(Clone, Copy, Debug)]
 pub enum WorldActions<'a> {
