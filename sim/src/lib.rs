@@ -68,7 +68,7 @@ pub use letters::Letter;
 pub use reward::Reward;
 pub use rng::SimRng;
 pub use robot_sensors::{RobotObservation, RobotSensorConfig, RobotSensors};
-pub use scenario::{Arena, ControllerChoice, Scenario, ScenarioError};
+pub use scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
 pub use sensor_model::{Footprint, FootprintKind, SensorModel};
 pub use sensor_setup::{SelectedSensors, SensorSetup};
 pub use simulation::{Simulation, SimulationState, StepReport, Totals};

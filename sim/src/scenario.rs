@@ -174,25 +174,67 @@ impl Scenario {
     /// Loads the field and policy, validates the settings and builds the
     /// simulation and controller. Errors name the offending input.
     pub fn build(&self) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
-        if let Arena::Screen(spec) = &self.arena {
-            spec.validate()?;
-        }
-        let field = Arc::new(self.arena.load(&self.field)?);
-        let mut config = self.config(&field);
+        let mut prepared = self.prepare()?;
         let controller: Box<dyn Controller> = match &self.controller {
-            ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds)),
+            ControllerChoice::Orbital => {
+                Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &prepared.config().thresholds))
+            }
             ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
             ControllerChoice::Policy(path) => {
                 let blob = policy_file::read(path)?;
-                config.world.forward_speed = f64::from(blob.actions().forward_speed());
+                prepared.config_mut().world.forward_speed = f64::from(blob.actions().forward_speed());
                 Box::new(GreedyPolicy::new(blob))
             }
         };
-        config.validate()?;
-        self.sensors.validate()?;
-        let sensors = self.sensors.build(&config);
-        let sim = Simulation::with_sensors(config, field, sensors, self.seed)?;
+        let sim = prepared.simulation(self.seed)?;
         Ok((sim, controller))
+    }
+
+    /// Validates the arena and the sensor settings, loads the field once
+    /// and derives the settings ([`config`](Self::config)): what any number
+    /// of simulations of this scenario share. For callers that choose the
+    /// turns themselves (the Python environments, one world per seed).
+    pub fn prepare(&self) -> Result<PreparedScenario, ScenarioError> {
+        if let Arena::Screen(spec) = &self.arena {
+            spec.validate()?;
+        }
+        self.sensors.validate()?;
+        let field = Arc::new(self.arena.load(&self.field)?);
+        let config = self.config(&field);
+        config.validate()?;
+        Ok(PreparedScenario { config, field, sensors: self.sensors.clone() })
+    }
+}
+
+/// A scenario's settings, loaded field and sensor settings, from
+/// [`Scenario::prepare`]: builds fresh simulations without loading the
+/// field again.
+#[derive(Clone, Debug)]
+pub struct PreparedScenario {
+    config: SimConfig,
+    field: Arc<ScalarField>,
+    sensors: SensorSetup,
+}
+
+impl PreparedScenario {
+    /// The settings every simulation gets.
+    pub fn config(&self) -> &SimConfig {
+        &self.config
+    }
+
+    /// The settings, to adjust (thresholds, stuck limit, forward speed)
+    /// before building simulations; [`simulation`](Self::simulation)
+    /// validates them.
+    pub fn config_mut(&mut self) -> &mut SimConfig {
+        &mut self.config
+    }
+
+    /// A fresh simulation whose world is seeded with `seed`, exactly as
+    /// [`Scenario::build`] builds it for that seed.
+    pub fn simulation(&self, seed: u64) -> Result<Simulation<SelectedSensors>, ScenarioError> {
+        self.config.validate()?;
+        let sensors = self.sensors.build(&self.config);
+        Ok(Simulation::with_sensors(self.config.clone(), self.field.clone(), sensors, seed)?)
     }
 }
 

@@ -1,0 +1,84 @@
+"""Steps per second of a VMAS scenario of the standard configuration's
+size on CPU: 8 agents and 250 movable passive discs of the agents' size,
+at our arena's density (a disc's radius is 1/80 of the arena side), random
+continuous actions. Runs in a virtual environment with `pip install vmas`
+(not a dependency of this project); prints one JSON object.
+
+    /tmp/vmas-venv/bin/python python/benchmarks/vmas_steps.py --envs 64 --steps 20
+"""
+
+import argparse
+import json
+import time
+
+import torch
+from vmas import make_env
+from vmas.simulator.core import Agent, Landmark, Sphere, World
+from vmas.simulator.scenario import BaseScenario
+from vmas.simulator.utils import ScenarioUtils
+
+RADIUS = 2.0 / 80  # arena side 2 (semidim 1); ours: radius 10 in 800
+
+
+class PuckScenario(BaseScenario):
+    """Agents among movable pucks that collide with everything: our
+    standard configuration's bodies in VMAS's simulator."""
+
+    def make_world(self, batch_dim, device, **kwargs):
+        n_agents = kwargs.pop("n_agents", 8)
+        n_pucks = kwargs.pop("n_pucks", 250)
+        ScenarioUtils.check_kwargs_consumed(kwargs)
+        world = World(batch_dim, device, x_semidim=1.0, y_semidim=1.0)
+        for i in range(n_agents):
+            world.add_agent(Agent(name=f"agent_{i}", shape=Sphere(RADIUS)))
+        for i in range(n_pucks):
+            world.add_landmark(Landmark(name=f"puck_{i}", collide=True, movable=True, shape=Sphere(RADIUS)))
+        return world
+
+    def reset_world_at(self, env_index=None):
+        ScenarioUtils.spawn_entities_randomly(
+            self.world.entities, self.world, env_index, min_dist_between_entities=2.2 * RADIUS,
+            x_bounds=(-1.0, 1.0), y_bounds=(-1.0, 1.0),
+        )
+
+    def observation(self, agent):
+        return torch.cat([agent.state.pos, agent.state.vel], dim=-1)
+
+    def reward(self, agent):
+        return torch.zeros(self.world.batch_dim, device=self.world.device)
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--envs", type=int, required=True)
+    parser.add_argument("--steps", type=int, default=20, help="env.step calls to time (each steps every env)")
+    parser.add_argument("--scenario", default="pucks", help="'pucks' (8 agents, 250 pucks) or a VMAS scenario taking n_agents")
+    parser.add_argument("--threads", type=int, default=2)
+    args = parser.parse_args()
+    torch.set_num_threads(args.threads)
+    if args.scenario == "pucks":
+        env = make_env(PuckScenario(), num_envs=args.envs, device="cpu", continuous_actions=True, seed=0)
+    else:  # a scenario of VMAS's own, with 8 agents
+        env = make_env(args.scenario, num_envs=args.envs, device="cpu", continuous_actions=True, seed=0, n_agents=8)
+    env.reset()
+    gen = torch.Generator().manual_seed(0)
+
+    def actions():
+        return [torch.rand((args.envs, 2), generator=gen) * 2 - 1 for _ in env.agents]
+
+    for _ in range(2):  # warm-up
+        env.step(actions())
+    start, cpu = time.perf_counter(), time.process_time()
+    for _ in range(args.steps):
+        env.step(actions())
+    seconds, cpu_seconds = time.perf_counter() - start, time.process_time() - cpu
+    print(json.dumps({
+        "scenario": args.scenario, "agents": len(env.agents), "bodies": len(env.world.entities), "envs": args.envs,
+        "calls": args.steps, "seconds": seconds, "steps_per_second": args.envs * args.steps / seconds,
+        "steps_per_cpu_second": args.envs * args.steps / cpu_seconds,
+        "torch": torch.__version__, "threads": torch.get_num_threads(),
+    }))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,400 @@
+//! `zumo_swarm._native`: the simulator of the `sim` crate for Python, as a
+//! batch of worlds stepped in Rust threads with NumPy arrays in and out.
+//!
+//! This crate holds no simulation logic: [`settings`] checks the keyword
+//! arguments and builds a `sim` scenario, [`world_env`] drives one
+//! simulation through `sim`'s step API (observe, advance, reset) with the
+//! reward and truncation an environment adds, [`batch`] steps many worlds
+//! in parallel, [`observation`] turns readings into arrays, and
+//! [`policy_codec`] encodes greedy tables with `shared`'s blob format. The
+//! Gymnasium and PettingZoo classes are Python (`zumo_swarm/`), over
+//! [`PyBatch`].
+#![warn(missing_docs)]
+
+pub mod batch;
+pub mod observation;
+pub mod policy_codec;
+pub mod settings;
+pub mod world_env;
+
+use batch::{Actions, Batch, StepError};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use observation::Observations;
+use policy_codec::PolicyHeader;
+use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use settings::{ActionKind, Autoreset, EnvArgs, ObservationKind, READING_LEN};
+use shared::{ActionTable, StateHasher};
+use sim::render::RenderOptions;
+use sim::reward::Reward;
+use sim::sensor_setup::SensorSetup;
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+fn step_error(e: StepError) -> PyErr {
+    match e {
+        StepError::WrongKind { .. } => PyTypeError::new_err(e.to_string()),
+        StepError::Ended { .. } => PyRuntimeError::new_err(e.to_string()),
+        _ => PyValueError::new_err(e.to_string()),
+    }
+}
+
+/// Worlds of one configuration, stepped together.
+#[pyclass(module = "zumo_swarm._native", name = "Batch")]
+pub struct PyBatch {
+    batch: Batch,
+}
+
+fn observations_array<'py>(py: Python<'py>, obs: Observations, shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match obs {
+        Observations::Readings(v) => PyArray1::from_vec(py, v).reshape(shape)?.into_any(),
+        Observations::States(v) => PyArray1::from_vec(py, v).reshape(shape)?.into_any(),
+    })
+}
+
+impl PyBatch {
+    /// The observation array's shape: worlds, robots, then floats per robot.
+    fn observation_shape(&self, worlds: usize) -> Vec<usize> {
+        let robots = self.batch.settings().robots();
+        match self.batch.settings().observation {
+            ObservationKind::Reading => vec![worlds, robots, READING_LEN],
+            ObservationKind::State(_) => vec![worlds, robots],
+        }
+    }
+
+    fn world_index(&self, world: usize) -> PyResult<usize> {
+        let n = self.batch.worlds().len();
+        if world < n {
+            Ok(world)
+        } else {
+            Err(value_error(format!("world = {world}: must be in 0..{n}")))
+        }
+    }
+}
+
+#[pymethods]
+impl PyBatch {
+    /// `num_worlds` worlds seeded `seed`, `seed + 1`, ...; the keyword
+    /// arguments are the environments' (docs/python.md). `autoreset` is
+    /// "off", "next-step" or "same-step"; `threads` defaults to one per
+    /// core.
+    #[new]
+    #[pyo3(signature = (
+        num_worlds = 1, *, field = "annulus".to_string(), robots = None, pucks = None, sensors = "disc".to_string(),
+        robot_config = None, seed = 1, max_steps = None, thresholds = None, reward = "reference".to_string(),
+        observation = "reading".to_string(), hasher = "original".to_string(), action = "discrete".to_string(),
+        actions = None, forward_speed = ActionTable::DEFAULT_FORWARD_SPEED, autoreset = "next-step".to_string(),
+        threads = None, arena = None
+    ))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        py: Python<'_>,
+        num_worlds: i64,
+        field: String,
+        robots: Option<i64>,
+        pucks: Option<i64>,
+        sensors: String,
+        robot_config: Option<String>,
+        seed: i64,
+        max_steps: Option<i64>,
+        thresholds: Option<(f64, f64)>,
+        reward: String,
+        observation: String,
+        hasher: String,
+        action: String,
+        actions: Option<Vec<f32>>,
+        forward_speed: f32,
+        autoreset: String,
+        threads: Option<i64>,
+        arena: Option<String>,
+    ) -> PyResult<PyBatch> {
+        let args = EnvArgs {
+            field,
+            arena,
+            robots,
+            pucks,
+            sensors,
+            robot_config,
+            seed,
+            max_steps,
+            thresholds,
+            reward,
+            observation,
+            hasher,
+            action,
+            actions: actions.unwrap_or_else(|| ActionTable::DEFAULT_ANGULAR.to_vec()),
+            forward_speed,
+        };
+        if num_worlds < 1 {
+            return Err(value_error(format!("num_worlds = {num_worlds}: must be a whole number of at least 1")));
+        }
+        let autoreset = match autoreset.as_str() {
+            "off" => Autoreset::Off,
+            "next-step" => Autoreset::NextStep,
+            "same-step" => Autoreset::SameStep,
+            other => {
+                return Err(value_error(format!("autoreset = {other:?}: expected \"off\", \"next-step\" or \"same-step\"")))
+            }
+        };
+        let threads = match threads {
+            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            Some(t) if t >= 1 => t as usize,
+            Some(t) => return Err(value_error(format!("threads = {t}: must be a whole number of at least 1"))),
+        };
+        let batch = py
+            .detach(|| {
+                let settings = args.settings().map_err(|e| e.to_string())?;
+                Batch::new(settings, num_worlds as usize, autoreset, threads).map_err(|e| e.to_string())
+            })
+            .map_err(PyValueError::new_err)?;
+        Ok(PyBatch { batch })
+    }
+
+    /// Number of worlds.
+    #[getter]
+    fn num_worlds(&self) -> usize {
+        self.batch.worlds().len()
+    }
+
+    /// Robots per world.
+    #[getter]
+    fn robots(&self) -> usize {
+        self.batch.settings().robots()
+    }
+
+    /// Threads that step the worlds.
+    #[getter]
+    fn threads(&self) -> usize {
+        self.batch.threads()
+    }
+
+    /// The action table's angular speeds, radians per step.
+    #[getter]
+    fn angular_speeds(&self) -> Vec<f32> {
+        self.batch.settings().actions.angular_speeds().to_vec()
+    }
+
+    /// The robots' forward speed, units per step.
+    #[getter]
+    fn forward_speed(&self) -> f32 {
+        self.batch.settings().actions.forward_speed()
+    }
+
+    /// The bound of a continuous action: the table's largest angular speed.
+    #[getter]
+    fn max_turn(&self) -> f32 {
+        self.batch.settings().max_turn()
+    }
+
+    /// "discrete" or "continuous".
+    #[getter]
+    fn action(&self) -> &'static str {
+        match self.batch.settings().action {
+            ActionKind::Discrete => "discrete",
+            ActionKind::Continuous => "continuous",
+        }
+    }
+
+    /// The hasher's name for state observations, `None` for readings.
+    #[getter]
+    fn hasher(&self) -> Option<&'static str> {
+        match self.batch.settings().observation {
+            ObservationKind::State(h) => Some(h.name()),
+            ObservationKind::Reading => None,
+        }
+    }
+
+    /// Number of states of a state observation, `None` for readings.
+    #[getter]
+    fn num_states(&self) -> Option<usize> {
+        match self.batch.settings().observation {
+            ObservationKind::State(h) => Some(h.num_states()),
+            ObservationKind::Reading => None,
+        }
+    }
+
+    /// The first world's seed.
+    #[getter]
+    fn seed(&self) -> u64 {
+        self.batch.settings().seed
+    }
+
+    /// Episode steps before truncation by the stuck limit.
+    #[getter]
+    fn stuck_limit(&self) -> u64 {
+        self.batch.settings().prepared.config().episode.stuck_limit
+    }
+
+    /// Truncation by `max_steps`, if set.
+    #[getter]
+    fn max_steps(&self) -> Option<u64> {
+        self.batch.settings().max_steps
+    }
+
+    /// Steps between formation checks.
+    #[getter]
+    fn check_interval(&self) -> u64 {
+        self.batch.settings().prepared.config().episode.check_interval
+    }
+
+    /// The reward's name.
+    #[getter]
+    fn reward(&self) -> &'static str {
+        self.batch.settings().reward.name()
+    }
+
+    /// Starts every world's next episode (a world that has not stepped
+    /// since it was built or reseeded keeps its first one); with `seeds`,
+    /// one per world, each world starts afresh from its seed. Returns the
+    /// observations.
+    #[pyo3(signature = (seeds = None))]
+    fn reset<'py>(&mut self, py: Python<'py>, seeds: Option<Vec<i64>>) -> PyResult<Bound<'py, PyAny>> {
+        let n = self.batch.worlds().len();
+        let seeds = match seeds {
+            Some(s) if s.len() != n => return Err(value_error(format!("seed: got {} seeds for {n} worlds", s.len()))),
+            Some(s) => Some(
+                s.iter()
+                    .map(|&x| u64::try_from(x).map_err(|_| value_error(format!("seed = {x}: must be a whole number of at least 0"))))
+                    .collect::<PyResult<Vec<u64>>>()?,
+            ),
+            None => None,
+        };
+        let batch = &mut self.batch;
+        let obs = py.detach(|| batch.reset(seeds.as_deref())).map_err(value_error)?;
+        observations_array(py, obs, &self.observation_shape(n))
+    }
+
+    /// Every world's current observations.
+    fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        observations_array(py, self.batch.observations(), &self.observation_shape(self.batch.worlds().len()))
+    }
+
+    /// One step of every world with a flat array of worlds x robots
+    /// actions (int64 indices or float64 angular speeds). Returns
+    /// (observations, reward per world, terminated, truncated, info), info
+    /// a dict of per-world arrays; with same-step autoreset it holds
+    /// `final_obs` (zeros for worlds that did not end) and `_final_obs`.
+    fn step<'py>(&mut self, py: Python<'py>, actions: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+        let out = if let Ok(a) = actions.extract::<PyReadonlyArray1<'py, i64>>() {
+            let a = a.as_slice()?;
+            let batch = &mut self.batch;
+            py.detach(|| batch.step(Actions::Discrete(a)))
+        } else if let Ok(a) = actions.extract::<PyReadonlyArray1<'py, f64>>() {
+            let a = a.as_slice()?;
+            let batch = &mut self.batch;
+            py.detach(|| batch.step(Actions::Continuous(a)))
+        } else {
+            return Err(PyTypeError::new_err("actions must be a one-dimensional int64 or float64 NumPy array"));
+        }
+        .map_err(step_error)?;
+        let n = out.steps.len();
+        let shape = self.observation_shape(n);
+        let column = |f: &dyn Fn(&world_env::WorldStep) -> f64| out.steps.iter().map(f).collect::<Vec<f64>>();
+        let info = PyDict::new(py);
+        info.set_item("eval", PyArray1::from_vec(py, column(&|s| s.eval)))?;
+        let ints = |f: &dyn Fn(usize) -> i64| PyArray1::from_vec(py, (0..n).map(f).collect::<Vec<i64>>());
+        info.set_item("episode_step", ints(&|i| out.steps[i].episode_step as i64))?;
+        info.set_item("robot_contacts", ints(&|i| out.steps[i].robot_contacts as i64))?;
+        let worlds = self.batch.worlds();
+        info.set_item("formations", ints(&|i| worlds[i].totals().formations as i64))?;
+        info.set_item("stuck_episodes", ints(&|i| worlds[i].totals().stuck as i64))?;
+        info.set_item("total_steps", ints(&|i| worlds[i].totals().steps as i64))?;
+        info.set_item("mean_eval", PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().mean_eval()).collect()))?;
+        info.set_item(
+            "collisions_per_1000",
+            PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().collisions_per_1000()).collect()),
+        )?;
+        info.set_item("reset", PyArray1::from_vec(py, out.steps.iter().map(|s| s.reset).collect::<Vec<bool>>()))?;
+        if let Some(finals) = out.final_observations {
+            info.set_item("final_obs", observations_array(py, finals, &shape)?)?;
+            info.set_item("_final_obs", PyArray1::from_vec(py, out.final_mask))?;
+        }
+        let rewards = PyArray1::from_vec(py, column(&|s| s.reward));
+        let terminated = PyArray1::from_vec(py, out.steps.iter().map(|s| s.terminated).collect::<Vec<bool>>());
+        let truncated = PyArray1::from_vec(py, out.steps.iter().map(|s| s.truncated).collect::<Vec<bool>>());
+        let obs = observations_array(py, out.observations, &shape)?;
+        Ok((obs, rewards, terminated, truncated, info).into_pyobject(py)?.into_any())
+    }
+
+    /// World `world` drawn as `host render` draws it: an RGB array of
+    /// `size` x `size` pixels (field grey, pucks red, robots blue).
+    #[pyo3(signature = (world = 0, size = 800, footprints = false))]
+    fn render<'py>(&self, py: Python<'py>, world: usize, size: u32, footprints: bool) -> PyResult<Bound<'py, PyAny>> {
+        let world = self.world_index(world)?;
+        if !(16..=4096).contains(&size) {
+            return Err(value_error(format!("render_size = {size}: must be 16 to 4096 pixels")));
+        }
+        let image = sim::render::draw(self.batch.worlds()[world].sim(), RenderOptions { size, footprints });
+        let (w, h) = (image.width() as usize, image.height() as usize);
+        Ok(PyArray1::from_vec(py, image.into_raw()).reshape([h, w, 3])?.into_any())
+    }
+
+    /// World `world`'s bodies (robots first, then pucks): an array of
+    /// (x, y) positions and one of headings of the robots, radians.
+    #[pyo3(signature = (world = 0))]
+    fn positions<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyAny>> {
+        let w = self.batch.worlds()[self.world_index(world)?].sim().world();
+        let xy: Vec<f64> = w.bodies().iter().flat_map(|b| [b.pos.x, b.pos.y]).collect();
+        let headings: Vec<f64> = w.robots().iter().map(|r| r.direction.y.atan2(r.direction.x)).collect();
+        let n = w.bodies().len();
+        Ok((PyArray1::from_vec(py, xy).reshape([n, 2])?, PyArray1::from_vec(py, headings)).into_pyobject(py)?.into_any())
+    }
+}
+
+/// Encodes a greedy table (one action per state) as policy blob bytes.
+#[pyfunction]
+#[pyo3(signature = (table, *, hasher, actions, forward_speed, field, name, trainer_steps, seed))]
+#[allow(clippy::too_many_arguments)]
+fn encode_policy<'py>(
+    py: Python<'py>,
+    table: Vec<i64>,
+    hasher: &str,
+    actions: Vec<f32>,
+    forward_speed: f32,
+    field: &str,
+    name: &str,
+    trainer_steps: u64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyBytes>> {
+    let header = PolicyHeader { hasher, actions: &actions, forward_speed, field, name, trainer_steps, seed };
+    let bytes = policy_codec::encode(&table, &header).map_err(value_error)?;
+    Ok(PyBytes::new(py, &bytes))
+}
+
+/// Decodes policy blob bytes read from `path` (named in errors) into a
+/// dict: hasher, actions, forward_speed, table, field, name,
+/// trainer_steps, seed.
+#[pyfunction]
+fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Bound<'py, PyDict>> {
+    let blob = sim::policy_file::decode(std::path::Path::new(path), data).map_err(value_error)?;
+    let d = PyDict::new(py);
+    d.set_item("hasher", blob.hasher().name())?;
+    d.set_item("actions", blob.actions().angular_speeds().to_vec())?;
+    d.set_item("forward_speed", blob.actions().forward_speed())?;
+    d.set_item("table", PyArray1::from_vec(py, policy_codec::table_of(&blob)))?;
+    let p = blob.provenance();
+    d.set_item("field", p.field.as_str())?;
+    d.set_item("name", p.name.as_str())?;
+    d.set_item("trainer_steps", p.trainer_steps)?;
+    d.set_item("seed", p.seed)?;
+    Ok(d)
+}
+
+/// The native module.
+#[pymodule]
+#[pyo3(name = "_native")]
+fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyBatch>()?;
+    m.add_function(wrap_pyfunction!(encode_policy, m)?)?;
+    m.add_function(wrap_pyfunction!(decode_policy, m)?)?;
+    m.add("HASHERS", StateHasher::ALL.iter().map(|h| h.name()).collect::<Vec<_>>())?;
+    m.add("REWARDS", Reward::ALL.iter().map(|r| r.name()).collect::<Vec<_>>())?;
+    m.add("SENSORS", SensorSetup::NAMES)?;
+    m.add("DEFAULT_ANGULAR", ActionTable::DEFAULT_ANGULAR.to_vec())?;
+    m.add("DEFAULT_FORWARD_SPEED", ActionTable::DEFAULT_FORWARD_SPEED)?;
+    m.add("READING_FIELDS", ["left", "mid", "right", "puck_left", "puck_right", "obstacle_left", "obstacle_right"])?;
+    Ok(())
+}

@@ -1,0 +1,119 @@
+"""The keyword arguments every environment takes, and the spaces they give.
+
+The simulator settings (``field``, ``robots``, ``pucks``, ``sensors``,
+``robot_config``, ``seed``, ``max_steps``, ``thresholds``, ``reward``,
+``observation``, ``hasher``, ``action``, ``actions``, ``forward_speed``) are
+checked in Rust by :class:`zumo_swarm._native.Batch`; this module only
+brings Python values into the types it takes and builds Gymnasium spaces
+from what the batch reports.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from gymnasium import spaces
+
+from zumo_swarm._native import Batch
+
+#: Render modes of every environment: the picture ``host render`` draws.
+RENDER_MODES = ["rgb_array"]
+
+
+def make_batch(num_worlds: int, autoreset: str, threads: int | None, settings: dict[str, Any]) -> Batch:
+    """A batch of ``num_worlds`` worlds with the environment's settings."""
+    settings = dict(settings)
+    config = settings.get("robot_config")
+    if isinstance(config, Mapping):
+        settings["robot_config"] = json.dumps(config)
+    elif isinstance(config, (str, os.PathLike)):
+        with open(config, encoding="utf-8") as f:
+            settings["robot_config"] = f.read()
+    elif config is not None:
+        raise TypeError(f"robot_config = {config!r}: expected a dict of settings or the path of a JSON file")
+    thresholds = settings.get("thresholds")
+    if thresholds is not None:
+        try:
+            outie, innie = (float(t) for t in thresholds)
+        except (TypeError, ValueError):
+            raise ValueError(f"thresholds = {thresholds!r}: must be two numbers (outie, innie)") from None
+        settings["thresholds"] = (outie, innie)
+    if "actions" in settings and settings["actions"] is not None:
+        settings["actions"] = [float(a) for a in settings["actions"]]
+    return Batch(num_worlds, autoreset=autoreset, threads=threads, **settings)
+
+
+def check_render(render_mode: str | None, render_size: int) -> tuple[str | None, int]:
+    """``render_mode`` ``None`` or ``"rgb_array"``, ``render_size`` 16 to 4096
+    pixels; anything else is refused by name."""
+    if render_mode is not None and render_mode not in RENDER_MODES:
+        raise ValueError(f"render_mode = {render_mode!r}: expected None or 'rgb_array'")
+    if not isinstance(render_size, (int, np.integer)) or not 16 <= render_size <= 4096:
+        raise ValueError(f"render_size = {render_size!r}: must be a whole number of pixels from 16 to 4096")
+    return render_mode, int(render_size)
+
+
+def robot_observation_space(batch: Batch) -> spaces.Space:
+    """One robot's observation: 7 floats in [0, 1], or a hashed state."""
+    if batch.num_states is None:
+        return spaces.Box(0.0, 1.0, shape=(7,), dtype=np.float32)
+    return spaces.Discrete(batch.num_states)
+
+
+def robot_action_space(batch: Batch) -> spaces.Space:
+    """One robot's action: an action-table index, or an angular speed."""
+    if batch.action == "discrete":
+        return spaces.Discrete(len(batch.angular_speeds))
+    return spaces.Box(-batch.max_turn, batch.max_turn, shape=(1,), dtype=np.float32)
+
+
+def world_observation_space(batch: Batch) -> spaces.Space:
+    """Every robot's observation of one world, stacked."""
+    if batch.num_states is None:
+        return spaces.Box(0.0, 1.0, shape=(batch.robots, 7), dtype=np.float32)
+    return spaces.MultiDiscrete(np.full(batch.robots, batch.num_states, dtype=np.int64))
+
+
+def world_action_space(batch: Batch) -> spaces.Space:
+    """Every robot's action of one world: one shared policy acts for all."""
+    if batch.action == "discrete":
+        return spaces.MultiDiscrete(np.full(batch.robots, len(batch.angular_speeds), dtype=np.int64))
+    return spaces.Box(-batch.max_turn, batch.max_turn, shape=(batch.robots,), dtype=np.float32)
+
+
+def flat_actions(batch: Batch, actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as the flat array the batch takes, its shape and type checked."""
+    a = np.asarray(actions)
+    if a.shape != shape:
+        raise ValueError(f"actions: expected an array of shape {shape}, got shape {a.shape}")
+    if batch.action == "discrete":
+        if not np.issubdtype(a.dtype, np.integer):
+            raise TypeError(f"actions: expected integers (action-table indices), got dtype {a.dtype}")
+        return np.ascontiguousarray(a, dtype=np.int64).reshape(-1)
+    if not (np.issubdtype(a.dtype, np.floating) or np.issubdtype(a.dtype, np.integer)):
+        raise TypeError(f"actions: expected angular speeds (floats), got dtype {a.dtype}")
+    return np.ascontiguousarray(a, dtype=np.float64).reshape(-1)
+
+
+def world_info(info: dict[str, np.ndarray], world: int) -> dict[str, Any]:
+    """One world's entries of a batch's info, as Python scalars."""
+    return {key: value[world].item() for key, value in info.items() if not key.startswith("_") and key != "final_obs"}
+
+
+class OneWorld:
+    """What the environments of one world share: drawing it and its bodies
+    (the class has ``_batch``, ``render_mode`` and ``render_size``)."""
+
+    def render(self):
+        """The world as ``host render`` draws it (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            return None
+        return self._batch.render(0, self.render_size)
+
+    def positions(self):
+        """Bodies' positions (robots first, then pucks) and the robots' headings."""
+        return self._batch.positions(0)

@@ -1,0 +1,57 @@
+"""The single-agent Gymnasium view of one world: one shared policy acts
+for every robot, as in the thesis."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+
+from zumo_swarm._settings import (
+    OneWorld,
+    check_render,
+    flat_actions,
+    make_batch,
+    world_action_space,
+    world_info,
+    world_observation_space,
+)
+
+
+class SwarmEnv(OneWorld, gym.Env):
+    """One world as a Gymnasium ``Env``: the observation stacks every
+    robot's (``(robots, 7)`` floats, or ``robots`` hashed states), the
+    action is ``MultiDiscrete`` over the robots (or angular speeds), the
+    reward is the global reward. ``terminated`` on a formation,
+    ``truncated`` at the stuck limit or ``max_steps``; ``info`` as in
+    :class:`zumo_swarm.parallel.SwarmParallelEnv`.
+
+    ``reset(seed=s)`` starts afresh from seed ``s``, the world ``host run
+    --seed s`` starts from; ``reset()`` starts the next episode (the very
+    first one is the constructor's ``seed``'s).
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
+        self.render_mode, self.render_size = check_render(render_mode, render_size)
+        self.settings = dict(settings)
+        self._batch = make_batch(1, "off", 1, settings)
+        self.observation_space = world_observation_space(self._batch)
+        self.action_space = world_action_space(self._batch)
+
+    @property
+    def batch(self):
+        """The native batch of one world (action table, hasher, limits)."""
+        return self._batch
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        obs = self._batch.reset(None if seed is None else [seed])
+        return obs[0], {}
+
+    def step(self, action):
+        flat = flat_actions(self._batch, action, self.action_space.shape)
+        obs, rewards, terminated, truncated, info = self._batch.step(flat)
+        return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), world_info(info, 0)
+

@@ -1,0 +1,132 @@
+"""Many worlds stepped in Rust threads: a Gymnasium vector environment with
+per-robot arrays, and its single-agent view."""
+
+from __future__ import annotations
+
+from typing import Any, Sequence
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
+from gymnasium.vector.utils import batch_space
+
+from zumo_swarm._settings import (
+    check_render,
+    flat_actions,
+    make_batch,
+    world_action_space,
+    world_observation_space,
+)
+
+_AUTORESET = {AutoresetMode.NEXT_STEP: "next-step", AutoresetMode.SAME_STEP: "same-step"}
+
+
+class SwarmVectorEnv(VectorEnv):
+    """``num_worlds`` worlds of one configuration, stepped together in Rust
+    threads (``threads``, default one per core) with no Python per robot or
+    per world: NumPy arrays in, NumPy arrays out.
+
+    - ``step(actions)``: ``actions`` of shape ``(worlds, robots)`` (action
+      indices, or angular speeds with ``action="continuous"``); returns
+      observations ``(worlds, robots, 7)`` float32 (or ``(worlds, robots)``
+      hashed states), rewards ``(worlds, robots)`` float64 (every robot of
+      a world the same global reward), terminations and truncations
+      ``(worlds,)``, and ``infos``, a dict of ``(worlds,)`` arrays (``eval``,
+      ``episode_step``, ``robot_contacts``, ``formations``,
+      ``stuck_episodes``, ``total_steps``, ``mean_eval``,
+      ``collisions_per_1000``, ``reset``), each with its ``_key`` mask.
+    - Autoreset: Gymnasium's default, **next-step**
+      (``AutoresetMode.NEXT_STEP``): the step in which a world's episode
+      terminates or is truncated returns its last observation; the world's
+      next step resets it, ignores its actions and returns the new
+      episode's first observation with reward 0, not terminated nor
+      truncated (``infos["reset"]`` marks it). ``autoreset_mode=
+      AutoresetMode.SAME_STEP`` (or ``"same-step"``) resets in the ending
+      step instead and puts the last observation in ``infos["final_obs"]``
+      (rows of the worlds marked in ``infos["_final_obs"]``).
+    - ``reset(seed=s)`` starts world ``i`` afresh from seed ``s + i`` (a list
+      gives each world's seed); ``reset()`` starts every world's next
+      episode. Before any reset, world ``i`` holds seed ``seed + i``.
+
+    :meth:`single_agent_view` gives the Gymnasium-convention view: one
+    environment per world, rewards of shape ``(worlds,)``.
+    Keyword arguments: see :func:`zumo_swarm.vector_env`.
+    """
+
+    def __init__(
+        self,
+        num_worlds: int,
+        *,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        threads: int | None = None,
+        render_mode: str | None = None,
+        render_size: int = 800,
+        **settings: Any,
+    ) -> None:
+        mode = {name: m for m, name in _AUTORESET.items()}.get(autoreset_mode, autoreset_mode)
+        if mode not in _AUTORESET:
+            raise ValueError(f"autoreset_mode = {autoreset_mode!r}: expected 'next-step' or 'same-step'")
+        self.render_mode, self.render_size = check_render(render_mode, render_size)
+        self.settings = dict(settings)
+        self._batch = make_batch(num_worlds, _AUTORESET[mode], threads, settings)
+        self.num_envs = self._batch.num_worlds
+        self.metadata = {"render_modes": ["rgb_array"], "autoreset_mode": mode}
+        self.single_observation_space = world_observation_space(self._batch)
+        self.single_action_space = world_action_space(self._batch)
+        self.observation_space = batch_space(self.single_observation_space, self.num_envs)
+        self.action_space = batch_space(self.single_action_space, self.num_envs)
+        self._action_shape = (self.num_envs, self._batch.robots)
+        # Every info entry is for every world: one read-only mask for all.
+        self._every_world = np.ones(self.num_envs, dtype=bool)
+        self._every_world.flags.writeable = False
+
+    @property
+    def batch(self):
+        """The native batch (action table, hasher, limits, threads)."""
+        return self._batch
+
+    def reset(self, *, seed: int | Sequence[int] | None = None, options: dict | None = None):
+        if seed is None:
+            seeds = None
+        elif isinstance(seed, (int, np.integer)):
+            super().reset(seed=int(seed))
+            seeds = [int(seed) + i for i in range(self.num_envs)]
+        else:
+            seeds = [int(s) for s in seed]
+            if len(seeds) != self.num_envs:
+                raise ValueError(f"seed: got {len(seeds)} seeds for {self.num_envs} worlds")
+            super().reset(seed=seeds[0])
+        return self._batch.reset(seeds), {}
+
+    def step(self, actions):
+        flat = flat_actions(self._batch, actions, self._action_shape)
+        obs, rewards, terminated, truncated, info = self._batch.step(flat)
+        for key in [k for k in info if not k.startswith("_") and k != "final_obs"]:
+            info["_" + key] = self._every_world
+        return obs, np.repeat(rewards[:, None], self._batch.robots, axis=1), terminated, truncated, info
+
+    def render(self):
+        """Every world as ``host render`` draws it (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            return None
+        return tuple(self._batch.render(i, self.render_size) for i in range(self.num_envs))
+
+    def single_agent_view(self) -> SingleAgentVectorEnv:
+        """This environment with Gymnasium's shapes: rewards ``(worlds,)``."""
+        return SingleAgentVectorEnv(self)
+
+
+class SingleAgentVectorEnv(VectorWrapper):
+    """A :class:`SwarmVectorEnv` as one Gymnasium environment per world:
+    observations and actions stack every robot's (``single_observation_space``
+    and ``single_action_space`` are :class:`zumo_swarm.single.SwarmEnv`'s),
+    the reward is the world's global reward, shape ``(worlds,)``."""
+
+    def step(self, actions):
+        obs, rewards, terminated, truncated, info = self.env.step(actions)
+        return obs, rewards[:, 0].copy(), terminated, truncated, info
+
+
+def make_single_agent_vector_env(num_envs: int = 1, **kwargs: Any) -> SingleAgentVectorEnv:
+    """``gymnasium.make_vec``'s entry point: the single-agent view of
+    ``num_envs`` worlds."""
+    return SwarmVectorEnv(num_envs, **kwargs).single_agent_view()
