@@ -6,9 +6,12 @@
 pub mod arena_choice;
 pub mod atomic;
 pub mod bench;
+pub mod display;
 pub mod experiment;
 pub mod inspect;
 pub mod learn;
+pub mod observe;
+pub mod panel_file;
 pub mod policy_file;
 pub mod render;
 pub mod report;

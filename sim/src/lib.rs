@@ -13,7 +13,8 @@
 //! it; [`policy_file`] reads policy blobs.
 //!
 //! Arenas: the thesis' square, or a screen lying flat with the field on
-//! it ([`arena`]: the 75" TV of the thesis' hardware).
+//! it ([`arena`]: the 75" TV of the thesis' hardware; [`panel`]: the image
+//! the screen shows).
 //!
 //! Everything random comes from a seeded [`SimRng`]; the whole state is
 //! serde-serialisable for bit-exact checkpoints. The crate reads field
@@ -35,6 +36,7 @@ pub mod field;
 pub mod field_source;
 pub mod grid;
 pub mod letters;
+pub mod panel;
 pub mod photo_sensors;
 pub mod physics;
 pub mod pixy_camera;
