@@ -178,7 +178,13 @@ impl DisplayArgs {
             Bind::Ip(ip) => SocketAddr::new(ip, self.port),
         };
         let hold_ms = self.hold * 1000.0;
-        anyhow::ensure!(hold_ms.is_finite() && hold_ms >= 0.0, "--hold {} is not a number of seconds", self.hold);
+        anyhow::ensure!(
+            hold_ms.is_finite() && hold_ms >= 0.0,
+            "--hold {}: give a number of seconds, {} to {}",
+            self.hold,
+            f64::from(host::display::MIN_HOLD_MS) / 1000.0,
+            f64::from(host::display::MAX_HOLD_MS) / 1000.0
+        );
         Ok(DisplaySettings {
             arena: self.screen.arena.screen()?,
             field: self.screen.field,
@@ -200,9 +206,10 @@ pub struct ObserveArgs {
     /// x,y of the panel's top-left, top-right, bottom-right, bottom-left.
     #[arg(long, value_parser = parse_corners)]
     pub corners: Corners,
-    /// The pucks' colour as the camera sees it, R,G,B.
-    #[arg(long, default_value = "200,44,44", value_parser = parse_rgb)]
-    pub puck_colour: [u8; 3],
+    /// The pucks' colour as the camera sees it, R,G,B [default: the
+    /// simulator's drawing's, 200,44,44].
+    #[arg(long, value_parser = parse_rgb)]
+    pub puck_colour: Option<[u8; 3]>,
     /// PNG to write: the top-down photo with the detected pucks, above
     /// them drawn over the field.
     #[arg(long)]
@@ -245,7 +252,7 @@ impl ObserveArgs {
             arena: self.screen.arena.screen()?,
             field: self.screen.field,
             corners: self.corners.0,
-            puck_colour: self.puck_colour,
+            puck_colour: self.puck_colour.unwrap_or(sim::render::PUCK.0),
             picture: self.picture,
         })
     }

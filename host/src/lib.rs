@@ -1,6 +1,6 @@
 //! The host side over the simulator (`sim`): the Q-learning trainer, the
-//! thesis' experiments and their reports, the tools for real robots, and
-//! the tools around policy blobs.
+//! thesis' experiments and their reports, the tools for real robots and
+//! for the field on their TV, and the tools around policy blobs.
 #![warn(missing_docs)]
 
 pub mod arena_choice;
