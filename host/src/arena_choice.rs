@@ -92,7 +92,8 @@ impl ArenaChoice {
         match self.arena()? {
             Arena::Screen(spec) => Ok(*spec),
             Arena::Square(_) => {
-                anyhow::bail!("--arena {self}: a screen arena is needed ({} or a FILE.toml), not the thesis' square", ArenaSpec::NAMES)
+                let names = ArenaSpec::NAMES;
+                anyhow::bail!("--arena {self}: a screen arena is needed ({names} or a FILE.toml), not the thesis' square")
             }
         }
     }

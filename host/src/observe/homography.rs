@@ -87,7 +87,8 @@ mod tests {
         assert!((mid[0] - 100.0).abs() < 1e-6 && (mid[1] - 50.0).abs() < 1e-6, "{mid:?}");
         // The middle of the top edge lies on the photo's top edge.
         let top = h.apply([127.0, 0.0]).unwrap();
-        let cross = (photo[1][0] - photo[0][0]) * (top[1] - photo[0][1]) - (photo[1][1] - photo[0][1]) * (top[0] - photo[0][0]);
+        let (edge, to_top) = ([photo[1][0] - photo[0][0], photo[1][1] - photo[0][1]], [top[0] - photo[0][0], top[1] - photo[0][1]]);
+        let cross = edge[0] * to_top[1] - edge[1] * to_top[0];
         assert!(cross.abs() < 1e-6, "{cross}");
     }
 

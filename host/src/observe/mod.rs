@@ -113,7 +113,9 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
     arena.validate().with_context(|| format!("arena {}", arena.name))?;
     let colour = ColourMatch::of(settings.puck_colour).with_context(|| {
         let [r, g, b] = settings.puck_colour;
-        format!("--puck-colour {r},{g},{b} is too grey to tell the pucks from the field: give their colour as the camera sees it")
+        format!(
+            "--puck-colour {r},{g},{b} is too grey to tell the pucks from the field: give their colour as the camera sees it"
+        )
     })?;
     let photo_path = &settings.photo;
     let photo = image::ImageReader::open(photo_path)
@@ -148,7 +150,10 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
         field: settings.field.to_string(),
         unit_mm: arena.unit_mm(),
         pixels_per_unit: scale,
-        pucks: centres.iter().map(|p| ObservedPuck { x: p.x, y: p.y, value: f64::from(field.evaluate(*p, &layout)) }).collect(),
+        pucks: centres
+            .iter()
+            .map(|p| ObservedPuck { x: p.x, y: p.y, value: f64::from(field.evaluate(*p, &layout)) })
+            .collect(),
         arena_pucks: arena.pucks,
         eval,
         success_eval: config.episode.success_eval,
