@@ -86,6 +86,18 @@ impl ArenaChoice {
         })
     }
 
+    /// The screen arena, for the tools of the TV (`host field export`,
+    /// `host display`, `host observe`): the thesis' square is refused.
+    pub fn screen(&self) -> Result<ArenaSpec> {
+        match self.arena()? {
+            Arena::Screen(spec) => Ok(*spec),
+            Arena::Square(_) => {
+                let names = ArenaSpec::NAMES;
+                anyhow::bail!("--arena {self}: a screen arena is needed ({names} or a FILE.toml), not the thesis' square")
+            }
+        }
+    }
+
     /// The arena a run uses without `--arena`: the TV with the robot's
     /// senses, the thesis' square otherwise.
     pub fn default_for(robot_senses: bool) -> ArenaChoice {
@@ -106,6 +118,9 @@ mod tests {
         for s in ["thesis", "tv75", "lab.toml"] {
             assert_eq!(s.parse::<ArenaChoice>().unwrap().to_string(), s);
         }
+        assert_eq!(ArenaChoice::Named("tv75".into()).screen().unwrap(), ArenaSpec::tv75());
+        let e = ArenaChoice::Thesis.screen().unwrap_err().to_string();
+        assert!(e.contains("--arena thesis") && e.contains("screen arena"), "{e}");
         let e = "tv55".parse::<ArenaChoice>().unwrap_err();
         assert!(e.contains("\"tv55\"") && e.contains("tv75"), "{e}");
     }

@@ -1,14 +1,17 @@
 //! The host side over the simulator (`sim`): the Q-learning trainer, the
-//! thesis' experiments and their reports, the tools for real robots, and
-//! the tools around policy blobs.
+//! thesis' experiments and their reports, the tools for real robots and
+//! for the field on their TV, and the tools around policy blobs.
 #![warn(missing_docs)]
 
 pub mod arena_choice;
 pub mod atomic;
 pub mod bench;
+pub mod display;
 pub mod experiment;
 pub mod inspect;
 pub mod learn;
+pub mod observe;
+pub mod panel_file;
 pub mod policy_file;
 pub mod render;
 pub mod report;

@@ -4,7 +4,7 @@ mod cli;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use cli::{Cli, Command, ExperimentAction, ExperimentArgs, MonitorArgs, PolicyCommand};
+use cli::{Cli, Command, ExperimentAction, ExperimentArgs, FieldCommand, MonitorArgs, PolicyCommand};
 use host::bench::BenchVariant;
 use host::run_summary::run_timed;
 use sim::render::RenderOptions;
@@ -95,6 +95,33 @@ fn run(cli: Cli) -> Result<()> {
             }
             let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
             flash::flash(&plan, avrdude.as_deref(), flash::PORT_WAIT, &mut std::io::stdout())
+        }
+        Command::Field(FieldCommand::Export(args)) => {
+            let arena = args.screen.arena.screen()?;
+            let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
+            println!("wrote {} ({w} x {h}: {} on {})", args.out.display(), args.screen.field, arena.name);
+            Ok(())
+        }
+        Command::Display(args) => {
+            let display = host::display::Display::start(&args.settings()?)?;
+            let url = display.url();
+            // The first line names the address (scripts and tests read it).
+            println!("display: serving {url}");
+            println!("  field: {url}   calibration: {url}?mode=calibrate   grey patches: {url}?mode=grey");
+            println!("  keys: c calibration, f field, g grey patches, Enter or click full-screen, h help; Ctrl-C stops");
+            std::io::stdout().flush().context("cannot write to stdout")?;
+            display.serve();
+            Ok(())
+        }
+        Command::Observe(args) => {
+            let json = args.json;
+            let observation = host::observe::observe(&args.settings()?)?;
+            let text = if json {
+                serde_json::to_string(&observation).context("cannot encode the observation")? + "\n"
+            } else {
+                observation.to_string()
+            };
+            std::io::stdout().write_all(text.as_bytes()).context("cannot write the observation")
         }
     }
 }

@@ -16,12 +16,15 @@
 //! corners), filling it.
 //!
 //! The screen shows the image scaled smoothly (bilinear), so the robots
-//! read the field with [`FieldSampling::Bilinear`]. Light: the display's
-//! light is `pixel ^ display_gamma`; the field value a pixel shows is the
-//! pixel value itself (`docs/robot-sensors.md`, "Light").
+//! read the field with [`FieldSampling::Bilinear`] ([`ArenaSpec::field_layout`]);
+//! panel pixel `(i, j)` shows the field at its centre
+//! ([`ArenaSpec::panel_pixel_centre`]). Light: the display's light is
+//! `pixel ^ display_gamma`; the pixel a field value is shown with is
+//! pre-compensated so that the light is `v ^ LIGHT_GAMMA`, the curve the
+//! robots' calibration assumes ([`crate::panel`], `docs/display.md`).
 
 use crate::config::SimConfig;
-use crate::field::{FieldFrame, FieldSampling, ScalarField};
+use crate::field::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
 use crate::validate::{check, positive, ConfigError};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
@@ -159,6 +162,23 @@ impl ArenaSpec {
         }
     }
 
+    /// Where `field` lies on this screen and how the robots read it: its
+    /// [`ArenaSpec::field_frame`], bilinear (as the screen scales it).
+    pub fn field_layout(&self, field: &ScalarField) -> FieldLayout {
+        FieldLayout { frame: self.field_frame((field.width(), field.height())), sampling: FieldSampling::Bilinear }
+    }
+
+    /// The position of panel pixel (`i`, `j`)'s centre, in units from the
+    /// screen's top-left corner (column `i` from the left, row `j` from the
+    /// top): the panel's pixels tile the visible area.
+    pub fn panel_pixel_centre(&self, i: u32, j: u32) -> Vec2 {
+        let size = self.size();
+        Vec2::new(
+            (f64::from(i) + 0.5) * size.x / f64::from(self.screen_px[0]),
+            (f64::from(j) + 0.5) * size.y / f64::from(self.screen_px[1]),
+        )
+    }
+
     /// Sets the arena, the bodies, the field's placement of `field` and the
     /// trial length in `config` (counts as given here; the caller may
     /// change them after).
@@ -176,8 +196,9 @@ impl ArenaSpec {
         world.robots = self.robots;
         world.pucks = self.pucks;
         world.forward_speed = self.forward_speed;
-        world.field_frame = Some(self.field_frame((field.width(), field.height())));
-        world.field_sampling = FieldSampling::Bilinear;
+        let layout = self.field_layout(field);
+        world.field_frame = Some(layout.frame);
+        world.field_sampling = layout.sampling;
     }
 }
 
@@ -213,6 +234,17 @@ mod tests {
     }
 
     #[test]
+    fn panel_pixels_tile_the_screen_centre_to_centre() {
+        let tv = ArenaSpec::tv75();
+        let size = tv.size();
+        let pixel = size.x / 3840.0;
+        let first = tv.panel_pixel_centre(0, 0);
+        assert!((first.x - pixel / 2.0).abs() < 1e-12 && (first.y - size.y / 2160.0 / 2.0).abs() < 1e-12);
+        let last = tv.panel_pixel_centre(3839, 2159);
+        assert!((size.x - last.x - pixel / 2.0).abs() < 1e-9 && (size.y - last.y - size.y / 4320.0).abs() < 1e-9);
+    }
+
+    #[test]
     fn applying_an_arena_sets_a_valid_world_read_bilinear() {
         let tv = ArenaSpec::tv75();
         let mut config = crate::config::SimConfig::default();
@@ -223,6 +255,7 @@ mod tests {
         assert_eq!(config.episode.stuck_limit, 15_000);
         assert_eq!(config.validate(), Ok(()));
         let bad = ArenaSpec { robot_radius_mm: -1.0, ..ArenaSpec::tv75() };
+        assert_eq!(config.world.field_layout(), tv.field_layout(&ScalarField::annulus_of(64, 36)));
         assert!(bad.validate().unwrap_err().to_string().contains("arena.robot_radius_mm"));
     }
 }

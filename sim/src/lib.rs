@@ -13,7 +13,8 @@
 //! it; [`policy_file`] reads policy blobs.
 //!
 //! Arenas: the thesis' square, or a screen lying flat with the field on
-//! it ([`arena`]: the 75" TV of the thesis' hardware).
+//! it ([`arena`]: the 75" TV of the thesis' hardware; [`panel`]: the image
+//! the screen shows).
 //!
 //! Everything random comes from a seeded [`SimRng`]; the whole state is
 //! serde-serialisable for bit-exact checkpoints. The crate reads field
@@ -36,6 +37,7 @@ pub mod field_source;
 pub mod grid;
 pub mod letters;
 pub mod mixed_sensors;
+pub mod panel;
 pub mod photo_sensors;
 pub mod physics;
 pub mod pixy_camera;

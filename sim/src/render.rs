@@ -3,12 +3,15 @@
 //! line, optionally each robot's sensor footprints. (Writing them as PNG
 //! or GIF files is the host's.)
 
+use crate::field::ScalarField;
 use crate::sensor_model::{FootprintKind, SensorModel};
 use crate::simulation::Simulation;
 use crate::vec2::Vec2;
+use crate::world::World;
 use image::{Rgb, RgbImage};
 
-const PUCK: Rgb<u8> = Rgb([200, 44, 44]);
+/// A puck's colour.
+pub const PUCK: Rgb<u8> = Rgb([200, 44, 44]);
 const ROBOT: Rgb<u8> = Rgb([0, 100, 200]);
 const HEADING: Rgb<u8> = Rgb([255, 255, 255]);
 const PUCK_SENSOR: Rgb<u8> = Rgb([250, 200, 0]);
@@ -34,42 +37,59 @@ impl Default for RenderOptions {
 /// Draws the simulation's current world.
 pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbImage {
     let world = sim.world();
+    let mut img = draw_world(world, sim.field(), options.size);
+    if !options.footprints {
+        return img;
+    }
+    let scale = scale_of(world, options.size);
+    let to_px = |p: Vec2| p * scale;
+    let mut footprints = Vec::new();
+    for i in 0..world.robots().len() {
+        footprints.clear();
+        sim.sensors().footprints(world, i, &mut footprints);
+        for f in &footprints {
+            let (colour, r) = match f.kind {
+                FootprintKind::Field => (FIELD_SENSOR, 2.0),
+                FootprintKind::Puck => (PUCK_SENSOR, f.radius * scale),
+                FootprintKind::Obstacle => (OBSTACLE_SENSOR, f.radius * scale),
+            };
+            if f.kind == FootprintKind::Field {
+                fill_circle(&mut img, to_px(f.centre), r, colour);
+            } else {
+                outline_circle(&mut img, to_px(f.centre), r, colour);
+            }
+        }
+    }
+    img
+}
+
+/// Draws a world over `field`, `size` pixels wide: the field (its value as
+/// grey, as the world reads it), pucks, robots with their heading.
+pub fn draw_world(world: &World, field: &ScalarField, size: u32) -> RgbImage {
     let (arena, layout) = (world.config().arena(), world.config().field_layout());
-    let scale = f64::from(options.size) / arena.x;
+    let scale = scale_of(world, size);
     let height = (arena.y * scale).round().max(1.0) as u32;
-    let mut img = RgbImage::from_fn(options.size, height, |x, y| {
+    let mut img = RgbImage::from_fn(size, height, |x, y| {
         let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
-        let v = (sim.field().evaluate(p, &layout) * 255.0).round() as u8;
+        let v = (field.evaluate(p, &layout) * 255.0).round() as u8;
         Rgb([v, v, v])
     });
     let to_px = |p: Vec2| p * scale;
     for puck in world.pucks() {
         fill_circle(&mut img, to_px(puck.pos), puck.radius * scale, PUCK);
     }
-    let mut footprints = Vec::new();
     for (i, robot) in world.robots().iter().enumerate() {
         let body = &world.bodies()[i];
         fill_circle(&mut img, to_px(body.pos), body.radius * scale, ROBOT);
         let tip = body.pos + robot.direction * body.radius;
         draw_line(&mut img, to_px(body.pos), to_px(tip), HEADING);
-        if options.footprints {
-            footprints.clear();
-            sim.sensors().footprints(world, i, &mut footprints);
-            for f in &footprints {
-                let (colour, r) = match f.kind {
-                    FootprintKind::Field => (FIELD_SENSOR, 2.0),
-                    FootprintKind::Puck => (PUCK_SENSOR, f.radius * scale),
-                    FootprintKind::Obstacle => (OBSTACLE_SENSOR, f.radius * scale),
-                };
-                if f.kind == FootprintKind::Field {
-                    fill_circle(&mut img, to_px(f.centre), r, colour);
-                } else {
-                    outline_circle(&mut img, to_px(f.centre), r, colour);
-                }
-            }
-        }
     }
     img
+}
+
+/// Pixels per unit of a drawing `size` pixels wide.
+fn scale_of(world: &World, size: u32) -> f64 {
+    f64::from(size) / world.config().arena().x
 }
 
 fn put(img: &mut RgbImage, x: i64, y: i64, colour: Rgb<u8>) {
@@ -91,7 +111,8 @@ fn fill_circle(img: &mut RgbImage, c: Vec2, r: f64, colour: Rgb<u8>) {
     }
 }
 
-fn outline_circle(img: &mut RgbImage, c: Vec2, r: f64, colour: Rgb<u8>) {
+/// A circle's outline of radius `r` around `c`, pixels.
+pub fn outline_circle(img: &mut RgbImage, c: Vec2, r: f64, colour: Rgb<u8>) {
     let steps = (r * 8.0).ceil().max(16.0) as usize;
     for k in 0..steps {
         let p = c + Vec2::from_angle(k as f64 * std::f64::consts::TAU / steps as f64) * r;

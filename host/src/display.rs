@@ -1,0 +1,136 @@
+//! `host display`: a local web server showing the field on the TV (the
+//! TV's own browser, or a computer's on HDMI), its calibration sequence and
+//! grey patches for measuring the display's gamma (`docs/display.md`).
+//!
+//! It serves three things and nothing else: the page (`/`, plain HTML and
+//! JavaScript built into the binary, so no internet is needed), the panel
+//! image (`/field.png`, [`crate::panel_file`]) and the page's settings
+//! (`/settings.json`). It binds where it is told, loopback by default.
+
+use crate::panel_file;
+use anyhow::{Context, Result};
+use serde::Serialize;
+use sim::arena::ArenaSpec;
+use sim::field_source::FieldSource;
+use std::net::{SocketAddr, TcpListener};
+use tiny_http::{Header, Method, Request, Response, Server};
+
+/// The page, built in.
+const PAGE: &str = include_str!("display.html");
+
+/// The shortest hold of a calibration screen, ms: the robots need each
+/// screen steady for 7 control periods (140 ms) after the TV has settled.
+pub const MIN_HOLD_MS: u32 = 500;
+
+/// The longest hold, ms: white and black must both pass within the 60 s a
+/// robot waits after button B.
+pub const MAX_HOLD_MS: u32 = 20_000;
+
+/// What to show and where to listen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DisplaySettings {
+    /// The screen.
+    pub arena: ArenaSpec,
+    /// The field.
+    pub field: FieldSource,
+    /// Address to listen on (port 0: any free port).
+    pub bind: SocketAddr,
+    /// How long the calibration sequence holds white and black, ms.
+    pub hold_ms: u32,
+}
+
+/// The page's settings, as `/settings.json` gives them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+struct PageSettings {
+    arena: String,
+    field: String,
+    panel: [u32; 2],
+    hold_ms: u32,
+    display_gamma: f64,
+}
+
+/// A display server, listening.
+pub struct Display {
+    server: Server,
+    address: SocketAddr,
+    png: Vec<u8>,
+    settings_json: String,
+}
+
+impl Display {
+    /// Renders the panel image and starts listening; errors name the
+    /// field, the arena or the address.
+    pub fn start(settings: &DisplaySettings) -> Result<Display> {
+        let hold = settings.hold_ms;
+        anyhow::ensure!(
+            (MIN_HOLD_MS..=MAX_HOLD_MS).contains(&hold),
+            "--hold {} s is outside {} to {} s: the robots need each screen steady for 140 ms after the TV has \
+             settled, and white and black within the 60 s they wait",
+            f64::from(hold) / 1000.0,
+            f64::from(MIN_HOLD_MS) / 1000.0,
+            f64::from(MAX_HOLD_MS) / 1000.0
+        );
+        let arena = &settings.arena;
+        arena.validate().with_context(|| format!("arena {}", arena.name))?;
+        let image = panel_file::panel_image(arena, &settings.field)?;
+        let png = panel_file::encode_png(&image)?;
+        let page = PageSettings {
+            arena: arena.name.clone(),
+            field: settings.field.to_string(),
+            panel: arena.screen_px,
+            hold_ms: hold,
+            display_gamma: arena.display_gamma,
+        };
+        let settings_json = serde_json::to_string(&page).context("cannot encode the page's settings")?;
+        let listener =
+            TcpListener::bind(settings.bind).with_context(|| format!("cannot listen on {}", settings.bind))?;
+        let address = listener.local_addr().with_context(|| format!("cannot read the address of {}", settings.bind))?;
+        let server = Server::from_listener(listener, None)
+            .map_err(|e| anyhow::anyhow!("cannot serve on {address}: {e}"))?;
+        Ok(Display { server, address, png, settings_json })
+    }
+
+    /// Where it listens.
+    pub fn address(&self) -> SocketAddr {
+        self.address
+    }
+
+    /// The page's address.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.address)
+    }
+
+    /// Answers requests until the process ends; a client that goes away
+    /// mid-answer is not an error.
+    pub fn serve(&self) {
+        for request in self.server.incoming_requests() {
+            let _ = self.answer(request);
+        }
+    }
+
+    fn answer(&self, request: Request) -> std::io::Result<()> {
+        if !matches!(request.method(), Method::Get | Method::Head) {
+            let text = format!("{} is not served: only GET and HEAD\n", request.method());
+            return request.respond(Response::from_string(text).with_status_code(405));
+        }
+        let path = request.url().split(['?', '#']).next().unwrap_or("").to_string();
+        let (body, kind) = match path.as_str() {
+            "/" | "/index.html" => (PAGE.as_bytes().to_vec(), "text/html; charset=utf-8"),
+            "/field.png" => (self.png.clone(), "image/png"),
+            "/settings.json" => (self.settings_json.as_bytes().to_vec(), "application/json"),
+            _ => {
+                let text = format!("not found: {path} (this server has /, /field.png and /settings.json)\n");
+                return request.respond(Response::from_string(text).with_status_code(404));
+            }
+        };
+        let response = Response::from_data(body).with_header(header("Content-Type", kind)).with_header(header(
+            "Cache-Control",
+            "no-store",
+        ));
+        request.respond(response)
+    }
+}
+
+fn header(name: &str, value: &str) -> Header {
+    Header::from_bytes(name.as_bytes(), value.as_bytes()).expect("ASCII header")
+}
