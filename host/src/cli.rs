@@ -62,7 +62,8 @@ pub enum Command {
         footprints: bool,
     },
     /// Measure steps per second of the standard configuration (8 robots,
-    /// 250 pucks, annulus, orbital construction), single-threaded.
+    /// 250 pucks, annulus, orbital construction), single-threaded; with
+    /// --sensors robot, the same with the robot's senses and random turns.
     Bench(BenchArgs),
     /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
     /// blob for the firmware) and <out>/<name>.ckpt (the complete training
