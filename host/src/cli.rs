@@ -4,6 +4,7 @@
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 use host::arena_choice::ArenaChoice;
+use host::bench::BenchVariant;
 use host::display::DisplaySettings;
 use host::experiment::shard::Shard;
 use host::experiment::RunOptions;
@@ -65,18 +66,9 @@ pub enum Command {
         footprints: bool,
     },
     /// Measure steps per second of the standard configuration (8 robots,
-    /// 250 pucks, annulus, orbital construction), single-threaded.
-    Bench {
-        /// All-pairs contact and sensor checks, like the original simulator.
-        #[arg(long)]
-        naive: bool,
-        /// 64 robots and 1,000 pucks (arena enlarged to the same density).
-        #[arg(long)]
-        scale: bool,
-        /// Steps to time.
-        #[arg(long, default_value_t = 1_000_000)]
-        steps: u64,
-    },
+    /// 250 pucks, annulus, orbital construction), single-threaded; with
+    /// --sensors robot, the same with the robot's senses and random turns.
+    Bench(BenchArgs),
     /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
     /// blob for the firmware) and <out>/<name>.ckpt (the complete training
     /// state), and prints formations, stuck episodes, speed and state
@@ -314,6 +306,56 @@ pub struct ReplayArgs {
     /// Distance between the tracks' centre lines, mm.
     #[arg(long, default_value_t = 85.0, value_parser = parse_positive)]
     pub track_mm: f64,
+}
+
+/// `host bench`'s options.
+#[derive(Args)]
+pub struct BenchArgs {
+    /// All-pairs contact and sensor checks, like the original simulator.
+    #[arg(long)]
+    pub naive: bool,
+    /// 64 robots and 1,000 pucks (arena enlarged to the same density).
+    #[arg(long)]
+    pub scale: bool,
+    /// disc (the reference model's discs, orbital construction) or
+    /// robot (the Zumo's senses with random turns, timed after a
+    /// 2,000-step warm-up; also prints the mean number of bodies in
+    /// the camera's range).
+    #[arg(long, value_enum, default_value_t = BenchSensors::Disc)]
+    pub sensors: BenchSensors,
+    /// thesis (800 x 800, 8 robots, 250 pucks), tv75 or a FILE.toml of
+    /// a screen arena (with its own robots and pucks).
+    #[arg(long, default_value = "thesis")]
+    pub arena: ArenaChoice,
+    /// Steps to time [default: 1,000,000; 20,000 with --sensors robot].
+    #[arg(long)]
+    pub steps: Option<u64>,
+}
+
+impl BenchArgs {
+    /// The configuration to measure, an arena file read and checked.
+    pub fn variant(&self) -> Result<BenchVariant> {
+        let arena = match &self.arena {
+            ArenaChoice::Thesis => None,
+            other => Some(other.arena()?),
+        };
+        Ok(BenchVariant { naive: self.naive, scale: self.scale, robot_senses: self.sensors == BenchSensors::Robot, arena })
+    }
+
+    /// Steps to time.
+    pub fn steps(&self) -> u64 {
+        let default = if self.sensors == BenchSensors::Robot { host::bench::ROBOT_STEPS } else { 1_000_000 };
+        self.steps.unwrap_or(default)
+    }
+}
+
+/// `host bench --sensors`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchSensors {
+    /// The reference model's disc sensors.
+    Disc,
+    /// The robot's photo-transistors and Pixy camera.
+    Robot,
 }
 
 fn parse_positive(s: &str) -> Result<f64, String> {

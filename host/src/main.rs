@@ -5,7 +5,6 @@ mod cli;
 use anyhow::{Context, Result};
 use clap::Parser;
 use cli::{Cli, Command, ExperimentAction, ExperimentArgs, FieldCommand, MonitorArgs, PolicyCommand};
-use host::bench::BenchVariant;
 use host::run_summary::run_timed;
 use sim::render::RenderOptions;
 use std::io::Write;
@@ -49,9 +48,8 @@ fn run(cli: Cli) -> Result<()> {
             }
             Ok(())
         }
-        Command::Bench { naive, scale, steps } => {
-            let rate = host::bench::run(BenchVariant { naive, scale }, steps)?;
-            println!("{rate:.0} steps/s");
+        Command::Bench(args) => {
+            println!("{}", host::bench::run(&args.variant()?, args.steps())?);
             Ok(())
         }
         Command::Train(args) => {

@@ -208,8 +208,10 @@ fn the_calibration_sequence_holds_white_then_black_then_shows_the_field() {
         .collect();
     assert_eq!(screens.iter().map(|s| s.0).collect::<Vec<_>>(), ["white", "black", "field"], "{log}");
     let (white, black) = (screens[1].1 - screens[0].1, screens[2].1 - screens[1].1);
+    // The page times both switches from the sequence's start; its clock
+    // reads to a tenth of a millisecond, so a hold may read 0.1 ms short.
     for (name, held) in [("white", white), ("black", black)] {
-        assert!((1500.0..1520.0).contains(&held), "{name} held {held} ms, not the 1.5 s asked: {log}");
+        assert!((1499.5..1520.0).contains(&held), "{name} held {held} ms, not the 1.5 s asked: {log}");
     }
     assert!(screens[0].1 < 1.0, "white did not start the sequence: {log}");
 

@@ -65,3 +65,18 @@ fn learning_allocates_nothing() {
     sim.run(&mut learner, 20_000);
     assert_eq!(allocations() - before, 0);
 }
+
+#[test]
+fn stepping_with_the_robots_senses_allocates_nothing_once_warmed_up() {
+    let scenario = sim::scenario::Scenario {
+        sensors: sim::sensor_setup::SensorSetup::Robot(Box::default()),
+        controller: sim::scenario::ControllerChoice::Random,
+        ..sim::scenario::Scenario::default()
+    };
+    let (mut sim, mut controller) = scenario.build().unwrap();
+    // the camera's buffers grow to the most bodies a frame has seen
+    sim.run(&mut controller, 2000);
+    let before = allocations();
+    sim.run(&mut controller, 5000);
+    assert_eq!(allocations() - before, 0);
+}

@@ -71,7 +71,11 @@ impl NeighbourIndex {
     /// Fills `out` with every body `j` (other than `body`, with an index
     /// above `after` if given) whose centre is closer to `body`'s than
     /// `r_body + r_j + margin`, in ascending order; `max_radius` bounds
-    /// every `r_j`.
+    /// every `r_j`. A first gather (`after` is `None`) leaves `out` empty
+    /// when none of them overlaps `body` by more than `threshold` (centres
+    /// closer than `r_body + r_j - threshold`, the contact test): then the
+    /// turn would test them all and change nothing.
+    #[allow(clippy::too_many_arguments)]
     pub fn contact_candidates(
         &self,
         bodies: &[Body],
@@ -79,6 +83,7 @@ impl NeighbourIndex {
         after: Option<usize>,
         max_radius: f64,
         margin: f64,
+        threshold: f64,
         out: &mut Candidates,
     ) {
         let (pos, radius) = (bodies[body].pos, bodies[body].radius);
@@ -97,6 +102,17 @@ impl NeighbourIndex {
             false
         };
         self.any_around(bodies, body, half, gather);
+        // The contact test's own arithmetic, so that it decides exactly as
+        // the turn would.
+        let overlaps = |j: &u32| {
+            let other = &bodies[*j as usize];
+            let touch = radius + other.radius - threshold;
+            !((touch <= 0.0) | ((other.pos - pos).length_squared() >= touch * touch))
+        };
+        if after.is_none() && !out.slots[..len].iter().any(overlaps) {
+            out.len = 0;
+            return;
+        }
         // Insertion sort: the list is short.
         let found = &mut out.slots[..len];
         for k in 1..found.len() {

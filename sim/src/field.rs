@@ -135,8 +135,15 @@ impl ScalarField {
     pub fn sense(&self, p: Vec2, layout: &FieldLayout) -> FieldValue {
         match layout.sampling {
             FieldSampling::Nearest => {
-                let (x, y) = self.nearest_cell(p, &layout.frame);
-                self.cell_index(x, y).map_or(FieldValue::ZERO, |k| self.fixed[k])
+                // The cell of [`ScalarField::nearest_cell`], decided without
+                // its integer conversions (a sensor reads three per step).
+                let f = &layout.frame;
+                let x = nearest_index(self.width as f64 * (p.x - f.x) / f.width, self.width);
+                let y = nearest_index(self.height as f64 * (p.y - f.y) / f.height, self.height);
+                match (x, y) {
+                    (Some(x), Some(y)) => self.fixed[y * self.width + x],
+                    _ => FieldValue::ZERO,
+                }
             }
             FieldSampling::Bilinear => FieldValue::from_f32(self.bilinear(p, &layout.frame) as f32),
         }
@@ -195,6 +202,20 @@ fn split(t: f64, n: usize) -> (usize, f64) {
         return (n - 1, 0.0);
     }
     (i as usize, t - i)
+}
+
+/// `round_half_away(t)` if it lies in `0..n`, else `None`. It is at least 0
+/// exactly when `t > -0.5` (-0.5 rounds away to -1) and below `n` exactly
+/// when `t < n - 0.5` (which rounds up to `n`). Inside, `t as u32`
+/// truncates (to 0 for `t` in (-0.5, 0)) and the fraction is exact, as in
+/// [`round_half_away`]; NaN passes both tests and reads cell 0, as there.
+#[inline]
+fn nearest_index(t: f64, n: usize) -> Option<usize> {
+    if (t <= -0.5) | (t >= n as f64 - 0.5) {
+        return None;
+    }
+    let whole = t as u32;
+    Some(whole as usize + usize::from(t - f64::from(whole) >= 0.5))
 }
 
 /// `t.round() as i64` without the libm call `round` compiles to on
@@ -287,6 +308,27 @@ mod tests {
         }
         assert_eq!(differ, 100, "bilinear: the inner sensor always reads more");
         assert!(same_cell >= 30, "nearest: {same_cell} of 100 pairs read one cell");
+    }
+
+    #[test]
+    fn nearest_sensing_reads_the_cell_that_rounding_picks_also_at_half_cells_and_outside() {
+        let f = ScalarField::annulus_of(64, 36);
+        let layout = FieldLayout { frame: FieldFrame { x: -3.5, y: 10.0, width: 800.0, height: 450.0 }, sampling: FieldSampling::Nearest };
+        let cell = 800.0 / 64.0;
+        let mut points = vec![Vec2::new(f64::NAN, 100.0), Vec2::new(1e300, 100.0), Vec2::new(-1e300, -1e300)];
+        for k in -40..1700 {
+            let t = f64::from(k) * 0.5 * cell - 3.5;
+            for d in [0.0, 1e-9, -1e-9, 0.3, 4.0, 6.25, -6.25] {
+                points.push(Vec2::new(t + d, 10.0 + (t + d) * 0.5625));
+                points.push(Vec2::new(400.0, t + d));
+                points.push(Vec2::new(t + d, 200.0));
+            }
+        }
+        for p in points {
+            let (x, y) = f.nearest_cell(p, &layout.frame);
+            let expected = f.cell_index(x, y).map_or(FieldValue::ZERO, |k| f.fixed[k]);
+            assert_eq!(f.sense(p, &layout), expected, "{p:?}");
+        }
     }
 
     #[test]

@@ -33,6 +33,8 @@ pub struct Neighbour {
 pub struct SpatialGrid {
     /// Columns per unit of x, rows per unit of y.
     cells_per_unit: Vec2,
+    /// The smaller of a cell's width and height.
+    cell_width: f64,
     /// Cells across the arena.
     cols: usize,
     /// Cells down the arena.
@@ -58,6 +60,7 @@ impl SpatialGrid {
         let (cols, rows) = (count(size.x), count(size.y));
         let mut grid = SpatialGrid {
             cells_per_unit: Vec2::new(cols as f64 / size.x, rows as f64 / size.y),
+            cell_width: 1.0 / (cols as f64 / size.x).max(rows as f64 / size.y),
             cols,
             rows,
             stride: cols + 2,
@@ -170,8 +173,9 @@ impl SpatialGrid {
     }
 
     /// The smaller of a cell's width and height.
+    #[inline]
     pub fn cell_width(&self) -> f64 {
-        1.0 / self.cells_per_unit.x.max(self.cells_per_unit.y)
+        self.cell_width
     }
 }
 

@@ -249,7 +249,8 @@ impl StepContext<'_> {
     fn resolve_circles(&mut self, i: usize) {
         let margin = CANDIDATE_MARGIN * self.max_radius;
         let mut candidates = std::mem::take(&mut self.scratch.candidates);
-        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, &mut candidates);
+        let threshold = self.config.overlap_threshold;
+        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, threshold, &mut candidates);
         let mut anchor = self.bodies[i].pos;
         let mut k = 0;
         while let Some(&j) = candidates.as_slice().get(k) {
@@ -257,7 +258,7 @@ impl StepContext<'_> {
             k += 1;
             if self.separate(i, j) && (self.bodies[i].pos - anchor).length_squared() > margin * margin {
                 anchor = self.bodies[i].pos;
-                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, &mut candidates);
+                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, threshold, &mut candidates);
                 k = 0;
             }
         }
