@@ -23,8 +23,9 @@ pub const PIXY_MAX_BLOCKS: usize = shared::camera::MAX_BLOCKS_PER_PERIOD;
 /// start, [`PIXY_MAX_BLOCKS`] colour-code blocks and the end marker.
 pub const PIXY_MAX_WORDS: u8 = 2 + 8 * PIXY_MAX_BLOCKS as u8 + 1;
 /// A frame's blocks are used in at most this many control periods, so a
-/// camera that stops seeing an object (and then sends nothing) clears it.
-pub const PIXY_HOLD_PERIODS: u8 = 2;
+/// camera that stops seeing an object (and then sends nothing) clears it
+/// (`shared::camera::HOLD_PERIODS`, which the simulator models).
+pub const PIXY_HOLD_PERIODS: u8 = shared::camera::HOLD_PERIODS;
 /// How long one TWI bus step may take before the bus counts as stalled
 /// (a byte takes 90 us at 100 kHz).
 pub const TWI_TIMEOUT_TICKS: u16 = 1_000 / TICK_US;

@@ -426,6 +426,11 @@ pub struct ScenarioArgs {
     /// docs/robot-sensors.md).
     #[arg(long, default_value = "disc", value_parser = parse_sensors)]
     pub sensors: SensorChoice,
+    /// Real-world noise, in multiples of the default (0 none, 1 the
+    /// default, 2 twice as much; docs/robot-sensors.md): wheel speeds,
+    /// turns and timing always, the robot senses' noise with --sensors robot.
+    #[arg(long, default_value_t = 0.0)]
+    pub noise: f64,
 }
 
 impl ScenarioArgs {
@@ -441,6 +446,7 @@ impl ScenarioArgs {
             broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
             arena: arena.arena()?,
             sensors: self.sensors.setup()?,
+            noise: self.noise,
         })
     }
 }
@@ -505,8 +511,10 @@ impl TrainArgs {
             overrides: TrainOverrides {
                 field: o.field,
                 sensors: o.sensors,
+                arena: o.arena,
                 robots: o.robots,
                 pucks: o.pucks,
+                noise: if o.randomise { Some(1.0) } else { o.noise },
                 seed: o.seed,
                 hasher: o.hasher,
                 reward: o.reward,
@@ -537,12 +545,25 @@ pub struct TrainOverrideArgs {
     /// or robot:CONFIG.json (docs/robot-sensors.md).
     #[arg(long)]
     pub sensors: Option<SensorChoice>,
-    /// Number of robots [default: 8].
+    /// thesis (the reference model's 800 x 800 square), tv75 (the thesis'
+    /// 75" TV lying flat) or a FILE.toml of a screen arena [default: tv75
+    /// with --sensors robot, else thesis].
+    #[arg(long)]
+    pub arena: Option<ArenaChoice>,
+    /// Number of robots [default: the arena's: 8 in the thesis' arena, 5 on tv75].
     #[arg(long)]
     pub robots: Option<usize>,
-    /// Number of pucks [default: 250].
+    /// Number of pucks [default: the arena's: 250 in the thesis' arena, 12 on tv75].
     #[arg(long)]
     pub pucks: Option<usize>,
+    /// Train with the default real-world noise (domain randomisation, the
+    /// same as --noise 1; docs/robot-sensors.md).
+    #[arg(long, conflicts_with = "noise")]
+    pub randomise: bool,
+    /// Real-world noise in multiples of the default (0 none, 1 the
+    /// default, 2 twice as much) [default: 0].
+    #[arg(long)]
+    pub noise: Option<f64>,
     /// Seed of every random choice [default: 1].
     #[arg(long)]
     pub seed: Option<u64>,

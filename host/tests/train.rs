@@ -15,13 +15,33 @@ use std::sync::Arc;
 /// A small, quick run: 4 robots, 60 pucks, a short stuck limit so that
 /// episodes end and reset within the test.
 fn small(seed: u64) -> TrainConfig {
-    TrainConfig { robots: 4, pucks: 60, seed, stuck_limit: Some(700), ..TrainConfig::default() }
+    TrainConfig { robots: Some(4), pucks: Some(60), seed, stuck_limit: Some(700), ..TrainConfig::default() }
 }
 
 fn trainer(config: TrainConfig) -> Trainer<sim::SelectedSensors> {
-    let field = Arc::new(config.field.load().unwrap());
-    let sensors = config.sensors.build(&config.sim_config()).unwrap();
-    Trainer::new(config, field, sensors, None).unwrap()
+    Trainer::start(config, None).unwrap()
+}
+
+/// Trains `config` for `steps` straight, and for `first` steps, through a
+/// checkpoint file, then the rest; both runs must end in the same state.
+/// Returns the checkpoint's format version.
+fn resumes_exactly(config: TrainConfig, first: u64, steps: u64) -> u16 {
+    let mut straight = trainer(config.clone());
+    straight.run(steps);
+    let mut head = trainer(config.clone());
+    head.run(first);
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, &head.state()).unwrap();
+    drop(head);
+    let state = checkpoint::decode(&bytes).unwrap();
+    assert_eq!(state.config.scenario().unwrap(), config.scenario().unwrap(), "the checkpoint keeps the run's settings");
+    let mut resumed = Trainer::restart(state).unwrap();
+    resumed.run(steps - first);
+    assert_eq!(resumed.learner().table(), straight.learner().table());
+    assert_eq!(resumed.totals(), straight.totals());
+    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+    assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
+    u16::from_le_bytes([bytes[8], bytes[9]])
 }
 
 /// Everything that evolves: Q-values, visits, counters, world, generators.
@@ -59,9 +79,7 @@ fn train_then_resume_equals_one_long_run() {
     drop(first);
 
     let state = checkpoint::load(&path).unwrap();
-    let field = Arc::new(state.config.field.load().unwrap());
-    let sensors = SensorChoice::Disc.build(&state.sim.config).unwrap();
-    let mut resumed = Trainer::resume(state, field, sensors).unwrap();
+    let mut resumed = Trainer::restart(state).unwrap();
     resumed.run(1100);
     assert_eq!(resumed.learner().table(), straight.learner().table());
     assert_eq!(resumed.totals(), straight.totals());
@@ -71,32 +89,32 @@ fn train_then_resume_equals_one_long_run() {
 
 #[test]
 fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkpoint() {
-    let authors = || TrainConfig {
+    let authors = TrainConfig {
         formation_check: host::train::config::FormationCheck { every: 300, stale: true },
         success: sim::SuccessSignal::EvalPrime,
         obstacle_discs: Some(host::train::config::ObstacleDiscs { radius: 2.0, sees: sim::ObstacleTargets::AnyBody }),
         ..small(11)
     };
-    let mut straight = trainer(authors());
-    straight.run(2500);
-
-    let mut first = trainer(authors());
-    first.run(1400);
-    let mut bytes = Vec::new();
-    checkpoint::write_to(&mut bytes, &first.state()).unwrap();
-    assert_eq!(u16::from_le_bytes([bytes[8], bytes[9]]), 2, "format 1 cannot hold these settings");
-    let state = checkpoint::decode(&bytes).unwrap();
-    assert_eq!(state.config, authors());
-    assert!(state.sim.checked_signal.is_some());
-    let field = Arc::new(state.config.field.load().unwrap());
-    let sensors = state.config.sensors.build(&state.sim.config).unwrap();
-    let mut resumed = Trainer::resume(state, field, sensors).unwrap();
-    resumed.run(1100);
-    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+    assert_eq!(resumes_exactly(authors, 1400, 2500), 2, "format 1 cannot hold these settings");
 }
 
 #[test]
-fn checkpoints_written_before_format_2_load_and_are_written_again_byte_for_byte() {
+fn a_noisy_run_of_the_robot_senses_on_the_tv_resumes_exactly_from_a_format_3_checkpoint() {
+    let noisy = TrainConfig {
+        sensors: SensorChoice::Robot(None),
+        noise: 1.0,
+        stuck_limit: Some(900),
+        seed: 12,
+        ..TrainConfig::default()
+    };
+    assert_eq!(noisy.arena_choice().to_string(), "tv75");
+    // resumed mid-episode, with camera links, held blocks and a latency
+    // frame in flight, after episode resets that drew new robot motions
+    assert_eq!(resumes_exactly(noisy, 1700, 2600), 3);
+}
+
+#[test]
+fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_byte() {
     // the published pre-trained tables of docs/reproduction were written by earlier builds
     let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");
     let mut files: Vec<_> = std::fs::read_dir(&docs)
@@ -105,14 +123,18 @@ fn checkpoints_written_before_format_2_load_and_are_written_again_byte_for_byte(
         .map(|e| e.unwrap().path())
         .collect();
     files.sort();
-    assert!(!files.is_empty(), "no published checkpoints under {}", docs.display());
-    for path in files.iter().take(2) {
-        let bytes = std::fs::read(path).unwrap();
-        assert_eq!(u16::from_le_bytes([bytes[8], bytes[9]]), 1, "{}", path.display());
-        let state = checkpoint::decode(&bytes).unwrap();
+    let mut versions = std::collections::BTreeMap::new();
+    for path in files {
+        let bytes = std::fs::read(&path).unwrap();
+        versions.entry(u16::from_le_bytes([bytes[8], bytes[9]])).or_insert((path, bytes));
+    }
+    assert!(versions.contains_key(&1), "no published format-1 checkpoint under {}", docs.display());
+    for (version, (path, bytes)) in &versions {
+        assert!(*version < checkpoint::VERSION, "{} is of format {version}", path.display());
+        let state = checkpoint::decode(bytes).unwrap();
         let mut again = Vec::new();
         checkpoint::write_to(&mut again, &state).unwrap();
-        assert!(again == bytes, "{} is written differently", path.display());
+        assert!(&again == bytes, "{} is written differently", path.display());
     }
 }
 
@@ -218,7 +240,7 @@ impl Controller for Probe {
 
 #[test]
 fn the_state_reached_is_the_state_decided_on_next() {
-    let config = small(6).sim_config();
+    let config = small(6).prepare().unwrap().config().clone();
     let field = Arc::new(sim::ScalarField::annulus());
     let mut sim = sim::Simulation::new(config, field, 6).unwrap();
     let mut probe = Probe { decided: Vec::new(), after: Vec::new(), starts: 0 };

@@ -28,6 +28,12 @@ pub const IMAGE_HEIGHT: u16 = 200;
 /// keeps the same ones.
 pub const MAX_BLOCKS_PER_PERIOD: usize = 4;
 
+/// A frame's blocks serve the control period the frame arrives in and, if
+/// no new frame comes, the next one: then they are dropped, so that a
+/// camera that stops seeing an object (and then sends nothing at all)
+/// clears it. The firmware holds blocks this way; the simulator models it.
+pub const HOLD_PERIODS: u8 = 2;
+
 /// One detected object as the Pixy reports it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct PixyBlock {

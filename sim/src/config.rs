@@ -5,6 +5,7 @@
 //! file only names what it changes. [`SimConfig::validate`] runs before a
 //! simulation is built and names the first offending value.
 
+use crate::actuation::ActuationNoise;
 use crate::broadphase::BroadPhase;
 use crate::disc_sensor_config::DiscSensorConfig;
 use crate::field::{FieldFrame, FieldLayout, FieldSampling};
@@ -46,6 +47,8 @@ pub struct WorldConfig {
     pub field_frame: Option<FieldFrame>,
     /// How positions read the field.
     pub field_sampling: FieldSampling,
+    /// How the robots really move (none: exactly as commanded).
+    pub actuation: ActuationNoise,
 }
 
 impl Default for WorldConfig {
@@ -67,6 +70,7 @@ impl Default for WorldConfig {
             broad_phase: BroadPhase::Grid,
             field_frame: None,
             field_sampling: FieldSampling::Nearest,
+            actuation: ActuationNoise::NONE,
         }
     }
 }
@@ -243,6 +247,7 @@ impl SimConfig {
             check("world.field_frame.x", f.x, true, "must be a finite number")?;
             check("world.field_frame.y", f.y, true, "must be a finite number")?;
         }
+        w.actuation.validate()?;
         let area = std::f64::consts::PI
             * (w.robots as f64 * w.robot_radius * w.robot_radius + w.pucks as f64 * w.puck_radius * w.puck_radius);
         let capacity = PACKING_DENSITY * w.arena_width * w.arena_height;

@@ -21,10 +21,12 @@
 //! images and policy files, and writes no files.
 #![warn(missing_docs)]
 
+pub mod actuation;
 pub mod arena;
 pub mod bitset;
 pub mod body;
 pub mod broadphase;
+pub mod camera_memory;
 pub mod config;
 pub mod control;
 pub mod controllers;
@@ -37,6 +39,7 @@ pub mod field_source;
 pub mod grid;
 pub mod letters;
 pub mod mixed_sensors;
+pub mod noise;
 pub mod panel;
 pub mod photo_sensors;
 pub mod physics;
@@ -45,6 +48,7 @@ pub mod policy_file;
 pub mod render;
 pub mod reward;
 pub mod rng;
+pub mod robot_noise;
 pub mod robot_sensors;
 pub mod scenario;
 pub mod sensor_model;

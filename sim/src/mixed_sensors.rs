@@ -4,7 +4,7 @@
 //! puck and obstacle discs.
 
 use crate::field::ScalarField;
-use crate::sensor_model::{Footprint, SensorModel};
+use crate::sensor_model::{Footprint, SensorMemory, SensorModel};
 use crate::world::World;
 use shared::SensorReading;
 
@@ -45,5 +45,22 @@ impl<M: SensorModel> SensorModel for MixedSensors<M> {
         self.field.footprints(world, robot, out);
         self.pucks.footprints(world, robot, out);
         self.obstacles.footprints(world, robot, out);
+    }
+
+    /// The three parts' camera models, in order.
+    fn memory(&self) -> SensorMemory {
+        let mut cameras = self.field.memory().cameras;
+        cameras.extend(self.pucks.memory().cameras);
+        cameras.extend(self.obstacles.memory().cameras);
+        SensorMemory { cameras }
+    }
+
+    fn restore(&mut self, memory: &SensorMemory) {
+        let mut rest = &memory.cameras[..];
+        for part in [&mut self.field, &mut self.pucks, &mut self.obstacles] {
+            let k = part.memory().cameras.len().min(rest.len());
+            part.restore(&SensorMemory { cameras: rest[..k].to_vec() });
+            rest = &rest[k..];
+        }
     }
 }

@@ -29,6 +29,8 @@
 
 use crate::validate::{check, ConfigError};
 use crate::field::{FieldLayout, ScalarField};
+use crate::rng::SimRng;
+use crate::robot_noise::RobotNoise;
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
@@ -59,10 +61,27 @@ impl PhotoResponse {
     /// The discharge time in microseconds over a field value `v` in [0, 1]
     /// with projector gamma `gamma`.
     pub fn discharge_us(&self, v: f64, gamma: f64) -> f64 {
-        let light = v.clamp(0.0, 1.0).powf(gamma);
-        let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
-        1.0 / (slow + light * (fast - slow))
+        self.discharge_of_light_us(v.clamp(0.0, 1.0).powf(gamma))
     }
+
+    /// The discharge time under `light`, relative to full white's.
+    pub fn discharge_of_light_us(&self, light: f64) -> f64 {
+        let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
+        1.0 / (slow + light.max(0.0) * (fast - slow))
+    }
+}
+
+/// The conditions of one reading with the sensor noise on: the screen's
+/// brightness gains of the episode and the generator of the jitter.
+pub struct PhotoNoise<'a> {
+    /// The noise's settings.
+    pub noise: &'a RobotNoise,
+    /// The brightness gains ([`RobotNoise::brightness_grid`]).
+    pub grid: &'a [f64],
+    /// The arena's size, over which the gains lie.
+    pub arena: Vec2,
+    /// The generator of this reading's jitter.
+    pub rng: &'a mut SimRng,
 }
 
 /// Geometry and response of the three field sensors (left, mid, right).
@@ -217,13 +236,28 @@ impl PhotoSensors {
         &self.points
     }
 
-    /// The reading of a robot at `pos` facing `direction` (unit vector).
-    pub fn read(&self, pos: Vec2, direction: Vec2, field: &ScalarField, layout: &FieldLayout) -> PhotoReading {
+    /// The reading of a robot at `pos` facing `direction` (unit vector),
+    /// with the sensor noise if given.
+    pub fn read(
+        &self,
+        pos: Vec2,
+        direction: Vec2,
+        field: &ScalarField,
+        layout: &FieldLayout,
+        mut noise: Option<PhotoNoise<'_>>,
+    ) -> PhotoReading {
         let mut r = PhotoReading::default();
         let mut shown = [0.0; 3];
         for i in 0..3 {
-            shown[i] = field.shown(pos + self.points[i].rotated(direction), layout);
-            r.discharge_us[i] = self.response[i].discharge_us(shown[i], self.gamma);
+            let point = pos + self.points[i].rotated(direction);
+            shown[i] = field.shown(point, layout);
+            r.discharge_us[i] = match noise.as_mut() {
+                None => self.response[i].discharge_us(shown[i], self.gamma),
+                Some(n) => {
+                    let light = shown[i].clamp(0.0, 1.0).powf(self.gamma) * RobotNoise::gain_at(n.grid, point, n.arena);
+                    n.noise.jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
+                }
+            };
             r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
         }
         r.values = if self.ideal { shown.map(|v| FieldValue::from_f32(v as f32)) } else { self.scales.values(&r.ticks) };
@@ -280,10 +314,10 @@ mod tests {
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
         // One cell over the whole arena: every point inside reads it.
         let at = Vec2::new(20.0, 20.0);
-        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, &SQUARE_100);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, &SQUARE_100, None);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ONE; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.bright));
-        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100, None);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
     }
@@ -295,7 +329,7 @@ mod tests {
         let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 5.0);
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
-        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, &SQUARE_100);
+        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, &SQUARE_100, None);
         let values = sensors.values(&r.ticks);
         assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
     }

@@ -110,6 +110,9 @@ pub struct StepContext<'a> {
     pub robots: &'a [Robot],
     /// Robots' forward speed.
     pub forward_speed: f64,
+    /// Each robot's forward speed this step, if not every robot drives at
+    /// `forward_speed` (actuation noise).
+    pub robot_speeds: Option<&'a [f64]>,
     /// Contact model.
     pub config: &'a PhysicsConfig,
     /// Arena width and height.
@@ -147,7 +150,11 @@ impl StepContext<'_> {
             next = sc.live.next_from(i + 1);
             let b = &mut self.bodies[i];
             if i < robots {
-                b.vel = self.robots[i].direction * self.forward_speed;
+                let speed = match self.robot_speeds {
+                    Some(speeds) => speeds[i],
+                    None => self.forward_speed,
+                };
+                b.vel = self.robots[i].direction * speed;
             }
             let moving = (b.vel.length_squared() >= stop2) & (b.vel != Vec2::ZERO);
             if moving {

@@ -64,6 +64,10 @@ pub struct PixyCameraConfig {
     /// Signatures and the classification into puck and obstacle bits (the
     /// firmware's `config::CAMERA`).
     pub classify: CameraConfig,
+    /// Periods between a frame's capture and its arrival at the robot: 1
+    /// (the Pixy processes a frame while capturing the next, at 50 frames
+    /// per second: one 20 ms period), or 0 for an ideal camera.
+    pub latency_frames: u8,
 }
 
 impl Default for PixyCameraConfig {
@@ -72,7 +76,7 @@ impl Default for PixyCameraConfig {
     /// and 80 mm high, tilted 20 degrees down; pucks 30 mm and robots'
     /// markers 60 mm tall; range 1.25 m; the Pixy's own blob settings (20
     /// pixels, merge at 5); 2 blocks per signature; the firmware's
-    /// classification.
+    /// classification; one frame of latency.
     fn default() -> PixyCameraConfig {
         PixyCameraConfig {
             forward_mm: 15.0,
@@ -87,6 +91,7 @@ impl Default for PixyCameraConfig {
             merge_distance: 5,
             max_blocks_per_signature: 2,
             classify: CameraConfig::DEFAULT,
+            latency_frames: 1,
         }
     }
 }
@@ -108,7 +113,9 @@ impl PixyCameraConfig {
         )?;
         positive("camera.puck_height_mm", self.puck_height_mm)?;
         positive("camera.robot_height_mm", self.robot_height_mm)?;
-        positive("camera.max_range_mm", self.max_range_mm)
+        positive("camera.max_range_mm", self.max_range_mm)?;
+        let l = f64::from(self.latency_frames);
+        check("camera.latency_frames", l, self.latency_frames <= 1, "must be 0 or 1")
     }
 }
 

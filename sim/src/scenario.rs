@@ -12,7 +12,9 @@ use crate::field_source::{FieldError, FieldSource};
 use crate::policy_file::{self, PolicyFileError};
 use crate::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::simulation::Simulation;
-use crate::validate::ConfigError;
+use crate::actuation::ActuationNoise;
+use crate::robot_noise::RobotNoise;
+use crate::validate::{self, ConfigError};
 use shared::ActionTable;
 use std::fmt;
 use std::path::PathBuf;
@@ -74,6 +76,10 @@ pub struct Scenario {
     pub arena: Arena,
     /// The robots' sensor model.
     pub sensors: SensorSetup,
+    /// Noise of the robot sensor model and of the robots' motion: the
+    /// default noise ([`RobotNoise::randomised`],
+    /// [`ActuationNoise::randomised`]) times this; 0 for none.
+    pub noise: f64,
 }
 
 impl Default for Scenario {
@@ -89,9 +95,15 @@ impl Default for Scenario {
             broad_phase: BroadPhase::Grid,
             arena: Arena::default(),
             sensors: SensorSetup::Disc,
+            noise: 0.0,
         }
     }
 }
+
+/// Robots in the thesis' arena.
+pub const THESIS_ROBOTS: usize = 8;
+/// Pucks in the thesis' arena.
+pub const THESIS_PUCKS: usize = 250;
 
 /// The settings of a field's experiments: the reference defaults with the
 /// given counts; the annulus thresholds and 150,000-step stuck limit on the
@@ -150,7 +162,7 @@ impl Scenario {
     /// in this scenario's arena, with its counts and contact search, and
     /// [`orbital_innies`] for orbital construction.
     pub fn config(&self, field: &ScalarField) -> SimConfig {
-        let mut c = field_config(&self.field, 8, 250);
+        let mut c = field_config(&self.field, THESIS_ROBOTS, THESIS_PUCKS);
         match &self.arena {
             Arena::Square(size) => {
                 c.world.arena_width = *size;
@@ -165,6 +177,9 @@ impl Scenario {
             c.world.pucks = pucks;
         }
         c.world.broad_phase = self.broad_phase;
+        if self.noise > 0.0 {
+            c.world.actuation = ActuationNoise::randomised().scaled(self.noise);
+        }
         if self.controller == ControllerChoice::Orbital {
             c.world.innies = orbital_innies(&self.field, c.world.robots);
         }
@@ -198,11 +213,13 @@ impl Scenario {
         if let Arena::Screen(spec) = &self.arena {
             spec.validate()?;
         }
-        self.sensors.validate()?;
+        validate::check("noise", self.noise, (0.0..=5.0).contains(&self.noise), "must be from 0 to 5 (times the default noise)")?;
+        let sensors = if self.noise > 0.0 { self.sensors.with_noise(&RobotNoise::randomised().scaled(self.noise)) } else { self.sensors.clone() };
+        sensors.validate()?;
         let field = Arc::new(self.arena.load(&self.field)?);
         let config = self.config(&field);
         config.validate()?;
-        Ok(PreparedScenario { config, field, sensors: self.sensors.clone() })
+        Ok(PreparedScenario { config, field, sensors })
     }
 }
 
@@ -220,6 +237,16 @@ impl PreparedScenario {
     /// The settings every simulation gets.
     pub fn config(&self) -> &SimConfig {
         &self.config
+    }
+
+    /// The loaded field.
+    pub fn field(&self) -> &Arc<ScalarField> {
+        &self.field
+    }
+
+    /// The sensor settings, the scenario's noise applied.
+    pub fn sensors(&self) -> &SensorSetup {
+        &self.sensors
     }
 
     /// The settings, to adjust (thresholds, stuck limit, forward speed)

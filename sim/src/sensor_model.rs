@@ -2,10 +2,21 @@
 //! turns the world into one [`SensorReading`] per robot, and can show what
 //! it senses for drawing.
 
+use crate::camera_memory::CameraMemory;
 use crate::field::ScalarField;
 use crate::vec2::Vec2;
 use crate::world::World;
+use serde::{Deserialize, Serialize};
 use shared::SensorReading;
+
+/// What a sensor model remembers between periods and a checkpoint must
+/// keep (the thesis' discs remember nothing).
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SensorMemory {
+    /// Per camera model (one for the robot model; a mix lists its parts'
+    /// in order), each robot's camera link.
+    pub cameras: Vec<Vec<CameraMemory>>,
+}
 
 /// Produces every robot's reading from the world and field.
 ///
@@ -18,6 +29,14 @@ pub trait SensorModel {
     /// Appends the areas robot `robot` senses, for drawing. The default
     /// draws nothing.
     fn footprints(&self, _world: &World, _robot: usize, _out: &mut Vec<Footprint>) {}
+
+    /// What the model remembers, for a checkpoint. The default: nothing.
+    fn memory(&self) -> SensorMemory {
+        SensorMemory::default()
+    }
+
+    /// Takes up a checkpoint's memory (`memory`'s). The default ignores it.
+    fn restore(&mut self, _memory: &SensorMemory) {}
 }
 
 /// What a drawn sensor area detects.

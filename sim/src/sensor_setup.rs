@@ -16,8 +16,9 @@ use crate::disc_sensor_config::DiscSensorConfig;
 use crate::disc_sensors::DiscSensors;
 use crate::field::ScalarField;
 use crate::mixed_sensors::MixedSensors;
+use crate::robot_noise::RobotNoise;
 use crate::robot_sensors::{RobotSensorConfig, RobotSensors};
-use crate::sensor_model::{Footprint, SensorModel};
+use crate::sensor_model::{Footprint, SensorMemory, SensorModel};
 use crate::validate::ConfigError;
 use crate::world::World;
 use shared::SensorReading;
@@ -56,6 +57,20 @@ impl SensorSetup {
             "disc-thesis" => Some(SensorSetup::DiscThesis),
             "robot" => Some(SensorSetup::Robot(Box::default())),
             _ => None,
+        }
+    }
+
+    /// This setup with the robot sensor model's noise set to `noise`
+    /// (in every part of a mix; the disc models have none).
+    pub fn with_noise(&self, noise: &RobotNoise) -> SensorSetup {
+        match self {
+            SensorSetup::Robot(robot) => SensorSetup::Robot(Box::new(RobotSensorConfig { noise: noise.clone(), ..(**robot).clone() })),
+            SensorSetup::Mixed { field, pucks, obstacles } => SensorSetup::Mixed {
+                field: Box::new(field.with_noise(noise)),
+                pucks: Box::new(pucks.with_noise(noise)),
+                obstacles: Box::new(obstacles.with_noise(noise)),
+            },
+            other => other.clone(),
         }
     }
 
@@ -120,6 +135,22 @@ impl SensorModel for SelectedSensors {
             SelectedSensors::Disc(s) => s.footprints(world, robot, out),
             SelectedSensors::Robot(s) => s.footprints(world, robot, out),
             SelectedSensors::Mixed(s) => s.footprints(world, robot, out),
+        }
+    }
+
+    fn memory(&self) -> SensorMemory {
+        match self {
+            SelectedSensors::Disc(s) => s.memory(),
+            SelectedSensors::Robot(s) => s.memory(),
+            SelectedSensors::Mixed(s) => s.memory(),
+        }
+    }
+
+    fn restore(&mut self, memory: &SensorMemory) {
+        match self {
+            SelectedSensors::Disc(s) => s.restore(memory),
+            SelectedSensors::Robot(s) => s.restore(memory),
+            SelectedSensors::Mixed(s) => s.restore(memory),
         }
     }
 }

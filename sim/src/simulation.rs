@@ -25,7 +25,7 @@ use crate::validate::ConfigError;
 use crate::eval::{eval, eval_prime, EvalPrime, EvalTracker};
 use crate::field::ScalarField;
 use crate::disc_sensors::DiscSensors;
-use crate::sensor_model::SensorModel;
+use crate::sensor_model::{SensorMemory, SensorModel};
 use crate::world::World;
 use crate::rng::SimRng;
 use crate::control::{Controller, Perception};
@@ -106,6 +106,9 @@ pub struct SimulationState {
     /// check (or at the episode's start), which the next check tests.
     /// `None` otherwise.
     pub checked_signal: Option<f64>,
+    /// What the sensor model remembers (the robot model's camera links),
+    /// as of [`Simulation::snapshot`].
+    pub sensor_memory: SensorMemory,
 }
 
 /// A running simulation with sensor model `S`.
@@ -143,6 +146,7 @@ impl<S: SensorModel> Simulation<S> {
             totals: Totals::default(),
             readings: Vec::new(),
             checked_signal: None,
+            sensor_memory: SensorMemory::default(),
         };
         Ok(Simulation::resume(state, field, sensors))
     }
@@ -153,6 +157,7 @@ impl<S: SensorModel> Simulation<S> {
     /// measured now.
     pub fn resume(mut state: SimulationState, field: Arc<ScalarField>, mut sensors: S) -> Self {
         let robots = state.world.robots().len();
+        sensors.restore(&state.sensor_memory);
         if state.readings.len() != robots {
             state.readings = vec![SensorReading::default(); robots];
             sensors.sense(&state.world, &field, &mut state.readings);
@@ -165,9 +170,16 @@ impl<S: SensorModel> Simulation<S> {
         Simulation { state, field, sensors, evaluation, turns: vec![0.0; robots] }
     }
 
-    /// The state to save for a bit-exact resume.
+    /// The state (its sensor memory as of the last snapshot; save a
+    /// [`Simulation::snapshot`] for a bit-exact resume).
     pub fn state(&self) -> &SimulationState {
         &self.state
+    }
+
+    /// The state to save for a bit-exact resume, the sensor model's memory
+    /// included.
+    pub fn snapshot(&self) -> SimulationState {
+        SimulationState { sensor_memory: self.sensors.memory(), ..self.state.clone() }
     }
 
     /// The world.

@@ -33,6 +33,14 @@ pub struct WorldState {
     pub steps: u64,
     /// Drawn for start positions and the coincident-centre nudge.
     pub rng: SimRng,
+    /// The seed the world was created with, from which the noise models
+    /// draw ([`crate::noise`]).
+    pub seed: u64,
+    /// Episodes begun before the current one (resets so far).
+    pub episode: u64,
+    /// Each robot's turn of the last step (a dropped period repeats it);
+    /// empty before the first step.
+    pub last_turns: Vec<f32>,
 }
 
 /// A simulated arena with robots and pucks.
@@ -41,6 +49,8 @@ pub struct World {
     state: WorldState,
     index: NeighbourIndex,
     scratch: PhysicsScratch,
+    /// Each robot's forward speed of the step (with actuation noise).
+    scratch_speeds: Vec<f64>,
 }
 
 impl World {
@@ -58,6 +68,9 @@ impl World {
             robots,
             steps: 0,
             rng,
+            seed,
+            episode: 0,
+            last_turns: Vec::new(),
         }))
     }
 
@@ -67,7 +80,7 @@ impl World {
     pub fn from_state(state: WorldState) -> World {
         let index = index_of(&state);
         let scratch = PhysicsScratch::new(&state.bodies, state.robots.len());
-        World { state, index, scratch }
+        World { state, index, scratch, scratch_speeds: Vec::new() }
     }
 
     /// A hand-placed scene (tests, figures): robots at the given positions,
@@ -86,6 +99,9 @@ impl World {
             robots: robot_state,
             steps: 0,
             rng: SimRng::seed_from_u64(seed),
+            seed,
+            episode: 0,
+            last_turns: Vec::new(),
         })
     }
 
@@ -100,21 +116,30 @@ impl World {
         let s = &mut self.state;
         s.bodies = start_positions(&s.config, &mut s.rng);
         s.robots = start_robots(&s.config, &mut s.rng);
+        s.episode += 1;
+        s.last_turns.clear();
         self.index = index_of(s);
         self.scratch = PhysicsScratch::new(&s.bodies, s.robots.len());
     }
 
     /// Turns every robot by its angular speed (radians, positive = right),
-    /// then runs one physics step.
+    /// then runs one physics step; with actuation noise
+    /// ([`crate::actuation`]) as each robot really moves.
     pub fn step(&mut self, turns: &[f32]) {
-        for (robot, &w) in self.state.robots.iter_mut().zip(turns) {
-            robot.turn(f64::from(w));
+        let noisy = !self.state.config.actuation.is_none();
+        if noisy {
+            self.actuate(turns);
+        } else {
+            for (robot, &w) in self.state.robots.iter_mut().zip(turns) {
+                robot.turn(f64::from(w));
+            }
         }
         let s = &mut self.state;
         StepContext {
             bodies: &mut s.bodies,
             robots: &s.robots,
             forward_speed: s.config.forward_speed,
+            robot_speeds: noisy.then_some(&self.scratch_speeds[..]),
             config: &s.physics,
             arena: s.config.arena(),
             max_radius: s.config.max_radius(),
@@ -124,6 +149,25 @@ impl World {
         }
         .step();
         s.steps += 1;
+    }
+
+    /// Turns the robots as they really do and sets their speeds for this
+    /// step: each one's motion of the episode, the period's length, a
+    /// dropped period's repeated turn.
+    fn actuate(&mut self, turns: &[f32]) {
+        let s = &mut self.state;
+        let actuation = &s.config.actuation;
+        s.last_turns.resize(s.robots.len(), 0.0);
+        self.scratch_speeds.resize(s.robots.len(), 0.0);
+        for (i, robot) in s.robots.iter_mut().enumerate() {
+            let motion = actuation.motion(s.seed, s.episode, i);
+            let (length, dropped) = actuation.period(s.seed, s.steps, i);
+            let commanded = turns.get(i).copied().unwrap_or(0.0);
+            let turn = if dropped { s.last_turns[i] } else { commanded };
+            s.last_turns[i] = turn;
+            robot.turn((f64::from(turn) + motion.turn_bias) * length);
+            self.scratch_speeds[i] = s.config.forward_speed * motion.wheel_speed_factor * length;
+        }
     }
 
     /// Arena and body settings.

@@ -41,3 +41,57 @@ fn a_puck_in_the_thesis_side_disc_is_sensed_by_the_discs_but_not_the_camera() {
     RobotSensors::new(&RobotSensorConfig::default(), 5.0).sense(&world, &field, &mut reading);
     assert!(!reading[0].puck_right && !reading[0].puck_left);
 }
+
+/// A simulation on the TV with the robot's senses and random turns, with
+/// the default noise times `noise`.
+fn noisy(noise: f64, seed: u64) -> Simulation<sim::SelectedSensors> {
+    let tv = sim::ArenaSpec::tv75();
+    let field = ScalarField::annulus_of(64, 36);
+    let mut config = SimConfig::default();
+    tv.apply(&mut config, &field);
+    config.world.actuation = sim::actuation::ActuationNoise::randomised().scaled(noise);
+    let robot = RobotSensorConfig { noise: sim::robot_noise::RobotNoise::randomised().scaled(noise), ..RobotSensorConfig::default() };
+    let sensors = sim::SensorSetup::Robot(Box::new(robot)).build(&config);
+    Simulation::with_sensors(config, Arc::new(field), sensors, seed).unwrap()
+}
+
+fn trajectory(sim: &mut Simulation<sim::SelectedSensors>, steps: u64) -> (Vec<(f64, f64)>, Vec<SensorReading>) {
+    let mut controller = RandomTurns::new(ActionTable::default());
+    sim.run(&mut controller, steps);
+    (sim.world().bodies().iter().map(|b| (b.pos.x, b.pos.y)).collect(), sim.readings().to_vec())
+}
+
+#[test]
+fn the_same_seed_gives_the_same_noise_and_zero_noise_is_the_noiseless_model() {
+    let a = trajectory(&mut noisy(1.0, 3), 3000);
+    assert_eq!(a, trajectory(&mut noisy(1.0, 3), 3000));
+    assert_ne!(a, trajectory(&mut noisy(1.0, 4), 3000), "another seed, other noise");
+    let quiet = trajectory(&mut noisy(0.0, 3), 3000);
+    assert_ne!(a, quiet, "the noise changes the run");
+    // Zero noise, given explicitly, is the model without noise.
+    let tv = sim::ArenaSpec::tv75();
+    let field = ScalarField::annulus_of(64, 36);
+    let mut config = SimConfig::default();
+    tv.apply(&mut config, &field);
+    let sensors = sim::SensorSetup::Robot(Box::default()).build(&config);
+    let mut plain = Simulation::with_sensors(config, Arc::new(field), sensors, 3).unwrap();
+    assert_eq!(quiet, trajectory(&mut plain, 3000));
+}
+
+#[test]
+fn a_noisy_run_resumed_from_its_snapshot_goes_on_exactly() {
+    let mut straight = noisy(2.0, 5);
+    let whole = trajectory(&mut straight, 2500);
+    let mut first = noisy(2.0, 5);
+    trajectory(&mut first, 1000);
+    let saved = serde_json::to_string(&first.snapshot()).unwrap();
+    let state: sim::SimulationState = serde_json::from_str(&saved).unwrap();
+    let fresh = noisy(2.0, 5);
+    let sensors = sim::SensorSetup::Robot(Box::new(RobotSensorConfig {
+        noise: sim::robot_noise::RobotNoise::randomised().scaled(2.0),
+        ..RobotSensorConfig::default()
+    }))
+    .build(fresh.config());
+    let mut resumed = Simulation::resume(state, Arc::new(fresh.field().clone()), sensors);
+    assert_eq!(trajectory(&mut resumed, 1500), whole);
+}

@@ -57,21 +57,18 @@ pub fn sample_states(
         ..Scenario::default()
     };
     let (mut sim, mut controller) = scenario.build()?;
-    let SelectedSensors::Robot(model) = sim.sensors() else {
-        bail!("the scenario did not build the robot sensor model")
-    };
-    let mut model: RobotSensors = (**model).clone();
     sim.run(&mut controller, warmup);
     let mut samples = Vec::with_capacity(count);
     while samples.len() < count {
         sim.run(&mut controller, every);
-        for robot in 0..sim.world().robots().len() {
+        let SelectedSensors::Robot(model) = sim.sensors() else {
+            bail!("the scenario did not build the robot sensor model")
+        };
+        for (robot, observation) in model.observations().iter().enumerate() {
             if samples.len() == count {
                 break;
             }
-            let mut observation = RobotObservation::default();
-            model.observe(sim.world(), sim.field(), robot, &mut observation);
-            samples.push(Sample { field: name.clone(), step: sim.totals().steps, robot, observation });
+            samples.push(Sample { field: name.clone(), step: sim.totals().steps, robot, observation: observation.clone() });
         }
     }
     Ok(samples)

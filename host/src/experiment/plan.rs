@@ -9,8 +9,9 @@
 
 use super::spec::{ArmController, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
+use crate::train::format2::TrainConfigV2;
 use crate::train::{OutputConfig, TrainConfig};
-use sim::scenario::orbital_innies;
+use sim::scenario::{orbital_innies, THESIS_ROBOTS};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
 
@@ -77,23 +78,39 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to the field's
 /// default counts as unset (the same run either way), and settings that use
-/// nothing newer than format 1 are hashed in its layout
-/// ([`TrainConfigV1`]), so that trials run before the newer settings
-/// existed keep their hashes.
+/// nothing newer than format 1 or 2 are hashed in its layout
+/// ([`TrainConfigV1`], [`TrainConfigV2`]), so that trials run before the
+/// newer settings existed keep their hashes. Settings with the robot's
+/// senses also hash their model's version
+/// ([`sim::robot_sensors::MODEL_VERSION`]): trials of another model are
+/// run again.
 #[derive(Serialize)]
 #[serde(untagged)]
 enum Hashed {
     V1(TrainConfigV1),
+    V2(TrainConfigV2),
     Current(TrainConfig),
+    /// Settings with the robot's senses, and the version of their model.
+    RobotSenses { model: u32, settings: Box<Hashed> },
 }
 
 /// [`Hashed`] settings of `config`.
 fn hashed(config: &TrainConfig) -> Hashed {
     let mut c = config.clone();
-    if c.innies == Some(orbital_innies(&c.field, c.robots)) {
+    if c.innies == Some(orbital_innies(&c.field, c.robots.unwrap_or(THESIS_ROBOTS))) {
         c.innies = None;
     }
-    TrainConfigV1::of(&c).map_or(Hashed::Current(c), Hashed::V1)
+    let robot_senses = c.sensors.is_robot();
+    let settings = match (TrainConfigV1::of(&c), TrainConfigV2::of(&c)) {
+        (Some(v1), _) => Hashed::V1(v1),
+        (None, Some(v2)) => Hashed::V2(v2),
+        (None, None) => Hashed::Current(c),
+    };
+    if robot_senses {
+        Hashed::RobotSenses { model: sim::robot_sensors::MODEL_VERSION, settings: Box::new(settings) }
+    } else {
+        settings
+    }
 }
 
 /// Whether two settings give the same run (a stored pre-training's).
@@ -125,7 +142,7 @@ pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u
             config.output = OutputConfig::default();
             let pretrain = arm.pretrain.as_ref().map(|p| {
                 let mut pre = arm.config.clone();
-                pre.robots = p.robots.unwrap_or(pre.robots);
+                pre.robots = p.robots.or(pre.robots);
                 pre.steps = scaled(p.steps, scale);
                 pre.seed = trial_seed(seed, "pretrain", trial);
                 pre.output = OutputConfig::default();

@@ -410,9 +410,9 @@ alpha = 0.1
     fn arms_merge_over_the_defaults_key_by_key() {
         let spec = ExperimentSpec::parse("x", FILE).unwrap();
         let (a, b) = (&spec.arms[0], &spec.arms[1]);
-        assert_eq!((a.controller, a.config.robots, a.row.as_str()), (ArmController::Oc, 4, "A"));
+        assert_eq!((a.controller, a.config.robots, a.row.as_str()), (ArmController::Oc, Some(4), "A"));
         assert_eq!(a.thesis[&Metric::Formations], 12.5);
-        assert_eq!((b.config.robots, b.config.learn.alpha, b.config.learn.gamma), (2, 0.1, 0.5));
+        assert_eq!((b.config.robots, b.config.learn.alpha, b.config.learn.gamma), (Some(2), 0.1, 0.5));
         assert_eq!(b.pretrain, Some(PretrainSpec { steps: 100, robots: Some(1) }));
         assert_eq!(spec.figures.len(), 2, "default figures");
     }

@@ -10,7 +10,6 @@ use sim::{EpisodeEnd, Simulation, Totals};
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Steps per collision block (the thesis' chapter 6 metric).
@@ -88,20 +87,16 @@ impl Running {
     /// of a pre-trained arm.
     pub fn start(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<Running> {
         let c = &plan.config;
-        let field = Arc::new(c.field.load()?);
         Ok(match plan.controller {
             ArmController::Oc => {
-                let mut config = c.sim_config();
-                config.world.innies = c.oc_innies();
+                let mut prepared = c.prepare()?;
+                let config = prepared.config_mut();
+                config.world.innies = c.oc_innies(config.world.robots);
                 let oc = OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds);
-                let sensors = c.sensors.build(&config)?;
-                let sim = Simulation::with_sensors(config, field, sensors, c.seed).context("invalid settings")?;
+                let sim = prepared.simulation(c.seed).context("invalid settings")?;
                 Running::Oc(Box::new(sim), oc)
             }
-            ArmController::Learn => {
-                let sensors = c.sensors.build(&c.sim_config())?;
-                Running::Learn(Box::new(Trainer::new(c.clone(), field, sensors, seed_table)?))
-            }
+            ArmController::Learn => Running::Learn(Box::new(Trainer::start(c.clone(), seed_table)?)),
         })
     }
 
@@ -167,8 +162,7 @@ pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> 
 
 /// Pre-trains a Q-table: a plain training run of `config`.
 pub fn pretrain(config: &TrainConfig) -> Result<Trainer<sim::sensor_setup::SelectedSensors>> {
-    let field = Arc::new(config.field.load()?);
-    let mut trainer = Trainer::new(config.clone(), field, config.sensors.build(&config.sim_config())?, None)?;
+    let mut trainer = Trainer::start(config.clone(), None)?;
     trainer.run(config.steps);
     Ok(trainer)
 }

@@ -110,10 +110,8 @@ mod tests {
     #[test]
     fn from_a_training_checkpoint() {
         use crate::train::{checkpoint, TrainConfig, Trainer};
-        let config = TrainConfig { robots: 2, pucks: 40, ..TrainConfig::default() };
-        let field = std::sync::Arc::new(config.field.load().unwrap());
-        let sensors = config.sensors.build(&config.sim_config()).unwrap();
-        let mut trainer = Trainer::new(config, field, sensors, None).unwrap();
+        let config = TrainConfig { robots: Some(2), pucks: Some(40), ..TrainConfig::default() };
+        let mut trainer = Trainer::start(config, None).unwrap();
         trainer.run(500);
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.ckpt");

@@ -6,21 +6,22 @@
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1 or 2), u16                         |
+//! | 8      | 2    | format version (1 to 3), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
-//! Format 2's body is the [`TrainingState`]; format 1's is the state
-//! without the settings added since ([`super::format1`]). A state
-//! that uses none of them is written as format 1, byte for byte what
-//! earlier builds wrote; both formats are read.
+//! Format 3's body is the [`TrainingState`]; formats 1 and 2 are the
+//! state without the settings added since ([`super::format1`],
+//! [`super::format2`]). A state is written in the oldest format that
+//! holds it, byte for byte what earlier builds wrote; all three are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
 //! a run killed at any moment leaves the old checkpoint or the new one.
 
 use super::format1::StateV1;
+use super::format2::StateV2;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
@@ -30,11 +31,14 @@ use std::path::Path;
 
 /// The first eight bytes of every checkpoint.
 pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
-/// The newest format version, which this build writes when format 1 cannot
-/// hold the state; it reads both. 2: the settings of how the thesis was run
-/// and the world config of a rectangular arena (width, height, the field's
-/// frame and sampling, puck mass, millimetres per unit).
-pub const VERSION: u16 = 2;
+/// The newest format version, which this build writes when no older one
+/// holds the state; it reads them all. 2: the settings of how the thesis
+/// was run and the world config of a rectangular arena (width, height, the
+/// field's frame and sampling, puck mass, millimetres per unit). 3: the
+/// run's arena and noise, the counts left to the arena, the motion noise,
+/// the world's seed, episode count and dropped-period turns, the robot
+/// senses' memory.
+pub const VERSION: u16 = 3;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
@@ -99,9 +103,10 @@ impl std::error::Error for CheckpointError {}
 
 /// Encodes a training state into `w`.
 pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
-    let (version, body) = match StateV1::of(state) {
-        Some(v1) => (1u16, postcard::to_stdvec(&v1)),
-        None => (VERSION, postcard::to_stdvec(state)),
+    let (version, body) = match (StateV1::of(state), StateV2::of(state)) {
+        (Some(v1), _) => (1u16, postcard::to_stdvec(&v1)),
+        (None, Some(v2)) => (2, postcard::to_stdvec(&v2)),
+        (None, None) => (VERSION, postcard::to_stdvec(state)),
     };
     let body = body.map_err(std::io::Error::other)?;
     let mut head = Vec::with_capacity(HEADER_LEN);
@@ -156,6 +161,7 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
     let malformed = |e: postcard::Error| CheckpointError::Malformed(e.to_string());
     match version {
         1 => postcard::from_bytes::<StateV1>(body).map(StateV1::into_state).map_err(malformed),
+        2 => postcard::from_bytes::<StateV2>(body).map(StateV2::into_state).map_err(malformed),
         _ => postcard::from_bytes(body).map_err(malformed),
     }
 }

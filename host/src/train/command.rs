@@ -13,7 +13,6 @@ use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, Prog
 use std::fmt;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 use std::time::Instant;
 
 /// Steps between progress-bar updates.
@@ -107,10 +106,8 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
     }
     config.validate()?;
     let seed_table = args.init_from.as_deref().map(|path| seed_table(path, &config)).transpose()?;
-    let field = Arc::new(config.field.load()?);
-    let sensors = config.sensors.build(&config.sim_config())?;
     let steps = config.steps;
-    Ok((Trainer::new(config, field, sensors, seed_table)?, steps))
+    Ok((Trainer::start(config, seed_table)?, steps))
 }
 
 /// A run continued from its checkpoint, with its own settings.
@@ -123,10 +120,8 @@ fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>,
         );
     }
     let state = checkpoint::load(path)?;
-    let field = Arc::new(state.config.field.load()?);
-    let sensors = state.config.sensors.build(&state.sim.config)?;
     let steps = args.steps.unwrap_or(state.config.steps);
-    let trainer = Trainer::resume(state, field, sensors).with_context(|| format!("cannot resume {}", path.display()))?;
+    let trainer = Trainer::restart(state).with_context(|| format!("cannot resume {}", path.display()))?;
     Ok((trainer, steps))
 }
 

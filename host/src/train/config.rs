@@ -3,9 +3,10 @@
 
 use crate::learn::{LearnConfig, StateHasherName};
 use sim::reward::Reward;
-use sim::scenario::{field_config, orbital_innies};
+use crate::arena_choice::ArenaChoice;
 use crate::sensor_choice::SensorChoice;
-use sim::{FieldSource, ObstacleTargets, SimConfig, SuccessSignal};
+use sim::scenario::orbital_innies;
+use sim::{BroadPhase, ControllerChoice, FieldSource, ObstacleTargets, PreparedScenario, Scenario, SuccessSignal};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -27,10 +28,20 @@ pub struct TrainConfig {
     pub field: FieldSource,
     /// The robots' sensor model.
     pub sensors: SensorChoice,
-    /// Number of robots.
-    pub robots: usize,
-    /// Number of pucks.
-    pub pucks: usize,
+    /// The arena: `thesis`, `tv75` or a screen arena file; `None` for
+    /// `tv75` with the robot's senses and the thesis' square otherwise
+    /// ([`ArenaChoice::default_for`]).
+    pub arena: Option<ArenaChoice>,
+    /// Number of robots; `None` for the arena's (8 in the thesis' square,
+    /// 5 on `tv75`).
+    pub robots: Option<usize>,
+    /// Number of pucks; `None` for the arena's (250 in the thesis' square,
+    /// 12 on `tv75`).
+    pub pucks: Option<usize>,
+    /// Real-world noise (domain randomisation), in multiples of the
+    /// default: the robots' motion and the robot senses' readings
+    /// ([`sim::Scenario::noise`]); 0 for none.
+    pub noise: f64,
     /// Steps to run.
     pub steps: u64,
     /// Seed of every random choice.
@@ -108,14 +119,16 @@ impl Default for OutputConfig {
 }
 
 impl Default for TrainConfig {
-    /// Annulus, disc sensors, 8 robots, 250 pucks, [`DEFAULT_STEPS`],
-    /// seed 1, the thesis' learner.
+    /// Annulus, disc sensors in the thesis' square (8 robots, 250 pucks),
+    /// no noise, [`DEFAULT_STEPS`], seed 1, the thesis' learner.
     fn default() -> TrainConfig {
         TrainConfig {
             field: FieldSource::Annulus,
             sensors: SensorChoice::Disc,
-            robots: 8,
-            pucks: 250,
+            arena: None,
+            robots: None,
+            pucks: None,
+            noise: 0.0,
             steps: DEFAULT_STEPS,
             seed: 1,
             stuck_limit: None,
@@ -141,11 +154,35 @@ impl TrainConfig {
         toml::from_str(&text).with_context(|| format!("config file {} is not a valid training config", path.display()))
     }
 
-    /// The simulation settings: the field's defaults ([`field_config`])
-    /// with this run's counts, stuck limit, formation checks and obstacle
-    /// discs; every robot an outie.
-    pub fn sim_config(&self) -> SimConfig {
-        let mut c = field_config(&self.field, self.robots, self.pucks);
+    /// The arena the run uses.
+    pub fn arena_choice(&self) -> ArenaChoice {
+        self.arena.clone().unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
+    }
+
+    /// The run as a scenario (arena and sensor files read and checked),
+    /// without the settings only training has.
+    pub fn scenario(&self) -> Result<Scenario> {
+        Ok(Scenario {
+            field: self.field.clone(),
+            controller: ControllerChoice::Random,
+            robots: self.robots,
+            pucks: self.pucks,
+            seed: self.seed,
+            broad_phase: BroadPhase::Grid,
+            arena: self.arena_choice().arena()?,
+            sensors: self.sensors.setup()?,
+            noise: self.noise,
+        })
+    }
+
+    /// Loads the field and derives the simulation settings: the field's
+    /// defaults ([`sim::scenario::field_config`]) in the run's arena, with
+    /// its counts, noise, stuck limit, formation checks and obstacle discs;
+    /// every robot an outie. Errors name the offending setting.
+    pub fn prepare(&self) -> Result<PreparedScenario> {
+        self.validate()?;
+        let mut prepared = self.scenario()?.prepare().context("invalid simulation settings")?;
+        let c = prepared.config_mut();
         if let Some(limit) = self.stuck_limit {
             c.episode.stuck_limit = limit;
         }
@@ -156,12 +193,17 @@ impl TrainConfig {
             c.sensors.obstacle.radius = discs.radius;
             c.sensors.obstacle_targets = discs.sees;
         }
-        c
+        if let Some(n) = self.innies.filter(|&n| n > c.world.robots) {
+            bail!("innies = {n}: cannot exceed robots = {}", c.world.robots);
+        }
+        c.validate().context("invalid simulation settings")?;
+        Ok(prepared)
     }
 
-    /// The innies of an orbital-construction run of these settings.
-    pub fn oc_innies(&self) -> usize {
-        self.innies.unwrap_or_else(|| orbital_innies(&self.field, self.robots))
+    /// The innies of an orbital-construction run of these settings with
+    /// `robots` robots.
+    pub fn oc_innies(&self, robots: usize) -> usize {
+        self.innies.unwrap_or_else(|| orbital_innies(&self.field, robots))
     }
 
     /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
@@ -180,13 +222,9 @@ impl TrainConfig {
         if let Some(r) = self.obstacle_discs.map(|d| d.radius).filter(|r| !(r.is_finite() && *r > 0.0)) {
             bail!("obstacle_discs.radius = {r}: must be positive");
         }
-        self.sim_config().validate().context("invalid simulation settings")?;
         self.learn.validate()?;
         if self.steps == 0 {
             bail!("steps = 0: must be positive");
-        }
-        if let Some(n) = self.innies.filter(|&n| n > self.robots) {
-            bail!("innies = {n}: cannot exceed robots = {}", self.robots);
         }
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
             bail!("obstacle_discs: only the disc sensor model takes them (sensors = {:?})", self.sensors.to_string());
@@ -232,10 +270,15 @@ pub struct TrainOverrides {
     /// photo-transistors and Pixy camera, through the firmware's arithmetic)
     /// or robot:CONFIG.json (docs/robot-sensors.md).
     pub sensors: Option<SensorChoice>,
-    /// Number of robots [default: 8].
+    /// thesis, tv75 or a FILE.toml [default: tv75 with the robot's senses,
+    /// else thesis].
+    pub arena: Option<ArenaChoice>,
+    /// Number of robots [default: the arena's].
     pub robots: Option<usize>,
-    /// Number of pucks [default: 250].
+    /// Number of pucks [default: the arena's].
     pub pucks: Option<usize>,
+    /// Real-world noise in multiples of the default [default: 0].
+    pub noise: Option<f64>,
     /// Seed of every random choice [default: 1].
     pub seed: Option<u64>,
     /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
@@ -259,8 +302,16 @@ impl TrainOverrides {
             config.field = v.clone();
         }
         set(&mut config.sensors, self.sensors.clone());
-        set(&mut config.robots, self.robots);
-        set(&mut config.pucks, self.pucks);
+        if let Some(arena) = &self.arena {
+            config.arena = Some(arena.clone());
+        }
+        if let Some(robots) = self.robots {
+            config.robots = Some(robots);
+        }
+        if let Some(pucks) = self.pucks {
+            config.pucks = Some(pucks);
+        }
+        set(&mut config.noise, self.noise);
         set(&mut config.seed, self.seed);
         set(&mut config.learn.hasher, self.hasher);
         set(&mut config.learn.reward, self.reward);
@@ -275,8 +326,10 @@ impl TrainOverrides {
         let flags = [
             ("--field", self.field.is_some()),
             ("--sensors", self.sensors.is_some()),
+            ("--arena", self.arena.is_some()),
             ("--robots", self.robots.is_some()),
             ("--pucks", self.pucks.is_some()),
+            ("--noise", self.noise.is_some()),
             ("--seed", self.seed.is_some()),
             ("--hasher", self.hasher.is_some()),
             ("--reward", self.reward.is_some()),
@@ -302,11 +355,12 @@ mod tests {
     fn a_file_names_what_it_changes_and_flags_win() {
         let text = "robots = 4\nfield = \"letter:L\"\n[learn]\nhasher = \"bits7\"\nalpha = 0.5\n[output]\nname = \"x\"\n";
         let mut c: TrainConfig = toml::from_str(text).unwrap();
-        assert_eq!((c.robots, c.pucks, c.learn.alpha), (4, 250, 0.5));
-        assert_eq!(c.sim_config().episode.stuck_limit, 50_000);
+        assert_eq!((c.robots, c.pucks, c.learn.alpha), (Some(4), None, 0.5));
+        let world = &c.prepare().unwrap().config().clone();
+        assert_eq!((world.episode.stuck_limit, world.world.pucks), (50_000, 250));
         let flags = TrainOverrides { alpha: Some(0.1), robots: Some(2), ..Default::default() };
         flags.apply(&mut c);
-        assert_eq!((c.robots, c.learn.alpha, c.learn.hasher.0.bits()), (2, 0.1, 7));
+        assert_eq!((c.robots, c.learn.alpha, c.learn.hasher.0.bits()), (Some(2), 0.1, 7));
         assert_eq!(flags.given(), ["--robots", "--alpha"]);
         c.validate().unwrap();
     }

@@ -8,17 +8,20 @@
 //! the one earlier builds gave it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 1 in
-//! their order, the types they share with format 2 unchanged.
+//! their order, the types they share with the newer formats unchanged.
+//! Format 1 is format 2 ([`super::format2`]) with fewer settings, so these
+//! convert to and from format 2's layout.
 
 use super::config::{FormationCheck, OutputConfig, TrainConfig};
+use super::format2::{SimConfigV2, SimulationV2, StateV2, TrainConfigV2, WorldConfigV2, WorldV2};
 use super::trainer::TrainingState;
 use crate::learn::{LearnConfig, QLearner};
 use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
-use sim::config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
+use sim::config::{EpisodeConfig, PhysicsConfig, SuccessSignal, Thresholds, WorldConfig};
 use sim::field::FieldSampling;
-use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World, WorldState};
+use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, Totals};
 
 /// A training state in format 1's layout.
 #[derive(Serialize, Deserialize)]
@@ -70,7 +73,7 @@ impl WorldConfigV1 {
     /// The settings in format 1, if the arena is the reference model's kind:
     /// square, 5 mm per unit, pucks of the default mass, the field over the
     /// whole arena read at the nearest cell.
-    fn of(w: &WorldConfig) -> Option<WorldConfigV1> {
+    fn of(w: &WorldConfigV2) -> Option<WorldConfigV1> {
         let plain = w.arena_width == w.arena_height
             && w.unit_mm == WorldConfig::default().unit_mm
             && w.puck_mass.is_none()
@@ -88,18 +91,22 @@ impl WorldConfigV1 {
         })
     }
 
-    fn into_config(self) -> WorldConfig {
-        WorldConfig {
+    fn into_v2(self) -> WorldConfigV2 {
+        let d = WorldConfig::default();
+        WorldConfigV2 {
             arena_width: self.arena_size,
             arena_height: self.arena_size,
+            unit_mm: d.unit_mm,
             robots: self.robots,
             innies: self.innies,
             pucks: self.pucks,
             robot_radius: self.robot_radius,
             puck_radius: self.puck_radius,
+            puck_mass: None,
             forward_speed: self.forward_speed,
             broad_phase: self.broad_phase,
-            ..WorldConfig::default()
+            field_frame: None,
+            field_sampling: FieldSampling::Nearest,
         }
     }
 }
@@ -113,31 +120,6 @@ struct WorldV1 {
     robots: Vec<Robot>,
     steps: u64,
     rng: SimRng,
-}
-
-impl WorldV1 {
-    fn of(world: &World) -> Option<WorldV1> {
-        let s = world.state();
-        Some(WorldV1 {
-            config: WorldConfigV1::of(&s.config)?,
-            physics: s.physics.clone(),
-            bodies: s.bodies.clone(),
-            robots: s.robots.clone(),
-            steps: s.steps,
-            rng: s.rng.clone(),
-        })
-    }
-
-    fn into_world(self) -> World {
-        World::from_state(WorldState {
-            config: self.config.into_config(),
-            physics: self.physics,
-            bodies: self.bodies,
-            robots: self.robots,
-            steps: self.steps,
-            rng: self.rng,
-        })
-    }
 }
 
 #[derive(Serialize, Deserialize)]
@@ -161,6 +143,10 @@ struct EpisodeV1 {
 impl TrainConfigV1 {
     /// The settings in format 1, if they use nothing format 1 cannot hold.
     pub fn of(c: &TrainConfig) -> Option<TrainConfigV1> {
+        TrainConfigV2::of(c).and_then(|c| TrainConfigV1::of_v2(&c))
+    }
+
+    fn of_v2(c: &TrainConfigV2) -> Option<TrainConfigV1> {
         let plain = c.formation_check == FormationCheck::default()
             && c.success == SuccessSignal::Eval
             && c.innies.is_none()
@@ -177,22 +163,24 @@ impl TrainConfigV1 {
             output: c.output.clone(),
         })
     }
-}
 
-impl From<TrainConfigV1> for TrainConfig {
-    /// The settings, with every one format 1 lacks at its default.
-    fn from(c: TrainConfigV1) -> TrainConfig {
-        TrainConfig {
-            field: c.field,
-            sensors: c.sensors,
-            robots: c.robots,
-            pucks: c.pucks,
-            steps: c.steps,
-            seed: c.seed,
-            stuck_limit: c.stuck_limit,
-            learn: c.learn,
-            output: c.output,
-            ..TrainConfig::default()
+    /// The settings with every one format 1 lacks at its default.
+    fn into_v2(self) -> TrainConfigV2 {
+        let d = TrainConfig::default();
+        TrainConfigV2 {
+            field: self.field,
+            sensors: self.sensors,
+            robots: self.robots,
+            pucks: self.pucks,
+            steps: self.steps,
+            seed: self.seed,
+            stuck_limit: self.stuck_limit,
+            learn: self.learn,
+            output: self.output,
+            formation_check: d.formation_check,
+            success: d.success,
+            innies: d.innies,
+            obstacle_discs: d.obstacle_discs,
         }
     }
 }
@@ -200,13 +188,14 @@ impl From<TrainConfigV1> for TrainConfig {
 impl StateV1 {
     /// The state in format 1, if it uses nothing format 1 cannot hold.
     pub fn of(state: &TrainingState) -> Option<StateV1> {
-        let s = &state.sim;
-        let e = &s.config.episode;
+        let v2 = StateV2::of(state)?;
+        let (s, e) = (&v2.sim, &v2.sim.config.episode);
         let plain_sim = !e.stale_eval && e.success_signal == SuccessSignal::Eval && s.checked_signal.is_none();
-        let config = TrainConfigV1::of(&state.config).filter(|_| plain_sim)?;
+        plain_sim.then_some(())?;
+        let w = &s.world;
         Some(StateV1 {
-            config,
-            field_crc: state.field_crc,
+            config: TrainConfigV1::of_v2(&v2.config)?,
+            field_crc: v2.field_crc,
             sim: SimulationV1 {
                 config: SimConfigV1 {
                     world: WorldConfigV1::of(&s.config.world)?,
@@ -221,26 +210,34 @@ impl StateV1 {
                         nu: e.nu,
                     },
                 },
-                world: WorldV1::of(&s.world)?,
+                world: WorldV1 {
+                    config: WorldConfigV1::of(&w.config)?,
+                    physics: w.physics.clone(),
+                    bodies: w.bodies.clone(),
+                    robots: w.robots.clone(),
+                    steps: w.steps,
+                    rng: w.rng.clone(),
+                },
                 controller_rng: s.controller_rng.clone(),
                 episode_step: s.episode_step,
                 totals: s.totals.clone(),
                 readings: s.readings.clone(),
             },
-            learner: state.learner.clone(),
+            learner: v2.learner,
         })
     }
 
     /// The state, with every setting format 1 lacks at its default.
     pub fn into_state(self) -> TrainingState {
-        let (c, s) = (self.config, self.sim);
+        let s = self.sim;
         let e = s.config.episode;
-        TrainingState {
-            config: c.into(),
+        let w = s.world;
+        StateV2 {
+            config: self.config.into_v2(),
             field_crc: self.field_crc,
-            sim: SimulationState {
-                config: SimConfig {
-                    world: s.config.world.into_config(),
+            sim: SimulationV2 {
+                config: SimConfigV2 {
+                    world: s.config.world.into_v2(),
                     physics: s.config.physics,
                     sensors: s.config.sensors,
                     thresholds: s.config.thresholds,
@@ -253,7 +250,14 @@ impl StateV1 {
                         ..EpisodeConfig::default()
                     },
                 },
-                world: s.world.into_world(),
+                world: WorldV2 {
+                    config: w.config.into_v2(),
+                    physics: w.physics,
+                    bodies: w.bodies,
+                    robots: w.robots,
+                    steps: w.steps,
+                    rng: w.rng,
+                },
                 controller_rng: s.controller_rng,
                 episode_step: s.episode_step,
                 totals: s.totals,
@@ -262,5 +266,6 @@ impl StateV1 {
             },
             learner: self.learner,
         }
+        .into_state()
     }
 }

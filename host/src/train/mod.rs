@@ -1,10 +1,11 @@
 //! Training: a run's settings ([`config`]), the learning loop over any
 //! sensor model ([`trainer`]), its checkpoint file ([`checkpoint`]; the
-//! layout of format 1: [`format1`]) and the `host train` command
+//! layouts of formats 1 and 2: [`format1`], [`format2`]) and the `host train` command
 //! ([`command`]).
 
 pub mod checkpoint;
 pub mod format1;
+pub mod format2;
 pub mod command;
 pub mod config;
 pub mod trainer;

@@ -3,7 +3,7 @@
 
 use super::config::{field_label, TrainConfig};
 use crate::learn::{QLearner, QTable};
-use sim::{EpisodeEnd, ScalarField, SensorModel, Simulation, SimulationState, Totals};
+use sim::{EpisodeEnd, ScalarField, SelectedSensors, SensorModel, Simulation, SimulationState, Totals};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
@@ -35,18 +35,33 @@ pub struct Trainer<S: SensorModel> {
     learner: QLearner,
 }
 
+impl Trainer<SelectedSensors> {
+    /// A new run of `config` with the sensor model it names.
+    pub fn start(config: TrainConfig, seed_table: Option<QTable>) -> Result<Self> {
+        let sim = config.prepare()?.simulation(config.seed).context("invalid simulation settings")?;
+        Trainer::new(config, sim, seed_table)
+    }
+
+    /// Continues a saved run, the field and sensor model rebuilt from its
+    /// settings.
+    pub fn restart(state: TrainingState) -> Result<Self> {
+        let prepared = state.config.prepare()?;
+        let sensors = prepared.sensors().build(&state.sim.config);
+        Trainer::resume(state, prepared.field().clone(), sensors)
+    }
+}
+
 impl<S: SensorModel> Trainer<S> {
-    /// A new run; `seed_table` (the thesis' RL2) replaces the initial
-    /// Q-values and must have the run's hasher and action count.
-    pub fn new(config: TrainConfig, field: Arc<ScalarField>, sensors: S, seed_table: Option<QTable>) -> Result<Self> {
+    /// A new run on `sim` (built from `config`, [`TrainConfig::prepare`]);
+    /// `seed_table` (the thesis' RL2) replaces the initial Q-values and
+    /// must have the run's hasher and action count.
+    pub fn new(config: TrainConfig, sim: Simulation<S>, seed_table: Option<QTable>) -> Result<Self> {
         config.validate()?;
         let learner = match seed_table {
             Some(q) => QLearner::with_table(config.learn.clone(), q)?,
             None => QLearner::new(config.learn.clone())?,
         };
-        let field_crc = field_fingerprint(&field);
-        let sim = Simulation::with_sensors(config.sim_config(), field, sensors, config.seed)
-            .context("invalid simulation settings")?;
+        let field_crc = field_fingerprint(sim.field());
         Ok(Trainer { config, field_crc, sim, learner })
     }
 
@@ -81,7 +96,7 @@ impl<S: SensorModel> Trainer<S> {
         TrainingState {
             config: self.config.clone(),
             field_crc: self.field_crc,
-            sim: self.sim.state().clone(),
+            sim: self.sim.snapshot(),
             learner: self.learner.clone(),
         }
     }

@@ -1,0 +1,274 @@
+//! Format 2: the training settings and state as they were laid out before
+//! the noise models (the robots' motion, the robot senses' noise and
+//! latency) and before a run's arena and noise were settings: the thesis'
+//! square or a rectangular arena of fixed settings, every count given.
+//! Settings and states that use nothing newer, but something format 1
+//! lacks, keep this layout: a checkpoint is byte for byte what earlier
+//! builds wrote, and an experiment trial's hash the one they gave it
+//! (`experiment::plan`).
+//!
+//! postcard is positional: these structs list the fields of format 2 in
+//! their order, the types they share with the newest format unchanged.
+//! The world's seed and episode count are derived on reading, as for
+//! format 1 ([`super::format1`]).
+
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::trainer::TrainingState;
+use crate::arena_choice::ArenaChoice;
+use crate::learn::{LearnConfig, QLearner};
+use crate::sensor_choice::SensorChoice;
+use serde::{Deserialize, Serialize};
+use shared::SensorReading;
+use sim::actuation::ActuationNoise;
+use sim::config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
+use sim::field::{FieldFrame, FieldSampling};
+use sim::scenario::{THESIS_PUCKS, THESIS_ROBOTS};
+use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World, WorldState};
+
+/// A training state in format 2's layout.
+#[derive(Serialize, Deserialize)]
+pub struct StateV2 {
+    pub(super) config: TrainConfigV2,
+    pub(super) field_crc: u32,
+    pub(super) sim: SimulationV2,
+    pub(super) learner: QLearner,
+}
+
+/// A [`TrainConfig`] without the settings added since format 2: the
+/// thesis' square, no noise, the counts resolved.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrainConfigV2 {
+    pub(super) field: FieldSource,
+    pub(super) sensors: SensorChoice,
+    pub(super) robots: usize,
+    pub(super) pucks: usize,
+    pub(super) steps: u64,
+    pub(super) seed: u64,
+    pub(super) stuck_limit: Option<u64>,
+    pub(super) learn: LearnConfig,
+    pub(super) output: OutputConfig,
+    pub(super) formation_check: FormationCheck,
+    pub(super) success: SuccessSignal,
+    pub(super) innies: Option<usize>,
+    pub(super) obstacle_discs: Option<ObstacleDiscs>,
+}
+
+impl TrainConfigV2 {
+    /// The settings in format 2, if they run in the thesis' square
+    /// without noise.
+    pub fn of(c: &TrainConfig) -> Option<TrainConfigV2> {
+        let plain = c.arena_choice() == ArenaChoice::Thesis && c.noise == 0.0;
+        plain.then(|| TrainConfigV2 {
+            field: c.field.clone(),
+            sensors: c.sensors.clone(),
+            robots: c.robots.unwrap_or(THESIS_ROBOTS),
+            pucks: c.pucks.unwrap_or(THESIS_PUCKS),
+            steps: c.steps,
+            seed: c.seed,
+            stuck_limit: c.stuck_limit,
+            learn: c.learn.clone(),
+            output: c.output.clone(),
+            formation_check: c.formation_check,
+            success: c.success,
+            innies: c.innies,
+            obstacle_discs: c.obstacle_discs,
+        })
+    }
+}
+
+impl From<TrainConfigV2> for TrainConfig {
+    /// The settings in the thesis' square, without noise.
+    fn from(c: TrainConfigV2) -> TrainConfig {
+        TrainConfig {
+            field: c.field,
+            sensors: c.sensors,
+            arena: Some(ArenaChoice::Thesis),
+            robots: Some(c.robots),
+            pucks: Some(c.pucks),
+            noise: 0.0,
+            steps: c.steps,
+            seed: c.seed,
+            stuck_limit: c.stuck_limit,
+            learn: c.learn,
+            output: c.output,
+            formation_check: c.formation_check,
+            success: c.success,
+            innies: c.innies,
+            obstacle_discs: c.obstacle_discs,
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+pub(super) struct SimulationV2 {
+    pub(super) config: SimConfigV2,
+    pub(super) world: WorldV2,
+    pub(super) controller_rng: SimRng,
+    pub(super) episode_step: u64,
+    pub(super) totals: Totals,
+    pub(super) readings: Vec<SensorReading>,
+    pub(super) checked_signal: Option<f64>,
+}
+
+#[derive(Serialize, Deserialize)]
+pub(super) struct SimConfigV2 {
+    pub(super) world: WorldConfigV2,
+    pub(super) physics: PhysicsConfig,
+    pub(super) sensors: DiscSensorConfig,
+    pub(super) thresholds: Thresholds,
+    pub(super) episode: EpisodeConfig,
+}
+
+/// The world settings without the actuation noise.
+#[derive(Serialize, Deserialize)]
+pub(super) struct WorldConfigV2 {
+    pub(super) arena_width: f64,
+    pub(super) arena_height: f64,
+    pub(super) unit_mm: f64,
+    pub(super) robots: usize,
+    pub(super) innies: usize,
+    pub(super) pucks: usize,
+    pub(super) robot_radius: f64,
+    pub(super) puck_radius: f64,
+    pub(super) puck_mass: Option<f64>,
+    pub(super) forward_speed: f64,
+    pub(super) broad_phase: BroadPhase,
+    pub(super) field_frame: Option<FieldFrame>,
+    pub(super) field_sampling: FieldSampling,
+}
+
+impl WorldConfigV2 {
+    pub(super) fn of(w: &WorldConfig) -> Option<WorldConfigV2> {
+        w.actuation.is_none().then(|| WorldConfigV2 {
+            arena_width: w.arena_width,
+            arena_height: w.arena_height,
+            unit_mm: w.unit_mm,
+            robots: w.robots,
+            innies: w.innies,
+            pucks: w.pucks,
+            robot_radius: w.robot_radius,
+            puck_radius: w.puck_radius,
+            puck_mass: w.puck_mass,
+            forward_speed: w.forward_speed,
+            broad_phase: w.broad_phase,
+            field_frame: w.field_frame,
+            field_sampling: w.field_sampling,
+        })
+    }
+
+    pub(super) fn into_config(self) -> WorldConfig {
+        WorldConfig {
+            arena_width: self.arena_width,
+            arena_height: self.arena_height,
+            unit_mm: self.unit_mm,
+            robots: self.robots,
+            innies: self.innies,
+            pucks: self.pucks,
+            robot_radius: self.robot_radius,
+            puck_radius: self.puck_radius,
+            puck_mass: self.puck_mass,
+            forward_speed: self.forward_speed,
+            broad_phase: self.broad_phase,
+            field_frame: self.field_frame,
+            field_sampling: self.field_sampling,
+            actuation: ActuationNoise::NONE,
+        }
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+pub(super) struct WorldV2 {
+    pub(super) config: WorldConfigV2,
+    pub(super) physics: PhysicsConfig,
+    pub(super) bodies: Vec<Body>,
+    pub(super) robots: Vec<Robot>,
+    pub(super) steps: u64,
+    pub(super) rng: SimRng,
+}
+
+/// The episodes a run has begun after its first: one per episode ended.
+fn episodes(totals: &Totals) -> u64 {
+    totals.formations + totals.stuck
+}
+
+impl StateV2 {
+    /// The state in format 2, if it uses nothing newer: the config of
+    /// [`TrainConfigV2::of`], no motion noise, no sensor memory, the world
+    /// seeded with the run's seed and one episode begun per episode ended.
+    pub fn of(state: &TrainingState) -> Option<StateV2> {
+        let s = &state.sim;
+        let w = s.world.state();
+        let config = TrainConfigV2::of(&state.config)?;
+        let plain = s.sensor_memory.cameras.is_empty()
+            && w.seed == state.config.seed
+            && w.episode == episodes(&s.totals)
+            && w.last_turns.is_empty();
+        plain.then_some(())?;
+        Some(StateV2 {
+            config,
+            field_crc: state.field_crc,
+            sim: SimulationV2 {
+                config: SimConfigV2 {
+                    world: WorldConfigV2::of(&s.config.world)?,
+                    physics: s.config.physics.clone(),
+                    sensors: s.config.sensors.clone(),
+                    thresholds: s.config.thresholds.clone(),
+                    episode: s.config.episode.clone(),
+                },
+                world: WorldV2 {
+                    config: WorldConfigV2::of(&w.config)?,
+                    physics: w.physics.clone(),
+                    bodies: w.bodies.clone(),
+                    robots: w.robots.clone(),
+                    steps: w.steps,
+                    rng: w.rng.clone(),
+                },
+                controller_rng: s.controller_rng.clone(),
+                episode_step: s.episode_step,
+                totals: s.totals.clone(),
+                readings: s.readings.clone(),
+                checked_signal: s.checked_signal,
+            },
+            learner: state.learner.clone(),
+        })
+    }
+
+    /// The state, with what format 2 lacks derived as [`StateV2::of`]
+    /// requires it.
+    pub fn into_state(self) -> TrainingState {
+        let (c, s) = (self.config, self.sim);
+        let (seed, episode) = (c.seed, episodes(&s.totals));
+        let w = s.world;
+        TrainingState {
+            config: c.into(),
+            field_crc: self.field_crc,
+            sim: SimulationState {
+                config: SimConfig {
+                    world: s.config.world.into_config(),
+                    physics: s.config.physics,
+                    sensors: s.config.sensors,
+                    thresholds: s.config.thresholds,
+                    episode: s.config.episode,
+                },
+                world: World::from_state(WorldState {
+                    config: w.config.into_config(),
+                    physics: w.physics,
+                    bodies: w.bodies,
+                    robots: w.robots,
+                    steps: w.steps,
+                    rng: w.rng,
+                    seed,
+                    episode,
+                    last_turns: Vec::new(),
+                }),
+                controller_rng: s.controller_rng,
+                episode_step: s.episode_step,
+                totals: s.totals,
+                readings: s.readings,
+                checked_signal: s.checked_signal,
+                sensor_memory: Default::default(),
+            },
+            learner: self.learner,
+        }
+    }
+}
