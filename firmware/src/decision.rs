@@ -9,7 +9,7 @@
 
 use shared::{
     ActionId, ActionMotors, BlobSummary, CameraConfig, DriveOutputs, FieldScales, FieldValue,
-    MotorCommand, PixyBlock, PolicyTable, SensorReading, State, StateHasher,
+    MotorCommand, PixyBlock, PolicyTable, Role, SensorReading, State, StateHasher,
 };
 
 /// Read access to the packed policy table (in flash on the robot).
@@ -42,13 +42,15 @@ pub struct Decision {
 }
 
 /// The decision's fixed inputs: calibration curves, camera classification,
-/// hasher, policy table and per-action motor outputs. It borrows the curves
+/// hasher, the robot's role (read by the role hasher only), policy table
+/// and per-action motor outputs. It borrows the curves
 /// (three of them take 246 bytes, which the robot keeps in one place).
 #[derive(Clone, Copy, Debug)]
 pub struct Decider<'a, P: PolicyBytes + ?Sized> {
     scales: &'a FieldScales,
     camera: CameraConfig,
     hasher: StateHasher,
+    role: Role,
     policy: &'a P,
     motors: ActionMotors,
 }
@@ -61,17 +63,18 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
         scales: &'a FieldScales,
         camera: CameraConfig,
         hasher: StateHasher,
+        role: Role,
         policy: &'a P,
         motors: ActionMotors,
     ) -> Self {
-        Decider { scales, camera, hasher, policy, motors }
+        Decider { scales, camera, hasher, role, policy, motors }
     }
 
     /// Decides for one period's raw times and blocks.
     pub fn decide(&self, times: &[u16; 3], blocks: &[PixyBlock]) -> Decision {
         let values = self.scales.values(times);
         let blobs = self.camera.classify(blocks);
-        let state = self.hasher.hash(&SensorReading::from_parts(values, blobs));
+        let state = self.hasher.hash_as(&SensorReading::from_parts(values, blobs), self.role);
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
         let byte = self.policy.byte(PolicyTable::byte_index(masked));
         let action = PolicyTable::action_in_byte(byte, masked);
@@ -99,7 +102,7 @@ mod tests {
         assert_eq!(motors_of(&blob), embedded::MOTORS);
         let cal = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
         let scales = cal.scales();
-        let d = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        let d = Decider::new(&scales, CAMERA, embedded::HASHER, Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
         // Walk states through readings: every (left < mid, right < mid, mid bin, pucks) combination.
         let k = embedded::HASHER.mid_bits();
         let curve = scales.0[1];
@@ -137,13 +140,13 @@ mod tests {
     #[test]
     fn uncalibrated_timeouts_are_dark_and_never_panic() {
         let scales = UNCALIBRATED.scales();
-        let d = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+        let d = Decider::new(&scales, CAMERA, embedded::HASHER, Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
         let dec = d.decide(&[u16::MAX; 3], &[]);
         assert_eq!(dec.values, [FieldValue::ZERO; 3]);
         assert_eq!(dec.state, State(0));
         // A short policy slice reads zeros instead of panicking.
         let scales = UNCALIBRATED.scales();
-        let d = Decider::new(&scales, CAMERA, StateHasher::OriginalObstacle, &[0u8; 3][..], embedded::MOTORS);
+        let d = Decider::new(&scales, CAMERA, StateHasher::OriginalObstacle, Role::Outie, &[0u8; 3][..], embedded::MOTORS);
         assert_eq!(d.decide(&[0; 3], &[]).action, ActionId(0));
     }
 }

@@ -41,6 +41,8 @@ fn main() -> ! {
     // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
     let mut since_calibration = LogFrame::CALIBRATION_EVERY - 1;
     let robot_id = board::robot_id();
+    // odd ids are innies: only a role-aware policy tells them apart
+    let role = shared::Role::of_robot_id(robot_id);
 
     board.watchdog_on();
     loop {
@@ -52,7 +54,7 @@ fn main() -> ! {
         let camera_ok = camera.acquire(&mut board).is_ok();
         let plan = supervisor.period(buttons, &times, camera_ok);
 
-        let decider = Decider::new(scales, CAMERA, embedded::HASHER, &policy, embedded::MOTORS);
+        let decider = Decider::new(scales, CAMERA, embedded::HASHER, role, &policy, embedded::MOTORS);
         let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {

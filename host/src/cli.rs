@@ -11,6 +11,7 @@ use host::experiment::RunOptions;
 use host::learn::StateHasherName;
 use host::observe::ObserveSettings;
 use host::sensor_choice::SensorChoice;
+use host::train::selection::SelectConfig;
 use host::train::{TrainOverrides, TrainRequest};
 use shared::StateHasher;
 use sim::reward::Reward;
@@ -515,6 +516,8 @@ impl TrainArgs {
                 robots: o.robots,
                 pucks: o.pucks,
                 noise: if o.randomise { Some(1.0) } else { o.noise },
+                select: o.select_every.zip(o.select_steps).map(|(every, steps)| SelectConfig { every, steps }),
+                distil_oc: o.distil_oc,
                 seed: o.seed,
                 hasher: o.hasher,
                 reward: o.reward,
@@ -564,11 +567,24 @@ pub struct TrainOverrideArgs {
     /// default, 2 twice as much) [default: 0].
     #[arg(long)]
     pub noise: Option<f64>,
+    /// Policy selection: every N training steps, evaluate the greedy
+    /// policy on a fixed evaluation world and keep the best as the run's
+    /// policy (docs/training.md) [default: none, the last greedy policy].
+    #[arg(long, requires = "select_steps")]
+    pub select_every: Option<u64>,
+    /// Steps of each evaluation of --select-every.
+    #[arg(long, requires = "select_every")]
+    pub select_steps: Option<u64>,
+    /// Start from orbital construction: distil this many of its steps, on
+    /// a world of the run's settings, into the table the run starts from
+    /// (docs/training.md).
+    #[arg(long)]
+    pub distil_oc: Option<u64>,
     /// Seed of every random choice [default: 1].
     #[arg(long)]
     pub seed: Option<u64>,
     /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
-    /// 7, 9) [default: original].
+    /// 7, 9), original-role (innies and outies apart) [default: original].
     #[arg(long)]
     pub hasher: Option<StateHasherName>,
     /// Reward: reference, thesis, collision, collision-spread [default:
@@ -612,20 +628,24 @@ pub enum ExperimentAction {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// From the published trials (<docs>/reproduction/<name>/trials/): every
-    /// experiment's table.md, trials.csv and figures, and
-    /// <docs>/reproduction.md from <docs>/reproduction/template.md.
+    /// From the published trials (<docs>/<document>/<name>/trials/): every
+    /// experiment's table.md, trials.csv and figures, and the documents
+    /// <docs>/reproduction.md and <docs>/robot-sensors.md from their
+    /// templates (<docs>/<document>/template.md). Run from the repository
+    /// root.
     Report {
         /// The docs directory.
         #[arg(long, default_value = "docs")]
         docs: PathBuf,
-        /// Write nothing; fail if <docs>/reproduction.md is not what the trials give.
+        /// Write nothing; fail if a document is not what the trials give.
         #[arg(long, conflicts_with = "scale")]
         check: bool,
         /// The scale the published trials ran at (another than 1 renders a
         /// quick run's page).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
+        /// Only these documents: reproduction, robot-sensors [default: both].
+        documents: Vec<String>,
     },
 }
 

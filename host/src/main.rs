@@ -139,13 +139,14 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             );
             Ok(())
         }
-        Some(ExperimentAction::Report { docs, check, scale }) => {
+        Some(ExperimentAction::Report { docs, check, scale, documents }) => {
             let log = |line: &str| eprintln!("{line}");
+            let documents = host::experiment::report::documents(&documents)?;
             if check {
-                host::experiment::report::check(&docs, &log)?;
-                println!("{} is what the published trials give", docs.join("reproduction.md").display());
+                let checked = host::experiment::report::check(&docs, &documents, &log)?;
+                println!("{} are what the published trials give", paths(&checked));
             } else {
-                let written = host::experiment::report::write(&docs, scale, &log)?;
+                let written = host::experiment::report::write(&docs, &documents, scale, &log)?;
                 println!("wrote {}", paths(&written));
             }
             Ok(())

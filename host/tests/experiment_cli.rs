@@ -35,7 +35,9 @@ fn quick_runs_of_every_experiment_produce_tables_and_figures() {
     for file in experiment_files() {
         let spec = host::experiment::ExperimentSpec::load(file.to_str().unwrap()).unwrap();
         let dir = out.path().join(&spec.name);
+        // from the repository root, against which files name sensor configs and policies
         let run = host()
+            .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
             .args(["experiment", file.to_str().unwrap(), "--trials", "2", "--scale", "0.0004", "--out"])
             .arg(&dir)
             .output()

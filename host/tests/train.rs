@@ -270,3 +270,26 @@ fn every_reward_variant_learns_something() {
         assert!(q.signal().is_finite());
     }
 }
+
+#[test]
+fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_and_resumes_exactly() {
+    let select = host::train::selection::SelectConfig { every: 600, steps: 400 };
+    let selecting = TrainConfig { select: Some(select), ..small(21) };
+    let mut with = trainer(selecting.clone());
+    let mut without = trainer(small(21));
+    with.run(2400);
+    without.run(2400);
+    assert_eq!(with.learner().table(), without.learner().table(), "evaluations do not touch the training world");
+    assert!(evolving(&with.state()).starts_with(&postcard::to_stdvec(&without.state().sim).unwrap()));
+
+    let best = with.selected().expect("four evaluations ran").clone();
+    assert!(best.step % 600 == 0 && best.step <= 2400);
+    assert_eq!(with.policy().unwrap().table().packed(), &best.packed[..], "the run's policy is the selected one");
+    assert_eq!(with.policy().unwrap().provenance().trainer_steps, best.step);
+    // the selected policy formed at least as much as the last greedy one in the evaluation world
+    let last = with.greedy_policy().unwrap();
+    let evaluation = host::train::selection::Evaluation::new(select, &selecting.prepare().unwrap(), selecting.seed).unwrap();
+    assert!(evaluation.formations(last) <= best.formations);
+
+    assert_eq!(resumes_exactly(selecting, 1500, 2400), 3, "formats 1 and 2 hold no selection");
+}

@@ -261,7 +261,7 @@ impl PolicyBlob {
         let mut angular_speeds = [0.0; ActionTable::MAX_ACTIONS];
         angular_speeds[..self.actions.len()].copy_from_slice(self.actions.angular_speeds());
         let body = Body {
-            hasher: self.hasher().bits(),
+            hasher: self.hasher().id(),
             action_count: self.actions.len() as u8,
             angular_speeds,
             forward_speed: self.actions.forward_speed(),
@@ -329,7 +329,7 @@ impl PolicyBlob {
     }
 
     fn from_body(body: &Body<'_>) -> Result<PolicyBlob, BlobError> {
-        let hasher = StateHasher::from_bits(body.hasher).ok_or(BlobError::UnknownHasher(body.hasher))?;
+        let hasher = StateHasher::from_id(body.hasher).ok_or(BlobError::UnknownHasher(body.hasher))?;
         let count = usize::from(body.action_count);
         if !(ActionTable::MIN_ACTIONS..=ActionTable::MAX_ACTIONS).contains(&count) {
             return Err(BlobError::ActionCount(body.action_count));

@@ -11,11 +11,13 @@
 //! | 4 .. 4+k-1      | 16 x m     | m = floor(mid x 2^k), clamped to 2^k - 1       |
 //! | 8 (10-bit only) | 256        | left obstacle sensor sees a robot              |
 //! | 9 (10-bit only) | 512        | right obstacle sensor sees a robot             |
+//! | 8 (role only)   | 256        | the robot is an innie ([`Role`])               |
 //!
 //! k = 3, 4, 5 for the 7-, 8- and 9-bit hashers; the 10-bit hasher is the
-//! 8-bit one plus the obstacle bits. 1 always means "sensed". Comparisons and
-//! the bin are computed on the Q1.15 [`FieldValue`]s, so they are exact on
-//! both the host and the AVR.
+//! 8-bit one plus the obstacle bits, the role hasher the 8-bit one plus the
+//! robot's role. 1 always means "sensed". Comparisons and the bin are
+//! computed on the Q1.15 [`FieldValue`]s, so they are exact on both the host
+//! and the AVR.
 //!
 //! Worked example (thesis section 3.2): left puck on, right off, mid 0.4,
 //! left 0.35, right 0.45, 8-bit hash: 1 + 4 + 6 x 16 = 101.
@@ -41,9 +43,35 @@ impl fmt::Display for State {
     }
 }
 
-/// The four state representations of the thesis, one type.
+/// A robot's role in the swarm, as orbital construction's innies and
+/// outies: a robot knows it from its build (the firmware: an odd robot id
+/// is an innie, [`Role::of_robot_id`]) and only the role hasher reads it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Role {
+    /// Pushes pucks outwards (orbital construction's outie), the default.
+    #[default]
+    Outie,
+    /// Keeps the inside free (orbital construction's innie).
+    Innie,
+}
+
+impl Role {
+    /// The role of the robot with this id: odd ids are innies, even ones
+    /// (and 0, no id) outies.
+    pub const fn of_robot_id(id: u8) -> Role {
+        if id % 2 == 1 {
+            Role::Innie
+        } else {
+            Role::Outie
+        }
+    }
+}
+
+/// The four state representations of the thesis and the role layout, one
+/// type.
 ///
-/// The wire id of each (in policy blobs and configs) is its bit count.
+/// The wire id of each (in policy blobs) is its bit count for the thesis'
+/// four, and `0x80 | 9` for the role hasher ([`StateHasher::id`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum StateHasher {
     /// 7 bits: 3-bit mid bin (8 field divisions). 128 states.
@@ -54,6 +82,10 @@ pub enum StateHasher {
     Bits9,
     /// 10 bits, "Original_Obstacle": Original plus two obstacle bits. 1024 states.
     OriginalObstacle,
+    /// 9 bits, ours: Original plus the robot's [`Role`] (bit 8 set for an
+    /// innie), so that one shared table can hold both of orbital
+    /// construction's behaviours. 512 states.
+    OriginalRole,
 }
 
 /// The quantised inputs a state encodes: what a hash keeps of a reading.
@@ -73,34 +105,48 @@ pub struct StateInputs {
     pub obstacle_left: bool,
     /// Bit 9 of the 10-bit hash: right obstacle (always false otherwise).
     pub obstacle_right: bool,
+    /// Bit 8 of the role hash: the robot is an innie (always false otherwise).
+    pub innie: bool,
 }
 
 impl StateHasher {
-    /// Every hasher, smallest first.
-    pub const ALL: [StateHasher; 4] = [
+    /// Every hasher, the thesis' four smallest first, then the role hasher.
+    pub const ALL: [StateHasher; 5] = [
         StateHasher::Bits7,
         StateHasher::Original,
         StateHasher::Bits9,
         StateHasher::OriginalObstacle,
+        StateHasher::OriginalRole,
     ];
 
-    /// The hasher with `bits` state bits (7, 8, 9 or 10), the wire id.
-    pub const fn from_bits(bits: u8) -> Option<StateHasher> {
-        match bits {
+    /// The hasher of a wire id ([`StateHasher::id`]).
+    pub const fn from_id(id: u8) -> Option<StateHasher> {
+        match id {
             7 => Some(StateHasher::Bits7),
             8 => Some(StateHasher::Original),
             9 => Some(StateHasher::Bits9),
             10 => Some(StateHasher::OriginalObstacle),
+            0x89 => Some(StateHasher::OriginalRole),
             _ => None,
         }
     }
 
-    /// Number of state bits, also the wire id.
+    /// The wire id in policy blobs: the bit count of the thesis' four,
+    /// `0x89` (the high bit for "with the role", and 9 bits) for the role
+    /// hasher.
+    pub const fn id(self) -> u8 {
+        match self {
+            StateHasher::OriginalRole => 0x89,
+            other => other.bits(),
+        }
+    }
+
+    /// Number of state bits.
     pub const fn bits(self) -> u8 {
         match self {
             StateHasher::Bits7 => 7,
             StateHasher::Original => 8,
-            StateHasher::Bits9 => 9,
+            StateHasher::Bits9 | StateHasher::OriginalRole => 9,
             StateHasher::OriginalObstacle => 10,
         }
     }
@@ -114,7 +160,7 @@ impl StateHasher {
     pub const fn mid_bits(self) -> u32 {
         match self {
             StateHasher::Bits7 => 3,
-            StateHasher::Original | StateHasher::OriginalObstacle => 4,
+            StateHasher::Original | StateHasher::OriginalObstacle | StateHasher::OriginalRole => 4,
             StateHasher::Bits9 => 5,
         }
     }
@@ -124,6 +170,11 @@ impl StateHasher {
         matches!(self, StateHasher::OriginalObstacle)
     }
 
+    /// Whether the hash carries the robot's role.
+    pub const fn has_role_bit(self) -> bool {
+        matches!(self, StateHasher::OriginalRole)
+    }
+
     /// The thesis' name for the hasher.
     pub const fn name(self) -> &'static str {
         match self {
@@ -131,26 +182,35 @@ impl StateHasher {
             StateHasher::Original => "original",
             StateHasher::Bits9 => "bits9",
             StateHasher::OriginalObstacle => "original-obstacle",
+            StateHasher::OriginalRole => "original-role",
         }
     }
 
     /// Every name [`StateHasher::from_name`] takes, as messages list them.
-    pub const NAMES: &'static str = "original, original-obstacle, bits7, bits9 (or their bit counts 8, 10, 7, 9)";
+    pub const NAMES: &'static str =
+        "original, original-obstacle, bits7, bits9 (or their bit counts 8, 10, 7, 9), original-role";
 
-    /// Parses a name (`original`, `original-obstacle`, `bits7`, `bits9`) or a
-    /// bit count (`7`, `8`, `9`, `10`).
+    /// Parses a name (`original`, `original-obstacle`, `bits7`, `bits9`,
+    /// `original-role`) or a bit count of the thesis' four (`7`, `8`, `9`,
+    /// `10`).
     pub fn from_name(name: &str) -> Option<StateHasher> {
         match name {
             "7" | "bits7" => Some(StateHasher::Bits7),
             "8" | "original" => Some(StateHasher::Original),
             "9" | "bits9" => Some(StateHasher::Bits9),
             "10" | "original-obstacle" => Some(StateHasher::OriginalObstacle),
+            "original-role" => Some(StateHasher::OriginalRole),
             _ => None,
         }
     }
 
-    /// What this hasher keeps of a reading.
+    /// What this hasher keeps of an outie's reading.
     pub fn quantise(self, reading: &SensorReading) -> StateInputs {
+        self.quantise_as(reading, Role::Outie)
+    }
+
+    /// What this hasher keeps of the reading of a robot of `role`.
+    pub fn quantise_as(self, reading: &SensorReading, role: Role) -> StateInputs {
         let obstacles = self.has_obstacle_bits();
         StateInputs {
             puck_left: reading.puck_left,
@@ -160,6 +220,7 @@ impl StateHasher {
             mid_bin: reading.mid.bin(self.mid_bits()),
             obstacle_left: obstacles && reading.obstacle_left,
             obstacle_right: obstacles && reading.obstacle_right,
+            innie: self.has_role_bit() && role == Role::Innie,
         }
     }
 
@@ -177,6 +238,9 @@ impl StateHasher {
             | bin << 4;
         if self.has_obstacle_bits() {
             s |= u16::from(inputs.obstacle_left) << 8 | u16::from(inputs.obstacle_right) << 9;
+        }
+        if self.has_role_bit() {
+            s |= u16::from(inputs.innie) << 8;
         }
         State(s)
     }
@@ -198,12 +262,20 @@ impl StateHasher {
             mid_bin: (s >> 4) & ((1 << k) - 1),
             obstacle_left: obstacles && s & 256 != 0,
             obstacle_right: obstacles && s & 512 != 0,
+            innie: self.has_role_bit() && s & 256 != 0,
         })
     }
 
-    /// Hashes a reading: [`StateHasher::pack`] of [`StateHasher::quantise`].
+    /// Hashes an outie's reading: [`StateHasher::pack`] of
+    /// [`StateHasher::quantise`].
     pub fn hash(self, reading: &SensorReading) -> State {
         self.pack(&self.quantise(reading))
+    }
+
+    /// Hashes the reading of a robot of `role` (only the role hasher tells
+    /// the roles apart).
+    pub fn hash_as(self, reading: &SensorReading, role: Role) -> State {
+        self.pack(&self.quantise_as(reading, role))
     }
 }
 
@@ -261,7 +333,7 @@ mod tests {
             obstacle_right: true,
         };
         for h in StateHasher::ALL {
-            assert_eq!(h.hash(&all_on).index(), h.num_states() - 1, "{h}");
+            assert_eq!(h.hash_as(&all_on, Role::Innie).index(), h.num_states() - 1, "{h}");
         }
         for h in StateHasher::ALL {
             assert_eq!(h.hash(&SensorReading::default()), State(0), "{h}");
@@ -318,18 +390,37 @@ mod tests {
     }
 
     #[test]
-    fn names_and_bit_ids_round_trip() {
-        for h in StateHasher::ALL {
-            assert_eq!(StateHasher::from_bits(h.bits()), Some(h));
-            assert_eq!(StateHasher::from_name(h.name()), Some(h));
+    fn the_role_hash_is_the_original_one_plus_bit_8_for_an_innie() {
+        let r = reading(0.35, 0.4, 0.45, true, false);
+        assert_eq!(StateHasher::OriginalRole.hash(&r), State(101));
+        assert_eq!(StateHasher::OriginalRole.hash_as(&r, Role::Outie), State(101));
+        assert_eq!(StateHasher::OriginalRole.hash_as(&r, Role::Innie), State(101 + 256));
+        let mut seen = SensorReading { obstacle_left: true, obstacle_right: true, ..r };
+        seen.mid = FieldValue::ONE;
+        // obstacles are not in the role layout; mid 1.0 is the top bin
+        assert_eq!(StateHasher::OriginalRole.hash_as(&seen, Role::Innie), State(1 + 4 + 8 + 15 * 16 + 256));
+        for h in [StateHasher::Bits7, StateHasher::Original, StateHasher::Bits9, StateHasher::OriginalObstacle] {
+            assert_eq!(h.hash_as(&r, Role::Innie), h.hash(&r), "{h} ignores the role");
         }
-        assert_eq!(StateHasher::from_bits(11), None);
-        assert_eq!(StateHasher::from_name("nine"), None);
+        assert_eq!((Role::of_robot_id(0), Role::of_robot_id(1), Role::of_robot_id(2), Role::of_robot_id(255)),
+            (Role::Outie, Role::Innie, Role::Outie, Role::Innie));
+    }
+
+    #[test]
+    fn names_and_wire_ids_round_trip() {
         for h in StateHasher::ALL {
+            assert_eq!(StateHasher::from_id(h.id()), Some(h));
+            assert_eq!(StateHasher::from_name(h.name()), Some(h));
             assert!(StateHasher::NAMES.contains(h.name()), "{h} missing from NAMES");
+        }
+        for h in [StateHasher::Bits7, StateHasher::Original, StateHasher::Bits9, StateHasher::OriginalObstacle] {
+            assert_eq!(h.id(), h.bits(), "the thesis' hashers keep their bit counts as ids");
             assert!(StateHasher::NAMES.contains(alloc_free_digits(h.bits()).as_str()), "{h}'s bits missing from NAMES");
         }
+        assert_eq!(StateHasher::from_id(11), None);
+        assert_eq!(StateHasher::from_name("nine"), None);
         assert!(StateHasher::Original.unpack(State(256)).is_none());
+        assert!(StateHasher::OriginalRole.unpack(State(512)).is_none());
     }
 
     /// A bit count as text, without an allocator.
@@ -358,11 +449,12 @@ mod tests {
 
     proptest! {
         #[test]
-        fn unpacking_a_hash_gives_back_the_quantised_inputs(r in arb_reading()) {
+        fn unpacking_a_hash_gives_back_the_quantised_inputs(r in arb_reading(), innie in any::<bool>()) {
+            let role = if innie { Role::Innie } else { Role::Outie };
             for h in StateHasher::ALL {
-                let s = h.hash(&r);
+                let s = h.hash_as(&r, role);
                 prop_assert!(s.index() < h.num_states());
-                prop_assert_eq!(h.unpack(s), Some(h.quantise(&r)));
+                prop_assert_eq!(h.unpack(s), Some(h.quantise_as(&r, role)));
             }
         }
 

@@ -42,7 +42,7 @@ pub use calibration::{FieldCalibration, FieldScales, SensorCurve, SensorRange, S
 pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
 pub use drive::{ActionMotors, DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;
-pub use hasher::{State, StateHasher, StateInputs};
+pub use hasher::{Role, State, StateHasher, StateInputs};
 pub use identity::FirmwareIdentity;
 pub use log::{Faults, LogError, LogFrame, RunMode};
 pub use policy::PolicyTable;

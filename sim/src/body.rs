@@ -42,6 +42,16 @@ pub enum RobotKind {
     Innie,
 }
 
+impl RobotKind {
+    /// The role a role-aware state hash reads ([`shared::Role`]).
+    pub const fn role(self) -> shared::Role {
+        match self {
+            RobotKind::Outie => shared::Role::Outie,
+            RobotKind::Innie => shared::Role::Innie,
+        }
+    }
+}
+
 /// A unicycle robot: a heading, constant forward speed; an action only turns it.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Robot {

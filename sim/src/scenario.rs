@@ -130,6 +130,16 @@ pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
     }
 }
 
+/// Settings for robots driven by `blob`: its forward speed, and with the
+/// role hasher orbital construction's mix of innies and outies on `field`
+/// ([`orbital_innies`]).
+pub fn drive_with(config: &mut SimConfig, blob: &shared::PolicyBlob, field: &FieldSource) {
+    config.world.forward_speed = f64::from(blob.actions().forward_speed());
+    if blob.hasher().has_role_bit() {
+        config.world.innies = orbital_innies(field, config.world.robots);
+    }
+}
+
 /// The arena a scenario runs in.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Arena {
@@ -197,7 +207,7 @@ impl Scenario {
             ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
             ControllerChoice::Policy(path) => {
                 let blob = policy_file::read(path)?;
-                prepared.config_mut().world.forward_speed = f64::from(blob.actions().forward_speed());
+                drive_with(prepared.config_mut(), &blob, &self.field);
                 Box::new(GreedyPolicy::new(blob))
             }
         };

@@ -7,10 +7,10 @@
 //! `docs/equivalence.md` describes the checks and their figures.
 
 use anyhow::{bail, Context, Result};
-use sim::scenario::{ControllerChoice, Scenario};
+use sim::scenario::{Arena, ControllerChoice, Scenario};
 use sim::sensor_setup::{SelectedSensors, SensorSetup};
-use sim::{FieldSource, RobotObservation, RobotSensors};
-use shared::{ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, State};
+use sim::{ArenaSpec, FieldSource, RobotObservation, RobotSensors};
+use shared::{ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, Role, State};
 use std::path::Path;
 
 /// CPU cycles per Timer3 tick (clk/64): the RC time resolution.
@@ -38,8 +38,9 @@ pub struct Sample {
 }
 
 /// Samples `count` robot states from episodes on `field` driven by the
-/// greedy policy in `policy` with the default robot sensor model: after
-/// `warmup` steps, every robot's observation every `every` steps.
+/// greedy policy in `policy` with the default robot sensor model on the TV
+/// (`tv75`) at the default noise, as the shipped policies were trained:
+/// after `warmup` steps, every robot's observation every `every` steps.
 pub fn sample_states(
     policy: &Path,
     field: FieldSource,
@@ -54,6 +55,8 @@ pub fn sample_states(
         controller: ControllerChoice::Policy(policy.to_path_buf()),
         sensors: SensorSetup::Robot(Box::default()),
         seed,
+        arena: Arena::Screen(Box::new(ArenaSpec::tv75())),
+        noise: 1.0,
         ..Scenario::default()
     };
     let (mut sim, mut controller) = scenario.build()?;
@@ -93,17 +96,19 @@ pub struct Expected {
 pub struct Expectation<'a> {
     model: &'a RobotSensors,
     policy: &'a PolicyBlob,
+    role: Role,
 }
 
 impl<'a> Expectation<'a> {
-    /// Expectations of `policy` on robots with sensor model `model`.
-    pub fn new(model: &'a RobotSensors, policy: &'a PolicyBlob) -> Expectation<'a> {
-        Expectation { model, policy }
+    /// Expectations of `policy` on a robot of `role` (the firmware's, from
+    /// its robot id) with sensor model `model`.
+    pub fn new(model: &'a RobotSensors, policy: &'a PolicyBlob, role: Role) -> Expectation<'a> {
+        Expectation { model, policy, role }
     }
 
     /// The state of raw times (ticks) and a camera frame.
     pub fn state(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> State {
-        self.policy.hasher().hash(&self.model.reading(ticks, frame))
+        self.policy.hasher().hash_as(&self.model.reading(ticks, frame), self.role)
     }
 
     /// Everything the firmware must do with raw times and a frame.
@@ -254,7 +259,7 @@ mod tests {
         let model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
         let policy = read_policy("robot-annulus-10bit.policy").unwrap().1;
         assert_eq!(policy.hasher(), StateHasher::OriginalObstacle);
-        let e = Expectation::new(&model, &policy);
+        let e = Expectation::new(&model, &policy, shared::Role::Outie);
         let puck = PixyBlock { signature: 1, x: 40, y: 150, width: 30, height: 20, angle: 0 };
         let ticks = [100, 200, 300];
         let (mt, mf) = mirrored(&ticks, &[puck]);

@@ -21,7 +21,7 @@
 use firmware::calibration_record;
 use sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
 use rand::{RngExt, SeedableRng};
-use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, RunMode, State, StateHasher};
+use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, RunMode, State, StateHasher};
 use std::collections::HashMap;
 use std::time::Instant;
 use tests::equivalence::{
@@ -45,6 +45,8 @@ struct Variant {
     /// Directory under `target/avr-none` of the ELF built with that policy.
     elf_dir: &'static str,
     hasher: StateHasher,
+    /// The firmware's robot id (its role: odd ids are innies).
+    robot_id: u8,
     build: &'static str,
 }
 
@@ -52,6 +54,7 @@ const EIGHT_BIT: Variant = Variant {
     policy: "robot-annulus-8bit.policy",
     elf_dir: "robot-annulus-8bit",
     hasher: StateHasher::Original,
+    robot_id: 0,
     build: "FIRMWARE_POLICY=policies/robot-annulus-8bit.policy FIRMWARE_OUT=target/avr-none/robot-annulus-8bit \
             scripts/build-firmware",
 };
@@ -60,8 +63,20 @@ const TEN_BIT: Variant = Variant {
     policy: "robot-annulus-10bit.policy",
     elf_dir: "robot-annulus-10bit",
     hasher: StateHasher::OriginalObstacle,
+    robot_id: 0,
     build: "FIRMWARE_POLICY=policies/robot-annulus-10bit.policy FIRMWARE_HASHER=original-obstacle \
             FIRMWARE_OUT=target/avr-none/robot-annulus-10bit scripts/build-firmware",
+};
+
+/// The role policy in an innie's firmware (robot id 1), so that the role
+/// bit takes part.
+const ROLE: Variant = Variant {
+    policy: "robot-annulus-role.policy",
+    elf_dir: "robot-annulus-role",
+    hasher: StateHasher::OriginalRole,
+    robot_id: 1,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-role.policy FIRMWARE_HASHER=original-role FIRMWARE_ROBOT_ID=1 \
+            FIRMWARE_OUT=target/avr-none/robot-annulus-role scripts/build-firmware",
 };
 
 /// One period's stimulus.
@@ -194,7 +209,8 @@ fn equivalence(v: &Variant) {
 
     let config = RobotSensorConfig::default();
     let model = RobotSensors::new(&config, 5.0);
-    let expectation = Expectation::new(&model, &policy);
+    let role = Role::of_robot_id(v.robot_id);
+    let expectation = Expectation::new(&model, &policy, role);
     let samples = samples_of(&path);
     assert!(samples.len() >= 1000, "{} samples", samples.len());
     let state_of = |frame: &[PixyBlock]| {
@@ -257,7 +273,7 @@ fn equivalence(v: &Variant) {
         })
         .count();
     let other = random_policy(&policy, 99);
-    let other_expectation = Expectation::new(&model, &other);
+    let other_expectation = Expectation::new(&model, &other, role);
     let other_mismatches = samples
         .iter()
         .zip(&nudged)
@@ -385,4 +401,9 @@ fn the_8bit_firmware_decides_as_the_simulator() {
 #[test]
 fn the_10bit_firmware_decides_as_the_simulator() {
     equivalence(&TEN_BIT);
+}
+
+#[test]
+fn the_role_firmware_of_an_innie_decides_as_the_simulator() {
+    equivalence(&ROLE);
 }

@@ -40,7 +40,7 @@ fn decoded(z: &mut Zumo) -> Vec<LogFrame> {
 /// The frame's decision, recomputed on the host from its raw times.
 fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutputs {
     let scales = CALIBRATION.scales();
-    let decider = Decider::new(&scales, CAMERA, embedded::HASHER, &embedded::POLICY[..], embedded::MOTORS);
+    let decider = Decider::new(&scales, CAMERA, embedded::HASHER, shared::Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
     let expected = decider.decide(&frame.raw_times, blocks);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);
@@ -257,9 +257,10 @@ fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period
     let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
     let periods = z.period_cycles();
     assert!(periods.len() >= 20);
-    // Each period starts on time, within what one encoder interrupt
-    // (about 100 cycles) shifts the poll of the timer.
-    assert!(periods.iter().all(|p| p.abs_diff(period) < 2 * CYCLES_PER_TICK), "periods (cycles): {periods:?}");
+    // Each period starts on time, within what the two wheels' encoder
+    // interrupts (about 100 cycles each, and at 6,000 counts/s they can
+    // fall together) shift the poll of the timer.
+    assert!(periods.iter().all(|p| p.abs_diff(period) < 3 * CYCLES_PER_TICK), "periods (cycles): {periods:?}");
     let work = *z.period_work_cycles().iter().max().unwrap();
     println!("period work, odometry at 6,000 counts/s, 8 colour-code blocks, sensors near timeout: {work} of {period} cycles");
     assert!(work < period, "a period's work took {work} cycles, longer than the period");

@@ -14,6 +14,7 @@ use crate::train::{OutputConfig, TrainConfig};
 use sim::scenario::{orbital_innies, THESIS_ROBOTS};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
+use std::path::PathBuf;
 
 /// Version of `TrialResult`'s layout and meaning, and of the
 /// simulator's results; part of the config hash, so results of another
@@ -39,8 +40,11 @@ pub struct TrialPlan {
     pub config: TrainConfig,
     /// The pre-training the run starts from, if any.
     pub pretrain: Option<PretrainPlan>,
-    /// Hash of the controller, config, pre-training and result format:
-    /// a stored result with another hash is stale.
+    /// The policy blob a policy arm runs.
+    pub policy: Option<PathBuf>,
+    /// Hash of the controller, config, pre-training (or the policy file's
+    /// contents) and result format: a stored result with another hash is
+    /// stale.
     pub hash: String,
 }
 
@@ -148,7 +152,14 @@ pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u
                 pre.output = OutputConfig::default();
                 PretrainPlan { hash: hash(&(format, hashed(&pre))), config: pre }
             });
-            let hash = hash(&(format, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash)));
+            let trial_hash = match &arm.policy {
+                // an unreadable file hashes as none: its trials fail naming it
+                Some(path) => {
+                    let blob = std::fs::read(path).map(|b| hash(&b)).ok();
+                    hash(&(format, arm.controller, hashed(&config), blob))
+                }
+                None => hash(&(format, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash))),
+            };
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),
@@ -156,7 +167,8 @@ pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u
                 controller: arm.controller,
                 config,
                 pretrain,
-                hash,
+                policy: arm.policy.clone(),
+                hash: trial_hash,
             });
         }
     }

@@ -11,11 +11,11 @@ use crate::train::TrainConfig;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 7] = [
+pub const BUILT_IN: [(&str, &str); 11] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     ("transfer", include_str!("../../../experiments/transfer.toml")),
     ("letters", include_str!("../../../experiments/letters.toml")),
@@ -23,6 +23,10 @@ pub const BUILT_IN: [(&str, &str); 7] = [
     ("state-bits", include_str!("../../../experiments/state-bits.toml")),
     ("obstacle", include_str!("../../../experiments/obstacle.toml")),
     ("collisions", include_str!("../../../experiments/collisions.toml")),
+    ("robot-senses-ablation", include_str!("../../../experiments/robot-senses-ablation.toml")),
+    ("robot-senses-sweep", include_str!("../../../experiments/robot-senses-sweep.toml")),
+    ("robustness", include_str!("../../../experiments/robustness.toml")),
+    ("robot-senses-letter", include_str!("../../../experiments/robot-senses-letter.toml")),
 ];
 
 /// A parsed experiment file.
@@ -84,6 +88,9 @@ pub enum ArmController {
     Oc,
     /// Q-learning, on-line from the first step.
     Learn,
+    /// A policy blob's greedy actions (the arm's `policy` file), as the
+    /// robot runs them: no learning.
+    Policy,
 }
 
 impl ArmController {
@@ -92,6 +99,7 @@ impl ArmController {
         match self {
             ArmController::Oc => "oc",
             ArmController::Learn => "learn",
+            ArmController::Policy => "policy",
         }
     }
 }
@@ -121,6 +129,9 @@ pub struct ArmSpec {
     pub config: TrainConfig,
     /// Pre-training (`learn` arms only).
     pub pretrain: Option<PretrainSpec>,
+    /// The policy blob a `policy` arm runs (relative to the working
+    /// directory: run from the repository root).
+    pub policy: Option<PathBuf>,
     /// The thesis' values of this arm, by metric.
     pub thesis: BTreeMap<Metric, f64>,
 }
@@ -230,6 +241,7 @@ struct ArmKeys {
     #[serde(default = "default_controller")]
     controller: ArmController,
     pretrain: Option<PretrainSpec>,
+    policy: Option<PathBuf>,
     #[serde(default)]
     thesis: BTreeMap<Metric, f64>,
 }
@@ -238,7 +250,7 @@ fn default_controller() -> ArmController {
     ArmController::Learn
 }
 
-const ARM_KEYS: [&str; 6] = ["name", "row", "column", "controller", "pretrain", "thesis"];
+const ARM_KEYS: [&str; 7] = ["name", "row", "column", "controller", "pretrain", "policy", "thesis"];
 
 impl ExperimentSpec {
     /// A built-in experiment by name, or a file by path.
@@ -353,8 +365,12 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
     }
-    if let Some(n) = config.innies.filter(|_| keys.controller != ArmController::Oc) {
-        bail!("{}: innies = {n}: only orbital construction has innies", context());
+    if (keys.controller == ArmController::Policy) != keys.policy.is_some() {
+        bail!("{}: a policy arm (controller = \"policy\") names its policy file (policy = \"FILE\"), and only a policy arm does", context());
+    }
+    let roles = keys.controller == ArmController::Oc || config.learn.hasher.0.has_role_bit();
+    if let Some(n) = config.innies.filter(|_| !roles) {
+        bail!("{}: innies = {n}: only orbital construction and the role hasher have innies", context());
     }
     Ok(ArmSpec {
         row: keys.row.unwrap_or_else(|| keys.name.clone()),
@@ -363,6 +379,7 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
         controller: keys.controller,
         config,
         pretrain: keys.pretrain,
+        policy: keys.policy,
         thesis: keys.thesis,
     })
 }
@@ -425,13 +442,40 @@ alpha = 0.1
         let bad = FILE.replace("ratio_to = \"A\"", "ratio_to = \"Z\"");
         assert!(e(&bad).contains("\"Z\" is neither a row nor an arm"), "{}", e(&bad));
         let innies = FILE.replace("row = \"b\"", "row = \"b\"\ninnies = 1");
-        assert!(e(&innies).contains("only orbital construction has innies"), "{}", e(&innies));
+        assert!(e(&innies).contains("only orbital construction and the role hasher have innies"), "{}", e(&innies));
         let syntax = FILE.replace("[table]", "[table");
         assert!(e(&syntax).contains("line 3"), "{}", e(&syntax));
         let metric = FILE.replace("\"formations_ratio\"", "\"speed\"");
         assert!(e(&metric).contains("speed"), "{}", e(&metric));
         let range = FILE.replace("alpha = 0.1", "alpha = 3.0");
         assert!(e(&range).contains("learn.alpha = 3"), "{}", e(&range));
+        let no_file = FILE.replace("controller = \"oc\"", "controller = \"policy\"");
+        assert!(e(&no_file).contains("names its policy file"), "{}", e(&no_file));
+        let stray = FILE.replace("controller = \"oc\"", "controller = \"oc\"\npolicy = \"p.policy\"");
+        assert!(e(&stray).contains("only a policy arm does"), "{}", e(&stray));
+    }
+
+    #[test]
+    fn a_policy_arm_runs_its_file_and_its_trials_hash_the_file_contents() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.policy");
+        let text = format!(
+            "title = \"t\"\n[[arms]]\nname = \"P\"\ncontroller = \"policy\"\npolicy = {:?}\nsteps = 300\nrobots = 3\npucks = 20\n",
+            path.display().to_string()
+        );
+        let spec = ExperimentSpec::parse("x", &text).unwrap();
+        assert_eq!(spec.arms[0].policy.as_deref(), Some(path.as_path()));
+        let heuristic = Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/oc-heuristic.policy");
+        std::fs::copy(&heuristic, &path).unwrap();
+        let plan = &super::super::plan::plans(&spec, 1, 1.0, 1)[0];
+        let result = super::super::trial::run(plan, None).unwrap();
+        assert_eq!((result.steps, result.states_visited), (300, None));
+        // another policy under the same name is another trial
+        let mut bytes = std::fs::read(&path).unwrap();
+        let last = bytes.len() - 5;
+        bytes[last] ^= 1;
+        std::fs::write(&path, &bytes).unwrap();
+        assert_ne!(super::super::plan::plans(&spec, 1, 1.0, 1)[0].hash, plan.hash);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use super::plan::{TrialPlan, RESULT_FORMAT};
 use super::spec::ArmController;
-use sim::controllers::{OrbitalConfig, OrbitalConstruction};
+use sim::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction};
 use crate::learn::QTable;
 use sim::sensor_setup::SelectedSensors;
 use sim::{EpisodeEnd, Simulation, Totals};
@@ -80,6 +80,8 @@ pub enum Running {
     Oc(Box<Simulation<SelectedSensors>>, OrbitalConstruction),
     /// Q-learning.
     Learn(Box<Trainer<SelectedSensors>>),
+    /// A policy's greedy actions.
+    Policy(Box<Simulation<SelectedSensors>>, GreedyPolicy),
 }
 
 impl Running {
@@ -97,6 +99,14 @@ impl Running {
                 Running::Oc(Box::new(sim), oc)
             }
             ArmController::Learn => Running::Learn(Box::new(Trainer::start(c.clone(), seed_table)?)),
+            ArmController::Policy => {
+                let path = plan.policy.as_deref().context("a policy arm without its policy file")?;
+                let blob = sim::policy_file::read(path)?;
+                let mut prepared = c.prepare()?;
+                sim::scenario::drive_with(prepared.config_mut(), &blob, &c.field);
+                let sim = prepared.simulation(c.seed).context("invalid settings")?;
+                Running::Policy(Box::new(sim), GreedyPolicy::new(blob))
+            }
         })
     }
 
@@ -105,13 +115,14 @@ impl Running {
         match self {
             Running::Oc(sim, oc) => sim.step(oc),
             Running::Learn(trainer) => trainer.step(),
+            Running::Policy(sim, policy) => sim.step(policy),
         }
     }
 
     /// The simulation.
     pub fn simulation(&self) -> &Simulation<SelectedSensors> {
         match self {
-            Running::Oc(sim, _) => sim,
+            Running::Oc(sim, _) | Running::Policy(sim, _) => sim,
             Running::Learn(trainer) => trainer.simulation(),
         }
     }
@@ -119,7 +130,7 @@ impl Running {
     /// The learner's states visited and states in all, for a learning run.
     fn states(&self) -> Option<(usize, usize)> {
         match self {
-            Running::Oc(..) => None,
+            Running::Oc(..) | Running::Policy(..) => None,
             Running::Learn(trainer) => {
                 let q = trainer.learner().table();
                 Some((q.states_visited(), q.hasher().num_states()))

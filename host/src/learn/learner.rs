@@ -161,8 +161,8 @@ impl Controller for QLearner {
     fn decide(&mut self, perception: &Perception<'_>, turns: &mut [f32], rng: &mut SimRng) {
         let hasher = self.q.hasher();
         self.chosen.clear();
-        for (reading, turn) in perception.readings.iter().zip(turns.iter_mut()) {
-            let state = hasher.hash(reading);
+        for ((reading, turn), robot) in perception.readings.iter().zip(turns.iter_mut()).zip(perception.robots) {
+            let state = hasher.hash_as(reading, robot.kind.role());
             let action = self.q.select(state, self.config.epsilon, rng);
             *turn = self.config.actions[action.index()];
             self.chosen.push((state, action));
@@ -182,8 +182,9 @@ impl Controller for QLearner {
         let reward = self.config.reward.reward(self.last_signal, signal);
         let hasher = self.q.hasher();
         let params = self.config.params();
-        for (&(s, a), reading) in self.chosen.iter().zip(outcome.readings) {
-            self.q.update(s, a, reward, hasher.hash(reading), params);
+        let robots = outcome.world.robots();
+        for ((&(s, a), reading), robot) in self.chosen.iter().zip(outcome.readings).zip(robots) {
+            self.q.update(s, a, reward, hasher.hash_as(reading, robot.kind.role()), params);
         }
         self.last_signal = signal;
     }

@@ -56,6 +56,9 @@ pub struct TrainReport {
     pub states_visited: usize,
     /// States of the hasher.
     pub states_total: usize,
+    /// With policy selection: the training step of the policy written and
+    /// its formations in the evaluation.
+    pub selected: Option<(u64, u64)>,
     /// The policy blob written.
     pub policy: PathBuf,
     /// The checkpoint written.
@@ -69,6 +72,9 @@ impl fmt::Display for TrainReport {
         writeln!(f, "stuck episodes       {}", self.stuck)?;
         writeln!(f, "steps per second     {:.0}", self.steps_per_second)?;
         writeln!(f, "states visited       {} of {}", self.states_visited, self.states_total)?;
+        if let Some((step, formations)) = self.selected {
+            writeln!(f, "selected policy      of step {step}: {formations} formations in its evaluation")?;
+        }
         writeln!(f, "policy               {}", self.policy.display())?;
         write!(f, "checkpoint           {}", self.checkpoint.display())
     }
@@ -198,6 +204,7 @@ fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport
         steps_per_second: if seconds > 0.0 { steps as f64 / seconds } else { f64::INFINITY },
         states_visited: q.states_visited(),
         states_total: q.hasher().num_states(),
+        selected: trainer.selected().map(|s| (s.step, s.formations)),
         policy: policy_path,
         checkpoint: checkpoint_path,
     })

@@ -4,6 +4,7 @@
 use crate::learn::{LearnConfig, StateHasherName};
 use sim::reward::Reward;
 use crate::arena_choice::ArenaChoice;
+use super::selection::SelectConfig;
 use crate::sensor_choice::SensorChoice;
 use sim::scenario::orbital_innies;
 use sim::{BroadPhase, ControllerChoice, FieldSource, ObstacleTargets, PreparedScenario, Scenario, SuccessSignal};
@@ -58,13 +59,22 @@ pub struct TrainConfig {
     /// What a check tests: `eval` (default), `eval-prime` (Eval' as
     /// printed) or `eval-prime-spread`.
     pub success: SuccessSignal,
-    /// Innies among the robots of an orbital-construction run; `None` for
-    /// half the robots on the annulus and none on letters and images
-    /// ([`orbital_innies`]). Learning runs have none.
+    /// Innies among the robots of an orbital-construction run or of a
+    /// learning run with the role hasher (`original-role`); `None` for half
+    /// the robots on the annulus and none on letters and images
+    /// ([`orbital_innies`]). Other learning runs have none.
     pub innies: Option<usize>,
     /// The disc sensor model's obstacle discs; `None` for the model's own
     /// (`disc`: radius r/4 seeing any body).
     pub obstacle_discs: Option<ObstacleDiscs>,
+    /// Policy selection: the run's policy is the best greedy policy of
+    /// periodic evaluations instead of the last one
+    /// ([`super::selection`]); `None` for the last.
+    pub select: Option<SelectConfig>,
+    /// Steps of orbital construction distilled into the table the run
+    /// starts from ([`super::distil`]); `None` to start from the initial
+    /// Q-values.
+    pub distil_oc: Option<u64>,
 }
 
 /// When an episode's formation is checked (`[formation_check]`).
@@ -138,6 +148,8 @@ impl Default for TrainConfig {
             success: SuccessSignal::Eval,
             innies: None,
             obstacle_discs: None,
+            select: None,
+            distil_oc: None,
         }
     }
 }
@@ -196,6 +208,10 @@ impl TrainConfig {
         if let Some(n) = self.innies.filter(|&n| n > c.world.robots) {
             bail!("innies = {n}: cannot exceed robots = {}", c.world.robots);
         }
+        if self.learn.hasher.0.has_role_bit() {
+            // a role-aware policy learns both roles, in orbital construction's mix
+            c.world.innies = self.oc_innies(c.world.robots);
+        }
         c.validate().context("invalid simulation settings")?;
         Ok(prepared)
     }
@@ -225,6 +241,9 @@ impl TrainConfig {
         self.learn.validate()?;
         if self.steps == 0 {
             bail!("steps = 0: must be positive");
+        }
+        if self.distil_oc == Some(0) {
+            bail!("distil_oc = 0: must be positive (or absent)");
         }
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
             bail!("obstacle_discs: only the disc sensor model takes them (sensors = {:?})", self.sensors.to_string());
@@ -279,10 +298,14 @@ pub struct TrainOverrides {
     pub pucks: Option<usize>,
     /// Real-world noise in multiples of the default [default: 0].
     pub noise: Option<f64>,
+    /// Policy selection [default: none, the last greedy policy].
+    pub select: Option<SelectConfig>,
+    /// Steps of orbital construction to distil into the starting table.
+    pub distil_oc: Option<u64>,
     /// Seed of every random choice [default: 1].
     pub seed: Option<u64>,
     /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
-    /// 7, 9) [default: original].
+    /// 7, 9), original-role (innies and outies apart) [default: original].
     pub hasher: Option<StateHasherName>,
     /// Reward: reference, thesis, collision, collision-spread [default:
     /// reference].
@@ -312,6 +335,12 @@ impl TrainOverrides {
             config.pucks = Some(pucks);
         }
         set(&mut config.noise, self.noise);
+        if let Some(select) = self.select {
+            config.select = Some(select);
+        }
+        if let Some(steps) = self.distil_oc {
+            config.distil_oc = Some(steps);
+        }
         set(&mut config.seed, self.seed);
         set(&mut config.learn.hasher, self.hasher);
         set(&mut config.learn.reward, self.reward);
@@ -330,6 +359,8 @@ impl TrainOverrides {
             ("--robots", self.robots.is_some()),
             ("--pucks", self.pucks.is_some()),
             ("--noise", self.noise.is_some()),
+            ("--select-every", self.select.is_some()),
+            ("--distil-oc", self.distil_oc.is_some()),
             ("--seed", self.seed.is_some()),
             ("--hasher", self.hasher.is_some()),
             ("--reward", self.reward.is_some()),

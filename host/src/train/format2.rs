@@ -55,9 +55,9 @@ pub struct TrainConfigV2 {
 
 impl TrainConfigV2 {
     /// The settings in format 2, if they run in the thesis' square
-    /// without noise.
+    /// without noise, policy selection or distillation.
     pub fn of(c: &TrainConfig) -> Option<TrainConfigV2> {
-        let plain = c.arena_choice() == ArenaChoice::Thesis && c.noise == 0.0;
+        let plain = c.arena_choice() == ArenaChoice::Thesis && c.noise == 0.0 && c.select.is_none() && c.distil_oc.is_none();
         plain.then(|| TrainConfigV2 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),
@@ -95,6 +95,8 @@ impl From<TrainConfigV2> for TrainConfig {
             success: c.success,
             innies: c.innies,
             obstacle_discs: c.obstacle_discs,
+            select: None,
+            distil_oc: None,
         }
     }
 }
@@ -199,7 +201,8 @@ impl StateV2 {
         let s = &state.sim;
         let w = s.world.state();
         let config = TrainConfigV2::of(&state.config)?;
-        let plain = s.sensor_memory.cameras.is_empty()
+        let plain = state.selected.is_none()
+            && s.sensor_memory.cameras.is_empty()
             && w.seed == state.config.seed
             && w.episode == episodes(&s.totals)
             && w.last_turns.is_empty();
@@ -269,6 +272,7 @@ impl StateV2 {
                 sensor_memory: Default::default(),
             },
             learner: self.learner,
+            selected: None,
         }
     }
 }

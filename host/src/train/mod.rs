@@ -8,6 +8,8 @@ pub mod format1;
 pub mod format2;
 pub mod command;
 pub mod config;
+pub mod distil;
+pub mod selection;
 pub mod trainer;
 
 pub use command::{train, TrainReport, TrainRequest};

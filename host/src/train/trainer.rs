@@ -2,18 +2,21 @@
 //! sensor model, and its complete state for checkpoints.
 
 use super::config::{field_label, TrainConfig};
+use super::distil::distil_orbital;
+use super::selection::{Evaluation, Selected};
 use crate::learn::{QLearner, QTable};
 use sim::{EpisodeEnd, ScalarField, SelectedSensors, SensorModel, Simulation, SimulationState, Totals};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
-use shared::{ActionTable, PolicyBlob, Provenance};
+use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
 use std::sync::Arc;
 
 /// Everything that determines a training run's future: its settings, the
 /// simulation (world, both generators, episode step, counters, readings)
-/// and the learner (Q-values, visits, previous reward signal). Saving it
-/// and resuming gives the same Q-table, counters and world, bit for bit.
+/// the learner (Q-values, visits, previous reward signal) and, with policy
+/// selection, the best policy so far. Saving it and resuming gives the
+/// same Q-table, counters, world and policy, bit for bit.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct TrainingState {
     /// The settings the run started with.
@@ -25,6 +28,8 @@ pub struct TrainingState {
     pub sim: SimulationState,
     /// The learner.
     pub learner: QLearner,
+    /// With policy selection: the best policy evaluated so far.
+    pub selected: Option<Selected>,
 }
 
 /// Q-learning on a simulation with sensor model `S`.
@@ -33,11 +38,24 @@ pub struct Trainer<S: SensorModel> {
     field_crc: u32,
     sim: Simulation<S>,
     learner: QLearner,
+    /// With policy selection: the evaluation world (of the run's settings
+    /// and configured sensor model) and the best policy so far.
+    evaluation: Option<Evaluation>,
+    selected: Option<Selected>,
 }
 
 impl Trainer<SelectedSensors> {
-    /// A new run of `config` with the sensor model it names.
+    /// A new run of `config` with the sensor model it names, from
+    /// `seed_table` or, with `distil_oc`, from orbital construction.
     pub fn start(config: TrainConfig, seed_table: Option<QTable>) -> Result<Self> {
+        let seed_table = match (config.distil_oc, seed_table) {
+            (Some(_), Some(_)) => bail!("distil_oc and --init-from both give the table the run starts from: choose one"),
+            (Some(steps), None) => {
+                let table = distil_orbital(&config, steps)?;
+                Some(QTable::from_policy(&table, config.learn.actions.len(), config.learn.initial_q))
+            }
+            (None, table) => table,
+        };
         let sim = config.prepare()?.simulation(config.seed).context("invalid simulation settings")?;
         Trainer::new(config, sim, seed_table)
     }
@@ -62,7 +80,12 @@ impl<S: SensorModel> Trainer<S> {
             None => QLearner::new(config.learn.clone())?,
         };
         let field_crc = field_fingerprint(sim.field());
-        Ok(Trainer { config, field_crc, sim, learner })
+        let evaluation = evaluation_of(&config)?;
+        let mut trainer = Trainer { config, field_crc, sim, learner, evaluation, selected: None };
+        trainer.greedy_policy()?;
+        // with selection the starting policy is evaluated too (step 0)
+        trainer.evaluate_if_due();
+        Ok(trainer)
     }
 
     /// Continues a saved run on `field`, which must be the field it
@@ -78,17 +101,54 @@ impl<S: SensorModel> Trainer<S> {
             );
         }
         let sim = Simulation::resume(state.sim, field, sensors);
-        Ok(Trainer { config: state.config, field_crc: state.field_crc, sim, learner: state.learner })
+        let evaluation = evaluation_of(&state.config)?;
+        let (config, field_crc, learner, selected) = (state.config, state.field_crc, state.learner, state.selected);
+        let trainer = Trainer { config, field_crc, sim, learner, evaluation, selected };
+        trainer.greedy_policy()?;
+        Ok(trainer)
     }
 
-    /// One step of simulation and learning.
+    /// One step of simulation and learning (and an evaluation when due).
     pub fn step(&mut self) -> Option<EpisodeEnd> {
-        self.sim.step(&mut self.learner)
+        let end = self.sim.step(&mut self.learner);
+        self.evaluate_if_due();
+        end
     }
 
     /// Runs `steps` steps.
-    pub fn run(&mut self, steps: u64) {
-        self.sim.run(&mut self.learner, steps);
+    pub fn run(&mut self, mut steps: u64) {
+        while steps > 0 {
+            let chunk = match &self.evaluation {
+                Some(e) => e.steps_to_next(self.totals().steps).min(steps),
+                None => steps,
+            };
+            self.sim.run(&mut self.learner, chunk);
+            self.evaluate_if_due();
+            steps -= chunk;
+        }
+    }
+
+    /// With selection, at an evaluation step: evaluates the greedy policy
+    /// and keeps it if it formed more than the best so far.
+    fn evaluate_if_due(&mut self) {
+        let step = self.totals().steps;
+        let Some(evaluation) = self.evaluation.as_ref().filter(|e| e.due(step)) else {
+            return;
+        };
+        // a run starts only if its policy exports (`new`, `resume`)
+        let Ok(policy) = self.greedy_policy() else {
+            return;
+        };
+        let packed = policy.table().packed().to_vec();
+        let formations = evaluation.formations(policy);
+        if self.selected.as_ref().is_none_or(|best| formations > best.formations) {
+            self.selected = Some(Selected { step, formations, packed });
+        }
+    }
+
+    /// With selection: the best policy so far.
+    pub fn selected(&self) -> Option<&Selected> {
+        self.selected.as_ref()
     }
 
     /// A copy of the complete state, for a checkpoint.
@@ -98,6 +158,7 @@ impl<S: SensorModel> Trainer<S> {
             field_crc: self.field_crc,
             sim: self.sim.snapshot(),
             learner: self.learner.clone(),
+            selected: self.selected.clone(),
         }
     }
 
@@ -126,16 +187,39 @@ impl<S: SensorModel> Trainer<S> {
         &self.sim
     }
 
-    /// The greedy policy as a blob for the firmware, with provenance: the
-    /// field, the run's name, the steps so far and the seed.
+    /// The run's policy as a blob for the firmware: with selection the
+    /// best evaluated so far (the current greedy one before the first
+    /// evaluation), else the current greedy one; its provenance names the
+    /// field, the run's name, the training steps it had and the seed.
     pub fn policy(&self) -> Result<PolicyBlob> {
+        let hasher = self.learner.table().hasher();
+        match self.selected.as_ref().filter(|_| self.evaluation.is_some()) {
+            Some(best) => {
+                let table = best.table(hasher).context("the selected policy does not fit the run's hasher")?;
+                self.blob(table, best.step)
+            }
+            None => self.greedy_policy(),
+        }
+    }
+
+    /// The current greedy policy as a blob.
+    pub fn greedy_policy(&self) -> Result<PolicyBlob> {
+        self.blob(self.learner.table().greedy_policy(), self.totals().steps)
+    }
+
+    fn blob(&self, table: PolicyTable, steps: u64) -> Result<PolicyBlob> {
         let c = &self.config;
         let actions = ActionTable::new(&c.learn.actions, self.sim.config().world.forward_speed as f32)
             .context("cannot export the policy")?;
-        let provenance = Provenance::new(&field_label(&c.field), &c.name(), self.totals().steps, c.seed)
-            .context("cannot export the policy")?;
-        PolicyBlob::new(actions, self.learner.table().greedy_policy(), provenance).context("cannot export the policy")
+        let provenance =
+            Provenance::new(&field_label(&c.field), &c.name(), steps, c.seed).context("cannot export the policy")?;
+        PolicyBlob::new(actions, table, provenance).context("cannot export the policy")
     }
+}
+
+/// The evaluation world of a run with selection.
+fn evaluation_of(config: &TrainConfig) -> Result<Option<Evaluation>> {
+    config.select.map(|select| Evaluation::new(select, &config.prepare()?, config.seed)).transpose()
 }
 
 /// CRC-32 of a field's size and values.

@@ -27,10 +27,11 @@ impl GreedyPolicy {
 impl Controller for GreedyPolicy {
     fn decide(&mut self, p: &Perception<'_>, turns: &mut [f32], _rng: &mut SimRng) {
         let (hasher, table, actions) = (self.blob.hasher(), self.blob.table(), self.blob.actions());
-        for (turn, reading) in turns.iter_mut().zip(p.readings) {
+        for ((turn, reading), robot) in turns.iter_mut().zip(p.readings).zip(p.robots) {
             // A decoded blob names only existing actions, so the lookup
             // cannot miss; 0 keeps the robot straight if it ever did.
-            *turn = actions.angular(table.action(hasher.hash(reading))).unwrap_or(0.0);
+            let state = hasher.hash_as(reading, robot.kind.role());
+            *turn = actions.angular(table.action(state)).unwrap_or(0.0);
         }
     }
 }

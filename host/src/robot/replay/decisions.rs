@@ -4,7 +4,7 @@
 use super::report::{Divergence, Stage, StageCounts, LISTED};
 use shared::{
     ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob, RobotProfile,
-    SensorReading, State,
+    Role, SensorReading, State,
 };
 
 /// What each stage should have produced from a frame's own inputs.
@@ -72,7 +72,9 @@ impl<'a> DecisionCheck<'a> {
     /// Each stage's result from the frame's logged inputs to that stage.
     fn expected(&self, f: &LogFrame) -> Expected {
         let values = self.calibration.map(|c| c.scales().values(&f.raw_times));
-        let state = self.policy.hasher().hash(&SensorReading::from_parts(f.values, f.blobs));
+        // the robot's role is its id's (odd: an innie), as the firmware takes it
+        let role = Role::of_robot_id(f.robot_id);
+        let state = self.policy.hasher().hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
         let in_range = f.state.index() < self.policy.hasher().num_states();
         let action = if in_range { self.policy.table().action(f.state) } else { ActionId(u8::MAX) };
         let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
