@@ -224,9 +224,22 @@ impl EnvArgs {
             self.reward.parse().map_err(|e: String| ArgumentError::new("reward", format!("{:?}", self.reward), e))?;
         let observation = match self.observation.as_str() {
             "reading" => ObservationKind::Reading,
-            "state" => ObservationKind::State(StateHasher::from_name(&self.hasher).ok_or_else(|| {
-                ArgumentError::new("hasher", format!("{:?}", self.hasher), format!("unknown hasher; expected {}", StateHasher::NAMES))
-            })?),
+            "state" => {
+                let hasher = StateHasher::from_name(&self.hasher).ok_or_else(|| {
+                    ArgumentError::new("hasher", format!("{:?}", self.hasher), format!("unknown hasher; expected {}", StateHasher::NAMES))
+                })?;
+                if hasher.has_role_bit() {
+                    // The environments have no innies yet, so every state
+                    // would be an outie's: refuse rather than mislead.
+                    return Err(ArgumentError::new(
+                        "hasher",
+                        format!("{:?}", self.hasher),
+                        "the role layout needs innies, which the Python environments do not have yet",
+                    )
+                    .into());
+                }
+                ObservationKind::State(hasher)
+            }
             other => {
                 return Err(ArgumentError::new("observation", format!("{other:?}"), "expected \"reading\" or \"state\"").into())
             }

@@ -33,6 +33,7 @@ BAD_SETTINGS = [
     ({"reward": "eval"}, ValueError, r"reward = \"eval\": unknown reward"),
     ({"observation": "pixels"}, ValueError, r"observation = \"pixels\""),
     ({"observation": "state", "hasher": "md5"}, ValueError, r"hasher = \"md5\": unknown hasher"),
+    ({"observation": "state", "hasher": "original-role"}, ValueError, r"hasher = \"original-role\": the role layout needs innies"),
     ({"action": "joystick"}, ValueError, r"action = \"joystick\""),
     ({"actions": [0.3]}, ValueError, r"actions = \[0.3\]: action count 1 is out of range"),
     ({"actions": [0.1, float("nan")]}, ValueError, r"actions = .*not a finite number"),
