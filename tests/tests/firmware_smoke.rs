@@ -258,8 +258,8 @@ fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period
     let periods = z.period_cycles();
     assert!(periods.len() >= 20);
     // Each period starts on time, within what the two wheels' encoder
-    // interrupts (about 100 cycles each, and at 6,000 counts/s they can
-    // fall together) shift the poll of the timer.
+    // interrupts (about 65 cycles each with their entry and exit, and at
+    // 6,000 counts/s they can fall together) shift the poll of the timer.
     assert!(periods.iter().all(|p| p.abs_diff(period) < 3 * CYCLES_PER_TICK), "periods (cycles): {periods:?}");
     let work = *z.period_work_cycles().iter().max().unwrap();
     println!("period work, odometry at 6,000 counts/s, 8 colour-code blocks, sensors near timeout: {work} of {period} cycles");
