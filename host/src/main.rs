@@ -13,12 +13,26 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 fn main() -> ExitCode {
+    end_quietly_on_a_closed_pipe();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// A reader that closes our output (`host policy inspect FILE | head -1`)
+/// ends the program as it ends other Unix tools, instead of a panic in
+/// `println!`: Rust ignores SIGPIPE, this restores its default action.
+/// Sockets are unaffected (std sends with `MSG_NOSIGNAL`).
+fn end_quietly_on_a_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any thread starts; setting a
+    // signal's action to its default has no other precondition.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -98,3 +98,18 @@ fn host_run_takes_the_robot_sensor_model_and_names_a_bad_config() {
     let out = host().args(["run", "--sensors", "sonar"]).output().unwrap();
     assert!(String::from_utf8(out.stderr).unwrap().contains("\"sonar\""));
 }
+
+#[test]
+fn output_into_a_closed_pipe_ends_quietly_without_a_panic() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let policy = concat!(env!("CARGO_MANIFEST_DIR"), "/../policies/oc-heuristic.policy");
+    let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("host"))
+        .args(["policy", "inspect", policy])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(!out.status.success());
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
