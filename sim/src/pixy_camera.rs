@@ -8,7 +8,9 @@
 //! frame, like the Pixy's own blob pipeline (`docs/robot-sensors.md`):
 //! 1. each body's silhouette is the bounding box of 2 x 12 points on its
 //!    bottom and top rims, clipped to the image; bodies beyond
-//!    `max_range`, or reaching behind the image plane, are not seen;
+//!    `max_range`, or reaching behind the image plane, are not seen (only
+//!    the bodies in a box around the view cone are visited, and cheap
+//!    culls come before projecting);
 //! 2. occlusion: nearer bodies' boxes hide what is behind them; a body's
 //!    block is the bounding box of its still visible part, its pixel count
 //!    the visible area;
@@ -22,12 +24,16 @@
 //!    2 per signature that is both kinds' two largest, otherwise distant
 //!    pucks would fill the four slots and robots would never be read.
 //!
+//! The stages are written for speed; `pixy_camera/reference.rs` (tests
+//! only) keeps them as first written, and the tests check that both give
+//! the same frames, block for block.
+//!
 //! Block fields follow the Pixy: `width = right - left`, `x = left + width / 2`
 //! (integer), likewise for y, with inclusive pixel bounds.
 
+use crate::grid::Neighbour;
 use crate::validate::{check, positive, ConfigError};
 use crate::vec2::Vec2;
-use crate::grid::Neighbour;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
@@ -370,7 +376,8 @@ impl PixyCamera {
         let edge = |sign: f64| apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius;
         let (mut min, mut max) = (apex, apex);
         let axes = [Vec2::new(1.0, 0.0), Vec2::new(-1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(0.0, -1.0)];
-        let arc_extremes = axes.into_iter().filter(|axis| axis.dot(lens.ahead) >= self.cos_half_h).map(|axis| apex + axis * radius);
+        let arc_extremes =
+            axes.into_iter().filter(|axis| axis.dot(lens.ahead) >= self.cos_half_h).map(|axis| apex + axis * radius);
         for p in [edge(1.0), edge(-1.0)].into_iter().chain(arc_extremes) {
             min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
             max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
@@ -499,7 +506,8 @@ impl PixyCamera {
         for blob in &self.blobs {
             groups.push(*blob);
             let mut grown = groups.len() - 1;
-            while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d)) {
+            while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
+            {
                 let (kept, absorbed) = (grown.min(other), grown.max(other));
                 groups[kept] = groups[kept].merged(&groups[absorbed]);
                 groups.remove(absorbed);
@@ -577,7 +585,9 @@ impl Candidate {
 
 /// Sorts bodies in view nearest first, ties by body index.
 fn sort_nearest_first(in_view: &mut [InView]) {
-    in_view.sort_by(|a, b| a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index)));
+    in_view.sort_unstable_by(|a, b| {
+        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
+    });
 }
 
 /// One coordinate's least and greatest value at each rim point over the
@@ -773,7 +783,13 @@ mod tests {
             d(),
             PixyCameraConfig { max_blocks_per_signature: 100, ..d() },
             PixyCameraConfig { max_blocks_per_signature: 100, min_area: 1, merge_distance: 0, ..d() },
-            PixyCameraConfig { max_blocks_per_signature: 100, fov_h_deg: 120.0, tilt_deg: 5.0, merge_distance: 12, ..d() },
+            PixyCameraConfig {
+                max_blocks_per_signature: 100,
+                fov_h_deg: 120.0,
+                tilt_deg: 5.0,
+                merge_distance: 12,
+                ..d()
+            },
             PixyCameraConfig { tilt_deg: -10.0, fov_v_deg: 40.0, forward_mm: 40.0, height_mm: 30.0, ..d() },
             PixyCameraConfig { tilt_deg: 45.0, fov_v_deg: 60.0, fov_h_deg: 50.0, ..d() },
             PixyCameraConfig { max_range_mm: 400.0, max_blocks_per_signature: 100, ..d() },
@@ -798,18 +814,25 @@ mod tests {
         let (robot_r, puck_r) = (w.robot_radius, w.puck_radius);
         let range = camera.max_range_mm / w.unit_mm;
         let half_h = (camera.fov_h_deg / 2.0).to_radians();
-        let inside = |p: Vec2| Vec2::new(p.x.clamp(robot_r, w.arena_width - robot_r), p.y.clamp(robot_r, w.arena_height - robot_r));
+        let inside = |p: Vec2| {
+            Vec2::new(p.x.clamp(robot_r, w.arena_width - robot_r), p.y.clamp(robot_r, w.arena_height - robot_r))
+        };
         let me = inside(Vec2::new(rng.random_range(0.0..w.arena_width), rng.random_range(0.0..w.arena_height)));
         // Headings along the axes too, where the search box is tightest.
         let quarter = std::f64::consts::FRAC_PI_2;
-        let heading = if seed % 3 == 0 { quarter * rng.random_range(0..4) as f64 } else { rng.random_range(-2.0 * quarter..2.0 * quarter) };
+        let heading = if seed % 3 == 0 {
+            quarter * rng.random_range(0..4) as f64
+        } else {
+            rng.random_range(-2.0 * quarter..2.0 * quarter)
+        };
         let around = |distance: f64, angle: f64| inside(me + Vec2::from_angle(heading + angle) * distance);
         let mut robots = vec![(me, heading, RobotKind::Outie)];
         let mut pucks = Vec::new();
         for _ in 0..rng.random_range(1..5) {
             let centre = around(rng.random_range(0.0..range), rng.random_range(-1.2..1.2));
             for _ in 0..rng.random_range(2..14) {
-                let offset = Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * rng.random_range(0.0..4.0 * puck_r);
+                let offset = Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU))
+                    * rng.random_range(0.0..4.0 * puck_r);
                 pucks.push(inside(centre + offset));
             }
         }
@@ -821,7 +844,8 @@ mod tests {
             }
         }
         for _ in 0..rng.random_range(2..8) {
-            let edge_of_range = around(range + rng.random_range(-2.0 * puck_r..2.0 * puck_r), rng.random_range(-half_h..half_h));
+            let edge_of_range =
+                around(range + rng.random_range(-2.0 * puck_r..2.0 * puck_r), rng.random_range(-half_h..half_h));
             let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
             let angle = side * (half_h + rng.random_range(-0.15..0.25));
             let edge_of_view = around(rng.random_range(0.0..range), angle);
@@ -885,9 +909,14 @@ mod tests {
             let (robot_r, puck_r) = (10.0, 8.0);
             for pose in 0..400 {
                 let quarter = std::f64::consts::FRAC_PI_2;
-                let heading = if pose % 2 == 0 { quarter * f64::from(pose / 2 % 4) } else { rng.random_range(-4.0..4.0) };
+                let heading =
+                    if pose % 2 == 0 { quarter * f64::from(pose / 2 % 4) } else { rng.random_range(-4.0..4.0) };
                 let ahead = Vec2::from_angle(heading);
-                let lens = Lens { pos: Vec2::new(rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)), ahead, right: Vec2::new(-ahead.y, ahead.x) };
+                let lens = Lens {
+                    pos: Vec2::new(rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)),
+                    ahead,
+                    right: Vec2::new(-ahead.y, ahead.x),
+                };
                 let (min, max) = camera.search_box(&lens, robot_r);
                 for k in 0..2000 {
                     let (radius, body) = if k % 2 == 0 { (robot_r, 1) } else { (puck_r, 2) };
