@@ -8,7 +8,9 @@
 //! frame, like the Pixy's own blob pipeline (`docs/robot-sensors.md`):
 //! 1. each body's silhouette is the bounding box of 2 x 12 points on its
 //!    bottom and top rims, clipped to the image; bodies beyond
-//!    `max_range`, or reaching behind the image plane, are not seen;
+//!    `max_range`, or reaching behind the image plane, are not seen (only
+//!    the bodies in a box around the view cone are visited, and cheap
+//!    culls come before projecting);
 //! 2. occlusion: nearer bodies' boxes hide what is behind them; a body's
 //!    block is the bounding box of its still visible part, its pixel count
 //!    the visible area;
@@ -22,9 +24,14 @@
 //!    2 per signature that is both kinds' two largest, otherwise distant
 //!    pucks would fill the four slots and robots would never be read.
 //!
+//! The stages are written for speed; `pixy_camera/reference.rs` (tests
+//! only) keeps them as first written, and the tests check that both give
+//! the same frames, block for block.
+//!
 //! Block fields follow the Pixy: `width = right - left`, `x = left + width / 2`
 //! (integer), likewise for y, with inclusive pixel bounds.
 
+use crate::grid::Neighbour;
 use crate::validate::{check, positive, ConfigError};
 use crate::vec2::Vec2;
 use crate::world::World;
@@ -198,6 +205,46 @@ struct Blob {
     area: u32,
 }
 
+impl Blob {
+    /// Whether the two merge into one block: the same signature, and apart
+    /// by at most `merge_distance` pixels along one axis while their
+    /// spans overlap along the other.
+    fn merges_with(&self, o: &Blob, merge_distance: i32) -> bool {
+        let (gx, gy) = (self.rect.gap_x(&o.rect), self.rect.gap_y(&o.rect));
+        self.signature == o.signature && ((gx <= merge_distance && gy <= 0) || (gy <= merge_distance && gx <= 0))
+    }
+
+    /// The two as one blob: the union of their boxes, the sum of their pixels.
+    fn merged(&self, o: &Blob) -> Blob {
+        Blob { signature: self.signature, rect: self.rect.union(&o.rect), area: self.area + o.area }
+    }
+}
+
+/// Where a robot's lens is and where it looks, in the world's frame.
+#[derive(Clone, Copy, Debug)]
+struct Lens {
+    pos: Vec2,
+    /// Unit vector along the robot's heading.
+    ahead: Vec2,
+    /// Unit vector to the robot's right.
+    right: Vec2,
+}
+
+/// A body that passed the culls of [`PixyCamera::candidate`]: where it is
+/// seen from, before its silhouette is projected.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    index: usize,
+    signature: u16,
+    /// Its centre's distance ahead of the lens and to the right of it.
+    ahead: f64,
+    side: f64,
+    radius: f64,
+    height: f64,
+    /// `ahead^2 + side^2`.
+    distance_squared: f64,
+}
+
 /// Rim points sampled per circle of a body's cylinder.
 const RIM_POINTS: usize = 12;
 
@@ -214,6 +261,9 @@ pub struct PixyCamera {
     fy: f64,
     /// tan(half the horizontal field of view), for culling.
     tan_half_h: f64,
+    /// cos and sin of half the horizontal field of view, for the search box.
+    cos_half_h: f64,
+    sin_half_h: f64,
     puck_height: f64,
     robot_height: f64,
     max_range: f64,
@@ -223,11 +273,15 @@ pub struct PixyCamera {
     merge_distance: i32,
     per_signature: usize,
     classify: CameraConfig,
-    rim: [Vec2; RIM_POINTS],
+    /// The rim points on a unit circle: ahead (cos) and right (sin) parts.
+    rim_ahead: [f64; RIM_POINTS],
+    rim_right: [f64; RIM_POINTS],
     in_view: Vec<InView>,
     pieces: Vec<Rect>,
     scratch: Vec<Rect>,
     blobs: Vec<Blob>,
+    /// The blobs merged so far (stage 3's output before it replaces `blobs`).
+    merged: Vec<Blob>,
 }
 
 impl PixyCamera {
@@ -236,6 +290,8 @@ impl PixyCamera {
         let tilt = config.tilt_deg.to_radians();
         let half_h = (config.fov_h_deg / 2.0).to_radians();
         let half_v = (config.fov_v_deg / 2.0).to_radians();
+        let rim: [Vec2; RIM_POINTS] =
+            std::array::from_fn(|k| Vec2::from_angle(std::f64::consts::TAU * k as f64 / RIM_POINTS as f64));
         PixyCamera {
             forward: config.forward_mm / unit_mm,
             height: config.height_mm / unit_mm,
@@ -244,6 +300,8 @@ impl PixyCamera {
             fx: f64::from(IMAGE_WIDTH) / 2.0 / half_h.tan(),
             fy: f64::from(IMAGE_HEIGHT) / 2.0 / half_v.tan(),
             tan_half_h: half_h.tan(),
+            cos_half_h: half_h.cos(),
+            sin_half_h: half_h.sin(),
             puck_height: config.puck_height_mm / unit_mm,
             robot_height: config.robot_height_mm / unit_mm,
             max_range: config.max_range_mm / unit_mm,
@@ -252,11 +310,13 @@ impl PixyCamera {
             merge_distance: i32::from(config.merge_distance),
             per_signature: usize::from(config.max_blocks_per_signature),
             classify: config.classify,
-            rim: std::array::from_fn(|k| Vec2::from_angle(std::f64::consts::TAU * k as f64 / RIM_POINTS as f64)),
+            rim_ahead: rim.map(|p| p.x),
+            rim_right: rim.map(|p| p.y),
             in_view: Vec::new(),
             pieces: Vec::new(),
             scratch: Vec::new(),
             blobs: Vec::new(),
+            merged: Vec::new(),
         }
     }
 
@@ -271,57 +331,136 @@ impl PixyCamera {
     pub fn frame(&mut self, world: &World, robot: usize, out: &mut Vec<PixyBlock>) {
         self.gather_in_view(world, robot);
         self.occlude();
-        self.merge_and_prune();
+        self.merge_close_blobs();
+        self.drop_enclosed_blobs();
         self.emit_blocks(out);
     }
 
     /// Stage 1: every other body in range and in front of the lens, with its
     /// silhouette, nearest first (ties by body index).
     fn gather_in_view(&mut self, world: &World, robot: usize) {
-        let bodies = world.bodies();
-        let robots = world.robots().len();
-        let (pos, dir) = (bodies[robot].pos, world.robots()[robot].direction);
-        let right = Vec2::new(-dir.y, dir.x);
-        let lens = pos + dir * self.forward;
-
+        let lens = Lens::of(world, robot, self.forward);
+        let (min, max) = self.search_box(&lens, world.config().max_radius());
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
-        world.any_body_near(lens, self.max_range, |row| {
+        world.any_body_in_box(min, max, |row| {
             for b in row {
-                let j = b.body as usize;
-                if j == robot {
-                    continue;
-                }
-                let rel = b.pos - lens;
-                let f = rel.dot(dir);
-                // Cheap culls before projecting: behind the lens, far outside the
-                // horizontal field of view, or out of range.
-                if f + b.radius < 0.0 {
-                    continue;
-                }
-                let (height, signature) = if j < robots {
-                    (self.robot_height, self.classify.robot_signature)
-                } else {
-                    (self.puck_height, self.classify.puck_signature)
-                };
-                let s = rel.dot(right);
-                if s.abs() > (f + b.radius + self.height + height) * self.tan_half_h + b.radius {
-                    continue;
-                }
-                let reach = self.max_range + b.radius;
-                let distance_squared = f * f + s * s;
-                if distance_squared > reach * reach {
-                    continue;
-                }
-                if let Some(rect) = self.silhouette(f, s, b.radius, height) {
-                    in_view.push(InView { distance: distance_squared.sqrt(), index: j, signature, rect });
+                let Some(c) = self.candidate(world.robots().len(), robot, &lens, b) else { continue };
+                if let Some(rect) = self.silhouette(c.ahead, c.side, c.radius, c.height) {
+                    in_view.push(c.in_view(rect));
                 }
             }
             false
         });
-        in_view
-            .sort_by(|a, b| a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index)));
+        sort_nearest_first(&mut in_view);
         self.in_view = in_view;
+    }
+
+    /// A box of the world holding the centre of every body that
+    /// [`Self::candidate`] passes, for bodies up to `max_radius`: the
+    /// sector from the apex of the widened view cone (half the horizontal
+    /// field of view each side) that reaches as far as the range does,
+    /// within the range's square around the lens, padded by a millionth
+    /// of its radius, far more than the culls' rounding.
+    fn search_box(&self, lens: &Lens, max_radius: f64) -> (Vec2, Vec2) {
+        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
+        // for every r <= max_radius and h <= the taller body lies inside the
+        // cone from `apex` ...
+        let tallest = self.puck_height.max(self.robot_height);
+        let behind = max_radius + self.height + tallest + max_radius / self.tan_half_h;
+        let apex = lens.pos - lens.ahead * behind;
+        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
+        let reach = self.max_range + max_radius;
+        let radius = reach + behind;
+        let pad = radius * 1e-6;
+        let edge = |sign: f64| apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius;
+        let (mut min, mut max) = (apex, apex);
+        let axes = [Vec2::new(1.0, 0.0), Vec2::new(-1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(0.0, -1.0)];
+        let arc_extremes =
+            axes.into_iter().filter(|axis| axis.dot(lens.ahead) >= self.cos_half_h).map(|axis| apex + axis * radius);
+        for p in [edge(1.0), edge(-1.0)].into_iter().chain(arc_extremes) {
+            min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
+            max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
+        }
+        let square = Vec2::new(reach, reach);
+        let (near, far) = (lens.pos - square, lens.pos + square);
+        let padding = Vec2::new(pad, pad);
+        (
+            Vec2::new(min.x.max(near.x), min.y.max(near.y)) - padding,
+            Vec2::new(max.x.min(far.x), max.y.min(far.y)) + padding,
+        )
+    }
+
+    /// Body `b` if it is another body than robot `robot` (of `robots`,
+    /// whose bodies come first) and the cheap culls before projecting keep
+    /// it: not behind the lens, not far outside the horizontal field of
+    /// view, in range.
+    fn candidate(&self, robots: usize, robot: usize, lens: &Lens, b: &Neighbour) -> Option<Candidate> {
+        let index = b.body as usize;
+        if index == robot {
+            return None;
+        }
+        let rel = b.pos - lens.pos;
+        let ahead = rel.dot(lens.ahead);
+        if ahead + b.radius < 0.0 {
+            return None;
+        }
+        let (height, signature) = if index < robots {
+            (self.robot_height, self.classify.robot_signature)
+        } else {
+            (self.puck_height, self.classify.puck_signature)
+        };
+        let side = rel.dot(lens.right);
+        if side.abs() > (ahead + b.radius + self.height + height) * self.tan_half_h + b.radius {
+            return None;
+        }
+        let reach = self.max_range + b.radius;
+        let distance_squared = ahead * ahead + side * side;
+        (distance_squared <= reach * reach).then_some(Candidate {
+            index,
+            signature,
+            ahead,
+            side,
+            radius: b.radius,
+            height,
+            distance_squared,
+        })
+    }
+
+    /// The clipped pixel box of a cylinder of `radius` and `height` whose
+    /// axis is `ahead` of and `side` right of the lens; `None` if it is out
+    /// of the image or reaches behind the image plane. Its 2 x 12 rim points
+    /// are projected in fixed-size arrays so that the arithmetic vectorises;
+    /// each point's coordinates are rounded exactly as one point at a time.
+    fn silhouette(&self, ahead: f64, side: f64, radius: f64, height: f64) -> Option<Rect> {
+        // The parts of depth, height in the image and x shared by both rims.
+        let point_ahead: [f64; RIM_POINTS] = std::array::from_fn(|k| ahead + radius * self.rim_ahead[k]);
+        let depth_ahead = point_ahead.map(|pf| pf * self.cos_tilt);
+        let down_ahead = point_ahead.map(|pf| -pf * self.sin_tilt);
+        let across: [f64; RIM_POINTS] = std::array::from_fn(|k| self.fx * (side + radius * self.rim_right[k]));
+        let (mut xs, mut ys) = (Extent::EMPTY, Extent::EMPTY);
+        for z in [0.0, height] {
+            let up = z - self.height;
+            let depth = depth_ahead.map(|d| d - up * self.sin_tilt);
+            if least(&depth) < self.near {
+                return None;
+            }
+            for k in 0..RIM_POINTS {
+                let inverse = 1.0 / depth[k];
+                let down = down_ahead[k] - up * self.cos_tilt;
+                xs.include(k, f64::from(IMAGE_WIDTH) / 2.0 + across[k] * inverse);
+                ys.include(k, f64::from(IMAGE_HEIGHT) / 2.0 + self.fy * down * inverse);
+            }
+        }
+        // A zero's sign may differ from the point by point minimum; the
+        // pixel is the same for both.
+        let rect = Rect {
+            left: first_pixel(xs.least(), IMAGE_WIDTH),
+            right: last_pixel(xs.greatest(), IMAGE_WIDTH),
+            top: first_pixel(ys.least(), IMAGE_HEIGHT),
+            bottom: last_pixel(ys.greatest(), IMAGE_HEIGHT),
+        };
+        (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
     }
 
     /// Stage 2: each body's still visible part after the nearer ones'
@@ -352,6 +491,44 @@ impl PixyCamera {
                 self.blobs.push(Blob { signature: body.signature, rect, area });
             }
         }
+    }
+
+    /// Stage 3, first half: merges close blobs of one signature until no two
+    /// merge (the Pixy's `combine2`). Each blob joins the groups merged so
+    /// far; a group that grows is checked against the others again. Since
+    /// growing only brings boxes closer, every order of merging ends in the
+    /// same groups, so this gives the Pixy's result, each group in the place
+    /// of its first blob.
+    fn merge_close_blobs(&mut self) {
+        let d = self.merge_distance;
+        let groups = &mut self.merged;
+        groups.clear();
+        for blob in &self.blobs {
+            groups.push(*blob);
+            let mut grown = groups.len() - 1;
+            while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
+            {
+                let (kept, absorbed) = (grown.min(other), grown.max(other));
+                groups[kept] = groups[kept].merged(&groups[absorbed]);
+                groups.remove(absorbed);
+                grown = kept;
+            }
+        }
+        std::mem::swap(&mut self.blobs, &mut self.merged);
+    }
+
+    /// Stage 3, second half: drops each block enclosed by another block (of
+    /// the same box: by an earlier one), in one pass (the Pixy's `combine`,
+    /// which drops them one by one: a block enclosed by one that is dropped
+    /// is enclosed by the one that encloses that, which stays).
+    fn drop_enclosed_blobs(&mut self) {
+        let blobs = &self.blobs;
+        let encloses = |o: usize, k: usize| {
+            o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k)
+        };
+        self.merged.clear();
+        self.merged.extend((0..blobs.len()).filter(|&k| !(0..blobs.len()).any(|o| encloses(o, k))).map(|k| blobs[k]));
+        std::mem::swap(&mut self.blobs, &mut self.merged);
     }
 
     /// Stage 4: the blobs as Pixy blocks, signature 1 first, largest first,
@@ -389,90 +566,93 @@ impl PixyCamera {
                 }),
         );
     }
+}
 
-    /// The clipped pixel box of a cylinder of `radius` and `height` whose
-    /// axis is `f` ahead of and `s` right of the lens; `None` if it is out
-    /// of the image or reaches behind the image plane.
-    fn silhouette(&self, f: f64, s: f64, radius: f64, height: f64) -> Option<Rect> {
-        let (mut min_x, mut max_x, mut min_y, mut max_y) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for z in [0.0, height] {
-            let up = z - self.height;
-            for p in &self.rim {
-                let (pf, ps) = (f + radius * p.x, s + radius * p.y);
-                let depth = pf * self.cos_tilt - up * self.sin_tilt;
-                if depth < self.near {
-                    return None;
-                }
-                let down = -pf * self.sin_tilt - up * self.cos_tilt;
-                let inverse = 1.0 / depth;
-                let x = f64::from(IMAGE_WIDTH) / 2.0 + self.fx * ps * inverse;
-                let y = f64::from(IMAGE_HEIGHT) / 2.0 + self.fy * down * inverse;
-                // Plain comparisons: no NaN can occur (depth >= near > 0).
-                if x < min_x {
-                    min_x = x;
-                }
-                if x > max_x {
-                    max_x = x;
-                }
-                if y < min_y {
-                    min_y = y;
-                }
-                if y > max_y {
-                    max_y = y;
-                }
-            }
-        }
-        let clip = |v: f64, hi: u16| v.clamp(-1.0, f64::from(hi)) as i32;
-        let rect = Rect {
-            left: clip(min_x.floor(), IMAGE_WIDTH).max(0),
-            right: clip(max_x.ceil() - 1.0, IMAGE_WIDTH).min(i32::from(IMAGE_WIDTH) - 1),
-            top: clip(min_y.floor(), IMAGE_HEIGHT).max(0),
-            bottom: clip(max_y.ceil() - 1.0, IMAGE_HEIGHT).min(i32::from(IMAGE_HEIGHT) - 1),
-        };
-        (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
-    }
-
-    /// Stage 3: merges close blobs of one signature until none are left,
-    /// then drops blocks enclosed by another block (the Pixy's `combine2`,
-    /// `combine`).
-    fn merge_and_prune(&mut self) {
-        let d = self.merge_distance;
-        let blobs = &mut self.blobs;
-        let mut merged = true;
-        while merged {
-            merged = false;
-            'outer: for i in 0..blobs.len() {
-                for j in i + 1..blobs.len() {
-                    let (a, b) = (blobs[i], blobs[j]);
-                    let (gx, gy) = (a.rect.gap_x(&b.rect), a.rect.gap_y(&b.rect));
-                    if a.signature == b.signature && ((gx <= d && gy <= 0) || (gy <= d && gx <= 0)) {
-                        blobs[i] = Blob { signature: a.signature, rect: a.rect.union(&b.rect), area: a.area + b.area };
-                        blobs.remove(j);
-                        merged = true;
-                        break 'outer;
-                    }
-                }
-            }
-        }
-        let mut k = 0;
-        while k < blobs.len() {
-            let enclosed = (0..blobs.len())
-                .any(|o| o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k));
-            if enclosed {
-                blobs.remove(k);
-            } else {
-                k += 1;
-            }
-        }
+impl Lens {
+    /// Robot `robot`'s lens, `forward` ahead of its centre.
+    fn of(world: &World, robot: usize, forward: f64) -> Lens {
+        let ahead = world.robots()[robot].direction;
+        Lens { pos: world.bodies()[robot].pos + ahead * forward, ahead, right: Vec2::new(-ahead.y, ahead.x) }
     }
 }
+
+impl Candidate {
+    /// The candidate in view with silhouette `rect`.
+    fn in_view(&self, rect: Rect) -> InView {
+        InView { distance: self.distance_squared.sqrt(), index: self.index, signature: self.signature, rect }
+    }
+}
+
+/// Sorts bodies in view nearest first, ties by body index.
+fn sort_nearest_first(in_view: &mut [InView]) {
+    in_view.sort_unstable_by(|a, b| {
+        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
+    });
+}
+
+/// One coordinate's least and greatest value at each rim point over the
+/// rims projected so far (one lane per rim point, so that the comparisons
+/// vectorise).
+#[derive(Clone, Copy, Debug)]
+struct Extent {
+    least: [f64; RIM_POINTS],
+    greatest: [f64; RIM_POINTS],
+}
+
+impl Extent {
+    const EMPTY: Extent = Extent { least: [f64::INFINITY; RIM_POINTS], greatest: [f64::NEG_INFINITY; RIM_POINTS] };
+
+    /// Takes in rim point `k`'s value on one rim (none is NaN).
+    #[inline(always)]
+    fn include(&mut self, k: usize, value: f64) {
+        self.least[k] = if value < self.least[k] { value } else { self.least[k] };
+        self.greatest[k] = if value > self.greatest[k] { value } else { self.greatest[k] };
+    }
+
+    fn least(&self) -> f64 {
+        least(&self.least)
+    }
+
+    fn greatest(&self) -> f64 {
+        self.greatest.into_iter().fold(f64::NEG_INFINITY, |m, v| if v > m { v } else { m })
+    }
+}
+
+/// The least of `values` (none is NaN).
+fn least(values: &[f64; RIM_POINTS]) -> f64 {
+    values.iter().fold(f64::INFINITY, |m, &v| if v < m { v } else { m })
+}
+
+/// The first pixel of a span that starts at `v`: `floor(v)` within
+/// `0..=end` (truncation is the floor from 0 up, and below 0 both give 0;
+/// libm's floor would be a call on the baseline x86-64).
+fn first_pixel(v: f64, end: u16) -> i32 {
+    (v as i32).clamp(0, i32::from(end))
+}
+
+/// The last pixel of a span that ends at `v`: `ceil(v) - 1` within
+/// `-1..=end - 1`.
+fn last_pixel(v: f64, end: u16) -> i32 {
+    if v <= 0.0 {
+        return -1;
+    }
+    let whole = v as i32;
+    let ceil_less_one = if f64::from(whole) < v { whole } else { whole - 1 };
+    ceil_less_one.min(i32::from(end) - 1)
+}
+
+#[cfg(test)]
+mod reference;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::body::RobotKind;
     use crate::config::SimConfig;
+    use crate::rng::SimRng;
+    use rand::{RngExt, SeedableRng};
     use shared::ImageRegion;
+    use std::sync::Arc;
 
     const R: f64 = 10.0;
 
@@ -592,5 +772,177 @@ mod tests {
         let c = PixyCameraConfig { height_mm: -1.0, ..PixyCameraConfig::default() };
         assert!(c.validate().unwrap_err().to_string().contains("camera.height_mm"));
         assert!(PixyCameraConfig::default().validate().is_ok());
+    }
+
+    /// Camera settings that stress other paths than the default: every
+    /// block sent, no merging or the smallest blobs, a wide or steep or
+    /// upward-tilted view, a short range.
+    fn camera_variants() -> Vec<PixyCameraConfig> {
+        let d = PixyCameraConfig::default;
+        vec![
+            d(),
+            PixyCameraConfig { max_blocks_per_signature: 100, ..d() },
+            PixyCameraConfig { max_blocks_per_signature: 100, min_area: 1, merge_distance: 0, ..d() },
+            PixyCameraConfig {
+                max_blocks_per_signature: 100,
+                fov_h_deg: 120.0,
+                tilt_deg: 5.0,
+                merge_distance: 12,
+                ..d()
+            },
+            PixyCameraConfig { tilt_deg: -10.0, fov_v_deg: 40.0, forward_mm: 40.0, height_mm: 30.0, ..d() },
+            PixyCameraConfig { tilt_deg: 45.0, fov_v_deg: 60.0, fov_h_deg: 50.0, ..d() },
+            PixyCameraConfig { max_range_mm: 400.0, max_blocks_per_signature: 100, ..d() },
+        ]
+    }
+
+    /// The thesis' square and the TV's scale (another unit, arena and range).
+    fn arena_scales() -> Vec<SimConfig> {
+        let mut tv = SimConfig::default();
+        crate::ArenaSpec::tv75().apply(&mut tv, &crate::ScalarField::annulus_of(64, 36));
+        vec![SimConfig::default(), tv]
+    }
+
+    /// A seeded random scene around robot 0 (somewhere in the arena, any
+    /// heading): clusters of touching and overlapping pucks in front of it,
+    /// robots close to it and to each other, bodies just inside and outside
+    /// the edges of the field of view and of the range, and bodies right in
+    /// front of the lens; all inside the arena.
+    fn random_scene(config: &SimConfig, camera: &PixyCameraConfig, seed: u64) -> World {
+        let mut rng = SimRng::seed_from_u64(seed);
+        let w = &config.world;
+        let (robot_r, puck_r) = (w.robot_radius, w.puck_radius);
+        let range = camera.max_range_mm / w.unit_mm;
+        let half_h = (camera.fov_h_deg / 2.0).to_radians();
+        let inside = |p: Vec2| {
+            Vec2::new(p.x.clamp(robot_r, w.arena_width - robot_r), p.y.clamp(robot_r, w.arena_height - robot_r))
+        };
+        let me = inside(Vec2::new(rng.random_range(0.0..w.arena_width), rng.random_range(0.0..w.arena_height)));
+        // Headings along the axes too, where the search box is tightest.
+        let quarter = std::f64::consts::FRAC_PI_2;
+        let heading = if seed % 3 == 0 {
+            quarter * rng.random_range(0..4) as f64
+        } else {
+            rng.random_range(-2.0 * quarter..2.0 * quarter)
+        };
+        let around = |distance: f64, angle: f64| inside(me + Vec2::from_angle(heading + angle) * distance);
+        let mut robots = vec![(me, heading, RobotKind::Outie)];
+        let mut pucks = Vec::new();
+        for _ in 0..rng.random_range(1..5) {
+            let centre = around(rng.random_range(0.0..range), rng.random_range(-1.2..1.2));
+            for _ in 0..rng.random_range(2..14) {
+                let offset = Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU))
+                    * rng.random_range(0.0..4.0 * puck_r);
+                pucks.push(inside(centre + offset));
+            }
+        }
+        for _ in 0..rng.random_range(1..6) {
+            let p = around(rng.random_range(2.0 * robot_r..0.6 * range), rng.random_range(-1.5..1.5));
+            let next = inside(p + Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * 2.05 * robot_r);
+            for q in [p, next] {
+                robots.push((q, rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), RobotKind::Outie));
+            }
+        }
+        for _ in 0..rng.random_range(2..8) {
+            let edge_of_range =
+                around(range + rng.random_range(-2.0 * puck_r..2.0 * puck_r), rng.random_range(-half_h..half_h));
+            let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+            let angle = side * (half_h + rng.random_range(-0.15..0.25));
+            let edge_of_view = around(rng.random_range(0.0..range), angle);
+            let at_lens = around(rng.random_range(robot_r..robot_r + 3.0 * puck_r), rng.random_range(-1.6..1.6));
+            pucks.extend([edge_of_range, edge_of_view, at_lens]);
+        }
+        World::scene(config, &robots, &pucks, seed)
+    }
+
+    /// Compares every robot's frame with the reference's; returns how many
+    /// blocks the frames hold.
+    fn assert_reference_frames(camera: &mut PixyCamera, world: &World, what: &str) -> usize {
+        let mut out = Vec::new();
+        (0..world.robots().len())
+            .map(|robot| {
+                camera.frame(world, robot, &mut out);
+                assert_eq!(out, reference::frame(camera, world, robot), "{what}, robot {robot}");
+                out.len()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn random_scenes_give_the_reference_frames() {
+        let mut blocks = 0;
+        for config in arena_scales() {
+            for (variant, settings) in camera_variants().iter().enumerate() {
+                let mut camera = PixyCamera::new(settings, config.world.unit_mm);
+                for seed in 0..150 {
+                    let world = random_scene(&config, settings, seed);
+                    let what = format!("unit {} mm, camera {variant}, seed {seed}", config.world.unit_mm);
+                    blocks += assert_reference_frames(&mut camera, &world, &what);
+                }
+            }
+        }
+        assert!(blocks > 10_000, "the scenes are seen: {blocks} blocks");
+    }
+
+    #[test]
+    fn simulated_runs_give_the_reference_frames() {
+        for config in arena_scales() {
+            let unit = config.world.unit_mm;
+            let sensors = crate::RobotSensors::new(&crate::RobotSensorConfig::default(), unit);
+            let field = Arc::new(crate::ScalarField::annulus_of(64, 36));
+            let mut sim = crate::Simulation::with_sensors(config, field, sensors, 3).unwrap();
+            let mut controller = crate::controllers::RandomTurns::new(shared::ActionTable::default());
+            let every_block = PixyCameraConfig { max_blocks_per_signature: 100, ..PixyCameraConfig::default() };
+            let mut camera = PixyCamera::new(&every_block, unit);
+            for step in 0..600 {
+                sim.run(&mut controller, 1);
+                assert_reference_frames(&mut camera, sim.world(), &format!("unit {unit} mm, step {step}"));
+            }
+        }
+    }
+
+    #[test]
+    fn the_search_box_holds_every_body_the_culls_pass() {
+        let mut rng = SimRng::seed_from_u64(17);
+        for settings in camera_variants() {
+            let camera = PixyCamera::new(&settings, 5.0);
+            let (robot_r, puck_r) = (10.0, 8.0);
+            for pose in 0..400 {
+                let quarter = std::f64::consts::FRAC_PI_2;
+                let heading =
+                    if pose % 2 == 0 { quarter * f64::from(pose / 2 % 4) } else { rng.random_range(-4.0..4.0) };
+                let ahead = Vec2::from_angle(heading);
+                let lens = Lens {
+                    pos: Vec2::new(rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)),
+                    ahead,
+                    right: Vec2::new(-ahead.y, ahead.x),
+                };
+                let (min, max) = camera.search_box(&lens, robot_r);
+                for k in 0..2000 {
+                    let (radius, body) = if k % 2 == 0 { (robot_r, 1) } else { (puck_r, 2) };
+                    let height = if body == 1 { camera.robot_height } else { camera.puck_height };
+                    let reach = camera.max_range + radius;
+                    // On the range's circle, on the widened cone's edges, or anywhere near.
+                    let (f, s) = match k % 3 {
+                        0 => {
+                            let angle = rng.random_range(-1.6..1.6) * (k % 7) as f64 / 6.0;
+                            (reach * angle.cos(), reach * angle.sin())
+                        }
+                        1 => {
+                            let f = rng.random_range(-radius..reach);
+                            let side = (f + radius + camera.height + height) * camera.tan_half_h + radius;
+                            (f, if k % 4 == 1 { side } else { -side })
+                        }
+                        _ => (rng.random_range(-reach..reach), rng.random_range(-reach..reach)),
+                    };
+                    let pos = lens.pos + lens.ahead * f + lens.right * s;
+                    let b = Neighbour { pos, radius, body };
+                    if camera.candidate(2, 0, &lens, &b).is_some() {
+                        let inside = min.x <= pos.x && pos.x <= max.x && min.y <= pos.y && pos.y <= max.y;
+                        assert!(inside, "{settings:?}: {pos:?} outside {min:?} ..= {max:?}");
+                    }
+                }
+            }
+        }
     }
 }
