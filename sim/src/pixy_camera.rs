@@ -469,9 +469,17 @@ impl PixyCamera {
     fn occlude(&mut self) {
         self.blobs.clear();
         for (k, body) in self.in_view.iter().enumerate() {
+            let nearer = &self.in_view[..k];
+            let Some(first) = nearer.iter().position(|n| n.rect.overlaps(&body.rect)) else {
+                // Nothing nearer overlaps it: its whole box is seen, no pieces needed.
+                if body.rect.area() >= self.min_area {
+                    self.blobs.push(Blob { signature: body.signature, rect: body.rect, area: body.rect.area() });
+                }
+                continue;
+            };
             self.pieces.clear();
             self.pieces.push(body.rect);
-            for nearer in &self.in_view[..k] {
+            for nearer in &nearer[first..] {
                 if !nearer.rect.overlaps(&body.rect) {
                     continue;
                 }
