@@ -16,8 +16,10 @@
 //!   a per-trial QUANTITY: `formations`, `stuck`, `first_formation`,
 //!   `collisions_per_1000`, `states_visited`, `collision_trend` (the slope,
 //!   per step, of the least-squares line through the trial's collisions per
-//!   1000-step block), or `steps_per_formation` (steps over the mean
-//!   formations, STAT `value`). `ARM` may be `A / B`: each trial of A over
+//!   1000-step block), `early_share` (the share of the trial's formations
+//!   made in the first fifth of its steps: about 0.2 at a steady rate,
+//!   more where the rate falls), or `steps_per_formation` (steps over the
+//!   mean formations, STAT `value`). `ARM` may be `A / B`: each trial of A over
 //!   the mean of B's. STAT: `mean`, `median`, `min`, `max`, `ci` (the 95 %
 //!   half-width), `mean±ci`, `n`, `ratio` (the mean, as a ratio), `percent`,
 //!   `times`, `count OP X` (trials with QUANTITY OP X; OP one of `<`, `<=`,
@@ -188,6 +190,7 @@ enum Quantity {
     Collisions,
     StatesVisited,
     CollisionTrend,
+    EarlyShare,
     StepsPerFormation,
 }
 
@@ -200,8 +203,9 @@ impl Quantity {
             "collisions_per_1000" => Quantity::Collisions,
             "states_visited" => Quantity::StatesVisited,
             "collision_trend" => Quantity::CollisionTrend,
+            "early_share" => Quantity::EarlyShare,
             "steps_per_formation" => Quantity::StepsPerFormation,
-            _ => bail!("unknown quantity {s:?}: expected formations, stuck, first_formation, collisions_per_1000, states_visited, collision_trend or steps_per_formation"),
+            _ => bail!("unknown quantity {s:?}: expected formations, stuck, first_formation, collisions_per_1000, states_visited, collision_trend, early_share or steps_per_formation"),
         })
     }
 
@@ -221,6 +225,10 @@ impl Quantity {
                     .collect();
                 Line::fit(&points).map(|l| l.slope)
             }
+            Quantity::EarlyShare => {
+                let early = r.formation_steps.iter().filter(|&&s| s < r.steps / 5).count();
+                (r.formations > 0).then(|| early as f64 / r.formations as f64)
+            }
         }
     }
 
@@ -233,7 +241,7 @@ impl Quantity {
             Quantity::Collisions => Some(Metric::CollisionsPer1000),
             Quantity::StatesVisited => Some(Metric::StatesVisited),
             Quantity::StepsPerFormation => Some(Metric::StepsPerFormation),
-            Quantity::CollisionTrend => None,
+            Quantity::CollisionTrend | Quantity::EarlyShare => None,
         }
     }
 }
@@ -460,6 +468,16 @@ mod tests {
         assert!(format!("{broken:#}").contains("line 2") && format!("{broken:#}").contains("not < 11"), "{broken:#}");
         let none = sources(&[], &[]);
         assert_eq!(render("{{x | A | formations | mean | > 5}}", &none).unwrap(), NOT_RUN, "no trials: nothing to check");
+    }
+
+    /// Trials of 1,000 steps with formations every 10 steps: 30 of them
+    /// make 19 in the first 200 steps, 8 make all theirs there.
+    #[test]
+    fn the_early_share_is_the_part_of_a_trials_formations_in_its_first_fifth() {
+        let s = sources(&[30, 8], &[]);
+        assert_eq!(render("{{x | A | early_share | percent}}", &s).unwrap(), "82 %");
+        assert_eq!(render("{{x | A | early_share | min}}", &s).unwrap(), "0.63");
+        assert!(render("{{x | A | early_share | percent | < 80}}", &s).is_err());
     }
 
     #[test]
