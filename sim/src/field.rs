@@ -132,6 +132,7 @@ impl ScalarField {
     }
 
     /// A sensor's reading at `p`, in fixed point.
+    #[inline]
     pub fn sense(&self, p: Vec2, layout: &FieldLayout) -> FieldValue {
         match layout.sampling {
             FieldSampling::Nearest => {
