@@ -8,7 +8,7 @@
 //! - Eval' (thesis chapter 6), two variants; see [`EvalPrime`].
 
 use crate::config::Thresholds;
-use crate::field::{FieldLayout, ScalarField};
+use crate::field::{FieldLayout, FieldSampling, ScalarField};
 use crate::vec2::Vec2;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -32,8 +32,45 @@ const DISTANCE_ONE: f64 = 4_294_967_296.0;
 /// equals a fresh [`eval`] exactly; the rounding (at most 2^-33 per puck)
 /// is far below anything Eval is compared with.
 fn fixed_distance(p: Vec2, layout: &FieldLayout, field: &ScalarField, t: &Thresholds) -> u64 {
-    let d = band_distance(f64::from(field.evaluate(p, layout)), t);
-    (d * DISTANCE_ONE).round() as u64
+    fixed_of_value(field.evaluate(p, layout), t)
+}
+
+/// The fixed-point band distance of a field value.
+fn fixed_of_value(value: f32, t: &Thresholds) -> u64 {
+    (band_distance(f64::from(value), t) * DISTANCE_ONE).round() as u64
+}
+
+/// Each puck position's fixed-point distance, the way [`fixed_distance`]
+/// finds it: with nearest sampling from a table of every cell's distance
+/// (a cell index and a load instead of the conversion and rounding of each
+/// moved puck: Eval every step is a learner's reward), with bilinear
+/// sampling by the formula.
+#[derive(Clone, Debug, PartialEq)]
+enum Distances {
+    /// Nearest sampling: each cell's distance, and that of the outside.
+    ByCell { cells: Vec<u64>, outside: u64 },
+    /// Bilinear sampling.
+    Interpolated,
+}
+
+impl Distances {
+    fn new(field: &ScalarField, layout: &FieldLayout, t: &Thresholds) -> Distances {
+        match layout.sampling {
+            FieldSampling::Nearest => Distances::ByCell {
+                cells: field.values().iter().map(|&v| fixed_of_value(v, t)).collect(),
+                outside: fixed_of_value(0.0, t),
+            },
+            FieldSampling::Bilinear => Distances::Interpolated,
+        }
+    }
+
+    #[inline]
+    fn at(&self, p: Vec2, layout: &FieldLayout, field: &ScalarField, t: &Thresholds) -> u64 {
+        match self {
+            Distances::ByCell { cells, outside } => field.truncated_cell(p, &layout.frame).map_or(*outside, |k| cells[k]),
+            Distances::Interpolated => fixed_distance(p, layout, field, t),
+        }
+    }
 }
 
 /// Eval from the sum of the pucks' fixed-point distances.
@@ -55,18 +92,22 @@ pub fn eval(world: &World, field: &ScalarField, t: &Thresholds) -> f64 {
 /// Eval kept current as the world steps: only the pucks that moved since
 /// the last update are looked up again, so Eval every step (a learner's
 /// reward) costs a few lookups instead of one per puck. Always equal to
-/// [`eval`] right after an update.
+/// [`eval`] right after an update. A tracker belongs to one field, one
+/// field layout and one set of thresholds: the ones it was made with,
+/// which every call must pass again.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvalTracker {
     /// Each body's fixed-point distance (0 for robots).
     distances: Vec<u64>,
     total: u64,
+    lookup: Distances,
 }
 
 impl EvalTracker {
     /// A tracker of `world`'s current pucks.
     pub fn new(world: &World, field: &ScalarField, t: &Thresholds) -> EvalTracker {
-        let mut tracker = EvalTracker { distances: vec![0; world.bodies().len()], total: 0 };
+        let lookup = Distances::new(field, &world.config().field_layout(), t);
+        let mut tracker = EvalTracker { distances: vec![0; world.bodies().len()], total: 0, lookup };
         tracker.rebuild(world, field, t);
         tracker
     }
@@ -76,7 +117,7 @@ impl EvalTracker {
         self.distances.fill(0);
         let layout = world.config().field_layout();
         for i in world.puck_range() {
-            self.distances[i] = fixed_distance(world.bodies()[i].pos, &layout, field, t);
+            self.distances[i] = self.lookup.at(world.bodies()[i].pos, &layout, field, t);
         }
         self.total = self.distances.iter().sum();
     }
@@ -85,11 +126,12 @@ impl EvalTracker {
     /// last update (the world's moved set, which this empties).
     pub fn update(&mut self, world: &mut World, field: &ScalarField, t: &Thresholds) {
         let (first_puck, layout) = (world.puck_range().start, world.config().field_layout());
+        let (lookup, distances, total) = (&self.lookup, &mut self.distances, &mut self.total);
         world.drain_moved(|i, body| {
             if i >= first_puck {
-                let d = fixed_distance(body.pos, &layout, field, t);
-                self.total = self.total - self.distances[i] + d;
-                self.distances[i] = d;
+                let d = lookup.at(body.pos, &layout, field, t);
+                *total = *total - distances[i] + d;
+                distances[i] = d;
             }
         });
     }
@@ -153,5 +195,41 @@ fn diagonal(arena: Vec2) -> f64 {
         arena.x * std::f64::consts::SQRT_2
     } else {
         arena.x.hypot(arena.y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::FieldFrame;
+
+    /// The per-cell table gives every position the distance of the formula:
+    /// on cell edges, between them, outside the grid on every side and at
+    /// non-finite coordinates, in a frame that does not start at the origin.
+    #[test]
+    fn the_cell_table_gives_the_formulas_distance_everywhere() {
+        let field = ScalarField::annulus_of(16, 12);
+        let layout = FieldLayout { frame: FieldFrame { x: 30.0, y: -12.5, width: 160.0, height: 90.0 }, sampling: FieldSampling::Nearest };
+        for t in [Thresholds::default(), Thresholds::LETTERS, Thresholds { outie: 0.2, innie: 0.3 }] {
+            let table = Distances::new(&field, &layout, &t);
+            let mut points: Vec<Vec2> = Vec::new();
+            for i in -8..=200 {
+                for j in -8..=130 {
+                    points.push(Vec2::new(20.0 + f64::from(i) * 0.9, -25.0 + f64::from(j) * 0.9));
+                }
+            }
+            // exactly on cell edges (10 x 7.5 units each) and a hair off them
+            let hair = |v: f64| v.abs().max(1.0) * f64::EPSILON;
+            for i in -1..=17 {
+                for j in -1..=13 {
+                    let edge = Vec2::new(30.0 + f64::from(i) * 10.0, -12.5 + f64::from(j) * 7.5);
+                    points.extend([edge, Vec2::new(edge.x - hair(edge.x), edge.y), Vec2::new(edge.x, edge.y + hair(edge.y))]);
+                }
+            }
+            points.extend([Vec2::new(f64::NAN, 40.0), Vec2::new(50.0, f64::INFINITY), Vec2::new(-1e300, 1e300)]);
+            for p in points {
+                assert_eq!(table.at(p, &layout, &field, &t), fixed_distance(p, &layout, &field, &t), "at {p:?}");
+            }
+        }
     }
 }

@@ -132,6 +132,7 @@ impl ScalarField {
     }
 
     /// A sensor's reading at `p`, in fixed point.
+    #[inline]
     pub fn sense(&self, p: Vec2, layout: &FieldLayout) -> FieldValue {
         match layout.sampling {
             FieldSampling::Nearest => {
@@ -163,14 +164,24 @@ impl ScalarField {
     /// cell found by truncation (0 outside), with bilinear the interpolation.
     pub fn evaluate(&self, p: Vec2, layout: &FieldLayout) -> f32 {
         match layout.sampling {
-            FieldSampling::Nearest => {
-                let f = &layout.frame;
-                let x = (self.width as f64 * (p.x - f.x) / f.width) as i64;
-                let y = (self.height as f64 * (p.y - f.y) / f.height) as i64;
-                self.cell(x, y)
-            }
+            FieldSampling::Nearest => self.truncated_cell(p, &layout.frame).map_or(0.0, |k| self.values[k]),
             FieldSampling::Bilinear => self.bilinear(p, &layout.frame) as f32,
         }
+    }
+
+    /// The row-major index of the cell [`ScalarField::evaluate`] reads at
+    /// `p` with nearest sampling (the cell found by truncation), or `None`
+    /// outside the grid.
+    #[inline]
+    pub fn truncated_cell(&self, p: Vec2, frame: &FieldFrame) -> Option<usize> {
+        let x = (self.width as f64 * (p.x - frame.x) / frame.width) as i64;
+        let y = (self.height as f64 * (p.y - frame.y) / frame.height) as i64;
+        self.cell_index(x, y)
+    }
+
+    /// Every cell's value, row-major.
+    pub fn values(&self) -> &[f32] {
+        &self.values
     }
 
     /// The bilinear interpolation at `p` between pixel centres (0 outside

@@ -172,6 +172,28 @@ impl SpatialGrid {
         })
     }
 
+    /// Writes to the start of `out` the bodies of body `body`'s cell and
+    /// the eight around it (those of [`SpatialGrid::any_around`]) whose
+    /// centres lie closer to `centre` than `sqrt(reach2)`, `body` itself
+    /// among them if it does; returns how many, and how many of those lie
+    /// closer than `sqrt(close2)`. `out` needs a slot for every body.
+    #[inline]
+    pub fn gather_around(&self, body: usize, centre: Vec2, reach2: f64, close2: f64, out: &mut [u32]) -> (usize, usize) {
+        let cell = self.cell_of[body] as usize;
+        let (mut len, mut close) = (0, 0);
+        for mid in [cell - self.stride, cell, cell + self.stride] {
+            // Each body is written to the next free slot and kept only if
+            // it is near: no branch to mispredict.
+            for n in &self.slots[self.start[mid - 1] as usize..self.start[mid + 2] as usize] {
+                let d2 = (n.pos - centre).length_squared();
+                out[len] = n.body;
+                len += usize::from(d2 < reach2);
+                close += usize::from(d2 < close2);
+            }
+        }
+        (len, close)
+    }
+
     /// The smaller of a cell's width and height.
     #[inline]
     pub fn cell_width(&self) -> f64 {

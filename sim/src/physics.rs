@@ -189,27 +189,30 @@ impl StepContext<'_> {
         }
     }
 
-    fn record(&mut self, contact: Contact) {
-        match contact {
-            Contact::Bodies(a, b) => {
-                for body in [a as usize, b as usize] {
-                    self.bodies[body].in_contact = true;
-                    self.scratch.live.insert(body);
-                }
-                let robots = self.robots.len() as u32;
-                if a < robots && b < robots {
-                    let pair = (a.min(b), a.max(b));
-                    if !self.scratch.robot_pairs.contains(&pair) {
-                        self.scratch.robot_pairs.push(pair);
-                    }
-                }
-            }
-            Contact::Wall { body, .. } => {
-                self.bodies[body as usize].in_contact = true;
-                self.scratch.live.insert(body as usize);
+    /// Records a contact between bodies `a` and `b`: both are in contact
+    /// (and live), robot pairs are counted once per step.
+    #[inline]
+    fn record_bodies(&mut self, a: u32, b: u32) {
+        for body in [a as usize, b as usize] {
+            self.bodies[body].in_contact = true;
+            self.scratch.live.insert(body);
+        }
+        let robots = self.robots.len() as u32;
+        if a < robots && b < robots {
+            let pair = (a.min(b), a.max(b));
+            if !self.scratch.robot_pairs.contains(&pair) {
+                self.scratch.robot_pairs.push(pair);
             }
         }
-        self.scratch.contacts.push(contact);
+        self.scratch.contacts.push(Contact::Bodies(a, b));
+    }
+
+    /// Records a wall contact (rare: not inlined).
+    #[inline(never)]
+    fn record_wall(&mut self, body: u32, point: Vec2, velocity: Vec2) {
+        self.bodies[body as usize].in_contact = true;
+        self.scratch.live.insert(body as usize);
+        self.scratch.contacts.push(Contact::Wall { body, point, velocity });
     }
 
     /// The four border walls in a fixed order (top, right, bottom, left),
@@ -243,7 +246,7 @@ impl StepContext<'_> {
             let normal = if d > 0.0 { delta * (1.0 / d) } else { inward };
             self.bodies[i].pos += normal * overlap;
             self.relocated(i);
-            self.record(Contact::Wall { body: i as u32, point, velocity: -b.vel });
+            self.record_wall(i as u32, point, -b.vel);
         }
     }
 
@@ -255,21 +258,24 @@ impl StepContext<'_> {
     /// again. So the result is the all-pairs result, exactly.
     fn resolve_circles(&mut self, i: usize) {
         let margin = CANDIDATE_MARGIN * self.max_radius;
-        let mut candidates = std::mem::take(&mut self.scratch.candidates);
         let threshold = self.config.overlap_threshold;
-        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, threshold, &mut candidates);
+        let candidates = &mut self.scratch.candidates;
+        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, threshold, candidates);
+        if candidates.as_slice().is_empty() {
+            return;
+        }
         let mut anchor = self.bodies[i].pos;
         let mut k = 0;
-        while let Some(&j) = candidates.as_slice().get(k) {
+        while let Some(&j) = self.scratch.candidates.as_slice().get(k) {
             let j = j as usize;
             k += 1;
             if self.separate(i, j) && (self.bodies[i].pos - anchor).length_squared() > margin * margin {
                 anchor = self.bodies[i].pos;
-                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, threshold, &mut candidates);
+                let candidates = &mut self.scratch.candidates;
+                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, threshold, candidates);
                 k = 0;
             }
         }
-        self.scratch.candidates = candidates;
     }
 
     /// Separates `i` and `j` if they overlap by more than the threshold,
@@ -303,7 +309,7 @@ impl StepContext<'_> {
         self.relocated(i);
         self.relocated(j);
         self.scratch.pending.insert(j);
-        self.record(Contact::Bodies(i as u32, j as u32));
+        self.record_bodies(i as u32, j as u32);
         true
     }
 
