@@ -275,6 +275,9 @@ pub struct PixyCamera {
     classify: CameraConfig,
     /// The rim points on a unit circle: ahead (cos) and right (sin) parts.
     rim_ahead: [f64; RIM_POINTS],
+    /// The rim point farthest back (least `rim_ahead`): the nearest to the
+    /// image plane of every rim ([`PixyCamera::silhouette`]).
+    rim_back: usize,
     rim_right: [f64; RIM_POINTS],
     in_view: Vec<InView>,
     pieces: Vec<Rect>,
@@ -312,6 +315,7 @@ impl PixyCamera {
             classify: config.classify,
             rim_ahead: rim.map(|p| p.x),
             rim_right: rim.map(|p| p.y),
+            rim_back: (0..RIM_POINTS).fold(0, |back, k| if rim[k].x < rim[back].x { k } else { back }),
             in_view: Vec::new(),
             pieces: Vec::new(),
             scratch: Vec::new(),
@@ -442,7 +446,10 @@ impl PixyCamera {
         for z in [0.0, height] {
             let up = z - self.height;
             let depth = depth_ahead.map(|d| d - up * self.sin_tilt);
-            if least(&depth) < self.near {
+            // A point's depth grows with its `rim_ahead` (radius > 0, and
+            // cos_tilt > 0 since the tilt stays within 90 degrees), each
+            // step rounded monotonically: the back point's is the least.
+            if depth[self.rim_back] < self.near {
                 return None;
             }
             for k in 0..RIM_POINTS {

@@ -54,6 +54,7 @@ impl QTable {
     }
 
     /// The values of one state's actions.
+    #[inline]
     pub fn row(&self, state: State) -> &[f64] {
         let start = state.index() * self.actions;
         &self.values[start..start + self.actions]
@@ -76,6 +77,7 @@ impl QTable {
 
     /// An action with the greatest value; among equal maxima, one chosen
     /// uniformly at random (the generator is drawn only when there is a tie).
+    #[inline]
     pub fn greedy(&self, state: State, rng: &mut impl RngExt) -> ActionId {
         let row = self.row(state);
         let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -88,6 +90,7 @@ impl QTable {
     /// Epsilon-greedy choice: with probability `epsilon` a uniformly random
     /// action, otherwise [`QTable::greedy`]. With `epsilon == 0` the
     /// exploration draw is skipped.
+    #[inline]
     pub fn select(&self, state: State, epsilon: f64, rng: &mut impl RngExt) -> ActionId {
         if epsilon > 0.0 && rng.random::<f64>() < epsilon {
             ActionId(rng.random_range(0..self.actions) as u8)
@@ -97,6 +100,7 @@ impl QTable {
     }
 
     /// The Q-learning update Q(s,a) += alpha (r + gamma max_a' Q(s',a') - Q(s,a)).
+    #[inline]
     pub fn update(&mut self, s: State, a: ActionId, reward: f64, next: State, params: QParams) {
         let next_best = self.row(next).iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let i = s.index() * self.actions + a.index();
