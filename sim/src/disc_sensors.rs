@@ -90,8 +90,16 @@ impl SensorModel for DiscSensors {
             // the robot serves both.
             let [obstacle_left, obstacle_right] = self.obstacle.map(|d| (at(d.offset), d.radius));
             let (mut seen_left, mut seen_right) = (false, false);
-            world.any_body_around(i, self.obstacle_reach + world.config().max_radius(), |row| {
+            let reach = self.obstacle_reach + world.config().max_radius();
+            // A body can touch a disc only within `reach` of the robot's
+            // centre (with room for rounding): most of those visited are
+            // farther, and skip the two exact tests.
+            let near2 = (reach * (1.0 + 1e-9)).powi(2);
+            world.any_body_around(i, reach, |row| {
                 for b in row {
+                    if (b.pos - pos).length_squared() >= near2 {
+                        continue;
+                    }
                     let counts = (b.body as usize != i) & (b.body < obstacles);
                     let overlaps = |(c, r): (Vec2, f64)| disc_overlaps(c, r, b.pos, b.radius);
                     seen_left |= counts & overlaps(obstacle_left);
