@@ -21,6 +21,10 @@
 //!
 //! Worked example (thesis section 3.2): left puck on, right off, mid 0.4,
 //! left 0.35, right 0.45, 8-bit hash: 1 + 4 + 6 x 16 = 101.
+//!
+//! Hashing is marked inline for the host, whose learner hashes every
+//! robot's reading twice a step, but not for the AVR, which hashes once a
+//! period and has little flash to spare.
 
 use crate::reading::SensorReading;
 use core::fmt;
@@ -210,6 +214,7 @@ impl StateHasher {
     }
 
     /// What this hasher keeps of the reading of a robot of `role`.
+    #[cfg_attr(not(target_arch = "avr"), inline)]
     pub fn quantise_as(self, reading: &SensorReading, role: Role) -> StateInputs {
         let obstacles = self.has_obstacle_bits();
         StateInputs {
@@ -227,6 +232,7 @@ impl StateHasher {
     /// Packs quantised inputs into a state with the canonical layout.
     /// Bins above the hasher's range are clamped to its top bin; obstacle
     /// bits are dropped by hashers that do not carry them.
+    #[cfg_attr(not(target_arch = "avr"), inline)]
     pub fn pack(self, inputs: &StateInputs) -> State {
         let k = self.mid_bits();
         let top_bin = (1u16 << k) - 1;
@@ -268,12 +274,14 @@ impl StateHasher {
 
     /// Hashes an outie's reading: [`StateHasher::pack`] of
     /// [`StateHasher::quantise`].
+    #[cfg_attr(not(target_arch = "avr"), inline)]
     pub fn hash(self, reading: &SensorReading) -> State {
         self.pack(&self.quantise(reading))
     }
 
     /// Hashes the reading of a robot of `role` (only the role hasher tells
     /// the roles apart).
+    #[cfg_attr(not(target_arch = "avr"), inline)]
     pub fn hash_as(self, reading: &SensorReading, role: Role) -> State {
         self.pack(&self.quantise_as(reading, role))
     }
