@@ -9,6 +9,7 @@
 
 use crate::config::Thresholds;
 use crate::field::{FieldLayout, FieldSampling, ScalarField};
+use crate::rounding::round_half_away;
 use crate::vec2::Vec2;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -35,9 +36,10 @@ fn fixed_distance(p: Vec2, layout: &FieldLayout, field: &ScalarField, t: &Thresh
     fixed_of_value(field.evaluate(p, layout), t)
 }
 
-/// The fixed-point band distance of a field value.
+/// The fixed-point band distance of a field value (a distance of at most
+/// 1, so the rounded value fits `i64` and is not negative).
 fn fixed_of_value(value: f32, t: &Thresholds) -> u64 {
-    (band_distance(f64::from(value), t) * DISTANCE_ONE).round() as u64
+    round_half_away(band_distance(f64::from(value), t) * DISTANCE_ONE) as u64
 }
 
 /// Each puck position's fixed-point distance, the way [`fixed_distance`]

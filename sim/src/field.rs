@@ -14,6 +14,7 @@
 //!   frame's border); outside the frame the screen is black (0). Sensors
 //!   and the evaluation of pucks both read this value.
 
+use crate::rounding::{floor, round_half_away};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::FieldValue;
@@ -208,7 +209,7 @@ fn split(t: f64, n: usize) -> (usize, f64) {
     if t <= 0.0 {
         return (0, 0.0);
     }
-    let i = t.floor();
+    let i = floor(t);
     if i as usize >= n - 1 {
         return (n - 1, 0.0);
     }
@@ -227,17 +228,6 @@ fn nearest_index(t: f64, n: usize) -> Option<usize> {
     }
     let whole = t as u32;
     Some(whole as usize + usize::from(t - f64::from(whole) >= 0.5))
-}
-
-/// `t.round() as i64` without the libm call `round` compiles to on
-/// baseline x86-64: the fractional part `t - trunc(t)` is exact, so the
-/// result is identical. No branch on the fraction, which is as likely to
-/// be above one half as below. (Indices beyond `i64` saturate, as `as`
-/// does.)
-fn round_half_away(t: f64) -> i64 {
-    let whole = t as i64;
-    let frac = t - whole as f64;
-    whole.saturating_add(i64::from(frac >= 0.5)).saturating_sub(i64::from(frac <= -0.5))
 }
 
 #[cfg(test)]
@@ -339,15 +329,6 @@ mod tests {
             let (x, y) = f.nearest_cell(p, &layout.frame);
             let expected = f.cell_index(x, y).map_or(FieldValue::ZERO, |k| f.fixed[k]);
             assert_eq!(f.sense(p, &layout), expected, "{p:?}");
-        }
-    }
-
-    #[test]
-    fn rounding_matches_the_standard_round() {
-        let mut values = vec![0.0, 0.49999999999999994, 0.5, 1.5, 2.4999, 63.5, -0.2, -0.5, -0.50001, -1.5, 1e300, f64::NAN];
-        values.extend((-4000..4000).map(|k| f64::from(k) * 0.0625 + 1e-9 * f64::from(k % 3)));
-        for t in values {
-            assert_eq!(round_half_away(t), t.round() as i64, "{t}");
         }
     }
 }

@@ -48,6 +48,7 @@ pub mod policy_file;
 pub mod render;
 pub mod reward;
 pub mod rng;
+pub mod rounding;
 pub mod robot_noise;
 pub mod robot_sensors;
 pub mod scenario;

@@ -31,6 +31,7 @@ use crate::validate::{check, ConfigError};
 use crate::field::{FieldLayout, ScalarField};
 use crate::rng::SimRng;
 use crate::robot_noise::RobotNoise;
+use crate::rounding;
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
@@ -129,7 +130,7 @@ impl Default for PhotoSensorConfig {
 /// `floor(us / tick)` capped at the timeout: the firmware's reading of a
 /// discharge that takes `us` microseconds.
 pub fn quantise_us(us: f64) -> u16 {
-    let ticks = (us / f64::from(RC_TICK_US)).floor();
+    let ticks = rounding::floor(us / f64::from(RC_TICK_US));
     if ticks >= f64::from(RC_TIMEOUT_TICKS) {
         RC_TIMEOUT_TICKS
     } else if ticks > 0.0 {

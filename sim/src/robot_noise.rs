@@ -7,6 +7,7 @@
 //! and the robot.
 
 use crate::noise::{self, Purpose};
+use crate::rounding::round_half_away;
 use crate::rng::SimRng;
 use crate::validate::{check, ConfigError};
 use crate::vec2::Vec2;
@@ -147,7 +148,7 @@ impl RobotNoise {
         if self.block_jitter_px > 0.0 {
             let jitter = |v: u16, limit: u16, rng: &mut SimRng| {
                 let moved = f64::from(v) + self.block_jitter_px * noise::normal(rng);
-                moved.round().clamp(0.0, f64::from(limit)) as u16
+                round_half_away(moved).clamp(0, i64::from(limit)) as u16
             };
             for b in frame.iter_mut() {
                 b.x = jitter(b.x, IMAGE_WIDTH - 1, rng);
