@@ -10,7 +10,7 @@ const WHOLE: f64 = 4_503_599_627_370_496.0; // 2^52
 /// `t.floor()`, the sign of a zero, NaN and the infinities included.
 #[inline]
 pub fn floor(t: f64) -> f64 {
-    if !(t.abs() < WHOLE) {
+    if t.abs() >= WHOLE || t.is_nan() {
         return t; // whole already, infinite or NaN
     }
     let whole = t as i64 as f64;
