@@ -247,6 +247,7 @@ struct Candidate {
 
 /// Rim points sampled per circle of a body's cylinder.
 const RIM_POINTS: usize = 12;
+const _: () = assert!(RIM_POINTS == 12, "`least` and `greatest` halve 12 lanes");
 
 /// The camera of a robot of a given radius, with scratch space so that a
 /// frame allocates nothing once warmed up.
@@ -434,38 +435,39 @@ impl PixyCamera {
     /// The clipped pixel box of a cylinder of `radius` and `height` whose
     /// axis is `ahead` of and `side` right of the lens; `None` if it is out
     /// of the image or reaches behind the image plane. Its 2 x 12 rim points
-    /// are projected in fixed-size arrays so that the arithmetic vectorises;
-    /// each point's coordinates are rounded exactly as one point at a time.
+    /// are projected in fixed-size arrays so that the arithmetic vectorises,
+    /// each point's coordinates rounded exactly as one point at a time; the
+    /// least and greatest are found by halving the arrays (few registers,
+    /// packed comparisons). Adding the image centre rounds monotonically,
+    /// so it is added to the extremes alone.
     fn silhouette(&self, ahead: f64, side: f64, radius: f64, height: f64) -> Option<Rect> {
-        // The parts of depth, height in the image and x shared by both rims.
+        let ups = [0.0 - self.height, height - self.height];
+        let (up_sin, up_cos) = (ups.map(|up| up * self.sin_tilt), ups.map(|up| up * self.cos_tilt));
+        // A point's depth grows with its `rim_ahead` (radius > 0, and
+        // cos_tilt > 0 since the tilt stays within 90 degrees), each step
+        // rounded monotonically: the back point's is the least of its rim.
+        let back = (ahead + radius * self.rim_ahead[self.rim_back]) * self.cos_tilt;
+        if back - up_sin[0] < self.near || back - up_sin[1] < self.near {
+            return None;
+        }
         let point_ahead: [f64; RIM_POINTS] = std::array::from_fn(|k| ahead + radius * self.rim_ahead[k]);
         let depth_ahead = point_ahead.map(|pf| pf * self.cos_tilt);
         let down_ahead = point_ahead.map(|pf| -pf * self.sin_tilt);
         let across: [f64; RIM_POINTS] = std::array::from_fn(|k| self.fx * (side + radius * self.rim_right[k]));
-        let (mut xs, mut ys) = (Extent::EMPTY, Extent::EMPTY);
-        for z in [0.0, height] {
-            let up = z - self.height;
-            let depth = depth_ahead.map(|d| d - up * self.sin_tilt);
-            // A point's depth grows with its `rim_ahead` (radius > 0, and
-            // cos_tilt > 0 since the tilt stays within 90 degrees), each
-            // step rounded monotonically: the back point's is the least.
-            if depth[self.rim_back] < self.near {
-                return None;
-            }
-            for k in 0..RIM_POINTS {
-                let inverse = 1.0 / depth[k];
-                let down = down_ahead[k] - up * self.cos_tilt;
-                xs.include(k, f64::from(IMAGE_WIDTH) / 2.0 + across[k] * inverse);
-                ys.include(k, f64::from(IMAGE_HEIGHT) / 2.0 + self.fy * down * inverse);
-            }
+        let (mut x, mut y) = ([[0.0; RIM_POINTS]; 2], [[0.0; RIM_POINTS]; 2]);
+        for rim in 0..2 {
+            let inverse = depth_ahead.map(|d| 1.0 / (d - up_sin[rim]));
+            x[rim] = std::array::from_fn(|k| across[k] * inverse[k]);
+            y[rim] = std::array::from_fn(|k| self.fy * (down_ahead[k] - up_cos[rim]) * inverse[k]);
         }
+        let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
         // A zero's sign may differ from the point by point minimum; the
         // pixel is the same for both.
         let rect = Rect {
-            left: first_pixel(xs.least(), IMAGE_WIDTH),
-            right: last_pixel(xs.greatest(), IMAGE_WIDTH),
-            top: first_pixel(ys.least(), IMAGE_HEIGHT),
-            bottom: last_pixel(ys.greatest(), IMAGE_HEIGHT),
+            left: first_pixel(cx + least(&x), IMAGE_WIDTH),
+            right: last_pixel(cx + greatest(&x), IMAGE_WIDTH),
+            top: first_pixel(cy + least(&y), IMAGE_HEIGHT),
+            bottom: last_pixel(cy + greatest(&y), IMAGE_HEIGHT),
         };
         (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
     }
@@ -605,37 +607,23 @@ fn sort_nearest_first(in_view: &mut [InView]) {
     });
 }
 
-/// One coordinate's least and greatest value at each rim point over the
-/// rims projected so far (one lane per rim point, so that the comparisons
-/// vectorise).
-#[derive(Clone, Copy, Debug)]
-struct Extent {
-    least: [f64; RIM_POINTS],
-    greatest: [f64; RIM_POINTS],
+/// The least of both rims' values (none is NaN): the lanes halved down to
+/// two (12, 6, then 2 of three), which keeps few registers live.
+fn least(rims: &[[f64; RIM_POINTS]; 2]) -> f64 {
+    let min = |a: f64, b: f64| if a < b { a } else { b };
+    let v: [f64; RIM_POINTS] = std::array::from_fn(|k| min(rims[0][k], rims[1][k]));
+    let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| min(v[k], v[k + RIM_POINTS / 2]));
+    let v: [f64; 2] = std::array::from_fn(|k| min(min(v[k], v[k + 2]), v[k + 4]));
+    min(v[1], v[0])
 }
 
-impl Extent {
-    const EMPTY: Extent = Extent { least: [f64::INFINITY; RIM_POINTS], greatest: [f64::NEG_INFINITY; RIM_POINTS] };
-
-    /// Takes in rim point `k`'s value on one rim (none is NaN).
-    #[inline(always)]
-    fn include(&mut self, k: usize, value: f64) {
-        self.least[k] = if value < self.least[k] { value } else { self.least[k] };
-        self.greatest[k] = if value > self.greatest[k] { value } else { self.greatest[k] };
-    }
-
-    fn least(&self) -> f64 {
-        least(&self.least)
-    }
-
-    fn greatest(&self) -> f64 {
-        self.greatest.into_iter().fold(f64::NEG_INFINITY, |m, v| if v > m { v } else { m })
-    }
-}
-
-/// The least of `values` (none is NaN).
-fn least(values: &[f64; RIM_POINTS]) -> f64 {
-    values.iter().fold(f64::INFINITY, |m, &v| if v < m { v } else { m })
+/// The greatest of both rims' values (none is NaN), as [`least`].
+fn greatest(rims: &[[f64; RIM_POINTS]; 2]) -> f64 {
+    let max = |a: f64, b: f64| if a > b { a } else { b };
+    let v: [f64; RIM_POINTS] = std::array::from_fn(|k| max(rims[0][k], rims[1][k]));
+    let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| max(v[k], v[k + RIM_POINTS / 2]));
+    let v: [f64; 2] = std::array::from_fn(|k| max(max(v[k], v[k + 2]), v[k + 4]));
+    max(v[1], v[0])
 }
 
 /// The first pixel of a span that starts at `v`: `floor(v)` within
