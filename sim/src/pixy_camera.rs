@@ -166,6 +166,39 @@ impl Rect {
         self.top.max(o.top) - self.bottom.min(o.bottom)
     }
 
+    /// The bounding box and pixel count of the part of `self` outside
+    /// `cut`, which overlaps it; `None` if `cut` covers it. The box is
+    /// `self`'s, but narrower where `cut` spans all its rows from one side
+    /// (lower where it spans all its columns from one side).
+    fn without(&self, cut: &Rect) -> Option<(Rect, u32)> {
+        let c = Rect {
+            left: self.left.max(cut.left),
+            top: self.top.max(cut.top),
+            right: self.right.min(cut.right),
+            bottom: self.bottom.min(cut.bottom),
+        };
+        if c == *self {
+            return None;
+        }
+        let mut rect = *self;
+        if c.top == self.top && c.bottom == self.bottom {
+            if c.left == self.left {
+                rect.left = c.right + 1;
+            }
+            if c.right == self.right {
+                rect.right = c.left - 1;
+            }
+        } else if c.left == self.left && c.right == self.right {
+            if c.top == self.top {
+                rect.top = c.bottom + 1;
+            }
+            if c.bottom == self.bottom {
+                rect.bottom = c.top - 1;
+            }
+        }
+        Some((rect, self.area() - c.area()))
+    }
+
     /// Appends the parts of `self` outside `cut` (up to four rectangles).
     fn subtract_into(&self, cut: &Rect, out: &mut Vec<Rect>) {
         if !self.overlaps(cut) {
@@ -281,6 +314,8 @@ pub struct PixyCamera {
     rim_back: usize,
     rim_right: [f64; RIM_POINTS],
     in_view: Vec<InView>,
+    /// The nearer boxes that overlap the body being occluded.
+    cuts: Vec<Rect>,
     pieces: Vec<Rect>,
     scratch: Vec<Rect>,
     blobs: Vec<Blob>,
@@ -318,6 +353,7 @@ impl PixyCamera {
             rim_right: rim.map(|p| p.y),
             rim_back: (0..RIM_POINTS).fold(0, |back, k| if rim[k].x < rim[back].x { k } else { back }),
             in_view: Vec::new(),
+            cuts: Vec::new(),
             pieces: Vec::new(),
             scratch: Vec::new(),
             blobs: Vec::new(),
@@ -474,40 +510,46 @@ impl PixyCamera {
 
     /// Stage 2: each body's still visible part after the nearer ones'
     /// silhouettes are cut away, as a blob (bounding box, pixel count) if it
-    /// has at least `min_area` pixels.
+    /// has at least `min_area` pixels. The nearer boxes that overlap it are
+    /// found in one pass; most bodies have none or one, whose visible part
+    /// has a closed form ([`Rect::without`]); more are cut away piece by
+    /// piece.
     fn occlude(&mut self) {
         self.blobs.clear();
-        for (k, body) in self.in_view.iter().enumerate() {
-            let nearer = &self.in_view[..k];
-            let Some(first) = nearer.iter().position(|n| n.rect.overlaps(&body.rect)) else {
-                // Nothing nearer overlaps it: its whole box is seen, no pieces needed.
-                if body.rect.area() >= self.min_area {
-                    self.blobs.push(Blob { signature: body.signature, rect: body.rect, area: body.rect.area() });
-                }
-                continue;
+        for k in 0..self.in_view.len() {
+            let body = self.in_view[k];
+            self.cuts.clear();
+            self.cuts.extend(self.in_view[..k].iter().filter(|n| n.rect.overlaps(&body.rect)).map(|n| n.rect));
+            let visible = match self.cuts[..] {
+                [] => Some((body.rect, body.rect.area())),
+                [cut] => body.rect.without(&cut),
+                _ => self.cut_pieces(body.rect),
             };
-            self.pieces.clear();
-            self.pieces.push(body.rect);
-            for nearer in &nearer[first..] {
-                if !nearer.rect.overlaps(&body.rect) {
-                    continue;
+            if let Some((rect, area)) = visible {
+                if area >= self.min_area {
+                    self.blobs.push(Blob { signature: body.signature, rect, area });
                 }
-                self.scratch.clear();
-                for piece in &self.pieces {
-                    piece.subtract_into(&nearer.rect, &mut self.scratch);
-                }
-                std::mem::swap(&mut self.pieces, &mut self.scratch);
-                if self.pieces.is_empty() {
-                    break;
-                }
-            }
-            let Some(first) = self.pieces.first() else { continue };
-            let rect = self.pieces.iter().fold(*first, |r, p| r.union(p));
-            let area = self.pieces.iter().map(Rect::area).sum();
-            if area >= self.min_area {
-                self.blobs.push(Blob { signature: body.signature, rect, area });
             }
         }
+    }
+
+    /// The bounding box and pixel count of what `cuts` leave of `rect`,
+    /// `None` if nothing: the pieces left after each cut.
+    fn cut_pieces(&mut self, rect: Rect) -> Option<(Rect, u32)> {
+        self.pieces.clear();
+        self.pieces.push(rect);
+        for cut in &self.cuts {
+            self.scratch.clear();
+            for piece in &self.pieces {
+                piece.subtract_into(cut, &mut self.scratch);
+            }
+            std::mem::swap(&mut self.pieces, &mut self.scratch);
+            if self.pieces.is_empty() {
+                return None;
+            }
+        }
+        let first = self.pieces[0];
+        Some((self.pieces.iter().fold(first, |r, p| r.union(p)), self.pieces.iter().map(Rect::area).sum()))
     }
 
     /// Stage 3, first half: merges close blobs of one signature until no two
@@ -765,6 +807,26 @@ mod tests {
         assert_eq!(out.iter().map(Rect::area).sum::<u32>(), 100 - 3 * 6);
         for p in &out {
             assert!(!p.overlaps(&cut) && a.contains(p));
+        }
+    }
+
+    #[test]
+    fn one_cut_leaves_the_box_and_pixels_of_the_pieces_it_leaves() {
+        let a = Rect { left: 2, top: 3, right: 6, bottom: 7 };
+        let spans = |lo: i32, hi: i32| (lo..=hi).flat_map(move |l| (l..=hi).map(move |r| (l, r)));
+        for (left, right) in spans(0, 8) {
+            for (top, bottom) in spans(1, 9) {
+                let cut = Rect { left, top, right, bottom };
+                if !a.overlaps(&cut) {
+                    continue;
+                }
+                let mut pieces = Vec::new();
+                a.subtract_into(&cut, &mut pieces);
+                let expected = pieces.first().map(|&first| {
+                    (pieces.iter().fold(first, |r, p| r.union(p)), pieces.iter().map(Rect::area).sum())
+                });
+                assert_eq!(a.without(&cut), expected, "{cut:?}");
+            }
         }
     }
 
