@@ -553,18 +553,21 @@ impl PixyCamera {
     }
 
     /// Stage 3, first half: merges close blobs of one signature until no two
-    /// merge (the Pixy's `combine2`). Each blob joins the groups merged so
-    /// far; a group that grows is checked against the others again. Since
-    /// growing only brings boxes closer, every order of merging ends in the
-    /// same groups, so this gives the Pixy's result, each group in the place
-    /// of its first blob.
+    /// merge (the Pixy's `combine2`). Each blob joins the first group merged
+    /// so far that it merges with (or starts a group); a group that grows is
+    /// checked against the others again. Since growing only brings boxes
+    /// closer, every order of merging ends in the same groups, so this gives
+    /// the Pixy's result, each group in the place of its first blob.
     fn merge_close_blobs(&mut self) {
         let d = self.merge_distance;
         let groups = &mut self.merged;
         groups.clear();
         for blob in &self.blobs {
-            groups.push(*blob);
-            let mut grown = groups.len() - 1;
+            let Some(mut grown) = groups.iter().position(|g| g.merges_with(blob, d)) else {
+                groups.push(*blob);
+                continue;
+            };
+            groups[grown] = groups[grown].merged(blob);
             while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
             {
                 let (kept, absorbed) = (grown.min(other), grown.max(other));
