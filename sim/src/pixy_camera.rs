@@ -38,7 +38,6 @@ use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::{CameraConfig, PixyBlock};
-use std::cmp::Ordering;
 
 /// Where the camera sits, what it sees, and how it forms blocks. Lengths
 /// are in millimetres.
@@ -225,7 +224,7 @@ impl Rect {
 #[derive(Clone, Copy, Debug)]
 struct InView {
     distance: f64,
-    index: usize,
+    index: u32,
     signature: u16,
     rect: Rect,
 }
@@ -393,6 +392,11 @@ impl PixyCamera {
             }
             false
         });
+        // The grid's rows come in order of growing y: roughly near to far
+        // if the lens looks that way, else far to near.
+        if lens.ahead.y < 0.0 {
+            in_view.reverse();
+        }
         sort_nearest_first(&mut in_view);
         self.in_view = in_view;
     }
@@ -641,15 +645,26 @@ impl Lens {
 impl Candidate {
     /// The candidate in view with silhouette `rect`.
     fn in_view(&self, rect: Rect) -> InView {
-        InView { distance: self.distance_squared.sqrt(), index: self.index, signature: self.signature, rect }
+        InView { distance: self.distance_squared.sqrt(), index: self.index as u32, signature: self.signature, rect }
     }
 }
 
-/// Sorts bodies in view nearest first, ties by body index.
+/// Sorts bodies in view nearest first, ties by body index: an insertion
+/// sort, for a frame holds a dozen or so bodies, found roughly in order.
 fn sort_nearest_first(in_view: &mut [InView]) {
-    in_view.sort_unstable_by(|a, b| {
-        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
-    });
+    for i in 1..in_view.len() {
+        let body = in_view[i];
+        let mut k = i;
+        // No distance is NaN.
+        while k > 0 && {
+            let nearer = &in_view[k - 1];
+            body.distance < nearer.distance || (body.distance == nearer.distance && body.index < nearer.index)
+        } {
+            in_view[k] = in_view[k - 1];
+            k -= 1;
+        }
+        in_view[k] = body;
+    }
 }
 
 /// The least of both rims' values (none is NaN): the lanes halved down to

@@ -2,10 +2,11 @@
 //! every body near the lens visited, merging restarted after each merge),
 //! kept as the reference the faster stages must match block for block.
 
-use super::{sort_nearest_first, Blob, Lens, PixyCamera, Rect};
+use super::{Blob, InView, Lens, PixyCamera, Rect};
 use crate::world::World;
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::PixyBlock;
+use std::cmp::Ordering;
 
 /// The frame robot `robot` sees through `camera`, by the reference stages.
 pub(super) fn frame(camera: &PixyCamera, world: &World, robot: usize) -> Vec<PixyBlock> {
@@ -33,6 +34,13 @@ fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
     });
     sort_nearest_first(&mut in_view);
     camera.in_view = in_view;
+}
+
+/// Sorts bodies in view nearest first, ties by body index.
+fn sort_nearest_first(in_view: &mut [InView]) {
+    in_view.sort_unstable_by(|a, b| {
+        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
+    });
 }
 
 /// The clipped pixel box of a cylinder, one rim point at a time.
