@@ -571,7 +571,12 @@ impl PixyCamera {
                 groups.push(*blob);
                 continue;
             };
+            let before = groups[grown].rect;
             groups[grown] = groups[grown].merged(blob);
+            if groups[grown].rect == before {
+                // Not grown: no other group comes any closer.
+                continue;
+            }
             while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
             {
                 let (kept, absorbed) = (grown.min(other), grown.max(other));
