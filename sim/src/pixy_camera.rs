@@ -242,8 +242,11 @@ impl Blob {
     /// by at most `merge_distance` pixels along one axis while their
     /// spans overlap along the other.
     fn merges_with(&self, o: &Blob, merge_distance: i32) -> bool {
+        if self.signature != o.signature {
+            return false;
+        }
         let (gx, gy) = (self.rect.gap_x(&o.rect), self.rect.gap_y(&o.rect));
-        self.signature == o.signature && ((gx <= merge_distance && gy <= 0) || (gy <= merge_distance && gx <= 0))
+        (gx <= merge_distance && gy <= 0) || (gy <= merge_distance && gx <= 0)
     }
 
     /// The two as one blob: the union of their boxes, the sum of their pixels.
