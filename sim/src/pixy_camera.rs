@@ -424,21 +424,32 @@ impl PixyCamera {
         let reach = self.max_range + max_radius;
         let radius = reach + behind;
         let pad = radius * 1e-6;
+        let (min, max) = (|a: f64, b: f64| if a < b { a } else { b }, |a: f64, b: f64| if a > b { a } else { b });
         let edge = |sign: f64| apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius;
-        let (mut min, mut max) = (apex, apex);
-        let axes = [Vec2::new(1.0, 0.0), Vec2::new(-1.0, 0.0), Vec2::new(0.0, 1.0), Vec2::new(0.0, -1.0)];
-        let arc_extremes =
-            axes.into_iter().filter(|axis| axis.dot(lens.ahead) >= self.cos_half_h).map(|axis| apex + axis * radius);
-        for p in [edge(1.0), edge(-1.0)].into_iter().chain(arc_extremes) {
-            min = Vec2::new(min.x.min(p.x), min.y.min(p.y));
-            max = Vec2::new(max.x.max(p.x), max.y.max(p.y));
+        let edges = [edge(1.0), edge(-1.0)];
+        let mut low = Vec2::new(min(apex.x, min(edges[0].x, edges[1].x)), min(apex.y, min(edges[0].y, edges[1].y)));
+        let mut high = Vec2::new(max(apex.x, max(edges[0].x, edges[1].x)), max(apex.y, max(edges[0].y, edges[1].y)));
+        // The arc between the edges reaches as far as `radius` along each
+        // axis within half the field of view of the heading.
+        let (a, c) = (lens.ahead, self.cos_half_h);
+        if a.x >= c {
+            high.x = apex.x + radius;
+        }
+        if -a.x >= c {
+            low.x = apex.x - radius;
+        }
+        if a.y >= c {
+            high.y = apex.y + radius;
+        }
+        if -a.y >= c {
+            low.y = apex.y - radius;
         }
         let square = Vec2::new(reach, reach);
         let (near, far) = (lens.pos - square, lens.pos + square);
         let padding = Vec2::new(pad, pad);
         (
-            Vec2::new(min.x.max(near.x), min.y.max(near.y)) - padding,
-            Vec2::new(max.x.min(far.x), max.y.min(far.y)) + padding,
+            Vec2::new(max(low.x, near.x), max(low.y, near.y)) - padding,
+            Vec2::new(min(high.x, far.x), min(high.y, far.y)) + padding,
         )
     }
 
