@@ -410,9 +410,10 @@ impl PixyCamera {
     /// A box of the world holding the centre of every body that
     /// [`Self::candidate`] passes, for bodies up to `max_radius`: the
     /// sector from the apex of the widened view cone (half the horizontal
-    /// field of view each side) that reaches as far as the range does,
-    /// within the range's square around the lens, padded by a millionth
-    /// of its radius, far more than the culls' rounding.
+    /// field of view each side) that reaches as far as the range does, cut
+    /// off `max_radius` behind the lens, within the range's square around
+    /// the lens, padded by a millionth of its radius, far more than the
+    /// culls' rounding.
     fn search_box(&self, lens: &Lens, max_radius: f64) -> (Vec2, Vec2) {
         // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
         // for every r <= max_radius and h <= the taller body lies inside the
@@ -425,10 +426,18 @@ impl PixyCamera {
         let radius = reach + behind;
         let pad = radius * 1e-6;
         let (min, max) = (|a: f64, b: f64| if a < b { a } else { b }, |a: f64, b: f64| if a > b { a } else { b });
+        // The cone's corners where the culls' `ahead >= -r` cuts it, and
+        // where its edges meet the arc.
+        let back = lens.pos - lens.ahead * max_radius;
+        let half_width = (self.height + tallest) * self.tan_half_h + max_radius;
         let edge = |sign: f64| apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius;
-        let edges = [edge(1.0), edge(-1.0)];
-        let mut low = Vec2::new(min(apex.x, min(edges[0].x, edges[1].x)), min(apex.y, min(edges[0].y, edges[1].y)));
-        let mut high = Vec2::new(max(apex.x, max(edges[0].x, edges[1].x)), max(apex.y, max(edges[0].y, edges[1].y)));
+        let corners = [back + lens.right * half_width, back - lens.right * half_width, edge(1.0), edge(-1.0)];
+        let mut low = corners[0];
+        let mut high = corners[0];
+        for p in &corners[1..] {
+            low = Vec2::new(min(low.x, p.x), min(low.y, p.y));
+            high = Vec2::new(max(high.x, p.x), max(high.y, p.y));
+        }
         // The arc between the edges reaches as far as `radius` along each
         // axis within half the field of view of the heading.
         let (a, c) = (lens.ahead, self.cos_half_h);
