@@ -2,16 +2,17 @@
 //! every body near the lens visited, merging restarted after each merge),
 //! kept as the reference the faster stages must match block for block.
 
-use super::{sort_nearest_first, Blob, Lens, PixyCamera, Rect};
+use super::{Blob, InView, Lens, PixyCamera, Rect};
 use crate::world::World;
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::PixyBlock;
+use std::cmp::Ordering;
 
 /// The frame robot `robot` sees through `camera`, by the reference stages.
 pub(super) fn frame(camera: &PixyCamera, world: &World, robot: usize) -> Vec<PixyBlock> {
     let mut camera = camera.clone();
     gather_in_view(&mut camera, world, robot);
-    camera.occlude();
+    occlude(&mut camera);
     merge_and_prune(&mut camera.blobs, camera.merge_distance);
     let mut out = Vec::new();
     camera.emit_blocks(&mut out);
@@ -33,6 +34,13 @@ fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
     });
     sort_nearest_first(&mut in_view);
     camera.in_view = in_view;
+}
+
+/// Sorts bodies in view nearest first, ties by body index.
+fn sort_nearest_first(in_view: &mut [InView]) {
+    in_view.sort_unstable_by(|a, b| {
+        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
+    });
 }
 
 /// The clipped pixel box of a cylinder, one rim point at a time.
@@ -73,6 +81,29 @@ fn silhouette(camera: &PixyCamera, f: f64, s: f64, radius: f64, height: f64) -> 
         bottom: clip(max_y.ceil() - 1.0, IMAGE_HEIGHT).min(i32::from(IMAGE_HEIGHT) - 1),
     };
     (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
+}
+
+/// Stage 2: each body's still visible part after the nearer ones'
+/// silhouettes are cut away, one nearer body at a time, as a blob if it has
+/// at least `min_area` pixels.
+fn occlude(camera: &mut PixyCamera) {
+    camera.blobs.clear();
+    for (k, body) in camera.in_view.iter().enumerate() {
+        let mut pieces = vec![body.rect];
+        for nearer in &camera.in_view[..k] {
+            let mut rest = Vec::new();
+            for piece in &pieces {
+                piece.subtract_into(&nearer.rect, &mut rest);
+            }
+            pieces = rest;
+        }
+        let Some(first) = pieces.first() else { continue };
+        let rect = pieces.iter().fold(*first, |r, p| r.union(p));
+        let area = pieces.iter().map(Rect::area).sum();
+        if area >= camera.min_area {
+            camera.blobs.push(Blob { signature: body.signature, rect, area });
+        }
+    }
 }
 
 /// Stage 3: merges the first mergeable pair and starts again until none
