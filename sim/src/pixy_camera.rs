@@ -285,7 +285,7 @@ struct Candidate {
 
 /// Rim points sampled per circle of a body's cylinder.
 const RIM_POINTS: usize = 12;
-const _: () = assert!(RIM_POINTS == 12, "`least` and `greatest` halve 12 lanes");
+const _: () = assert!(RIM_POINTS == 12, "`halving` halves 12 lanes");
 
 /// The camera of a robot of a given radius, with scratch space so that a
 /// frame allocates nothing once warmed up.
@@ -743,23 +743,27 @@ fn has_avx2() -> bool {
     false
 }
 
-/// The least of both rims' values (none is NaN): the lanes halved down to
-/// two (12, 6, then 2 of three), which keeps few registers live.
+/// The least of both rims' values (none is NaN).
+#[inline(always)]
 fn least(rims: &[[f64; RIM_POINTS]; 2]) -> f64 {
-    let min = |a: f64, b: f64| if a < b { a } else { b };
-    let v: [f64; RIM_POINTS] = std::array::from_fn(|k| min(rims[0][k], rims[1][k]));
-    let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| min(v[k], v[k + RIM_POINTS / 2]));
-    let v: [f64; 2] = std::array::from_fn(|k| min(min(v[k], v[k + 2]), v[k + 4]));
-    min(v[1], v[0])
+    halving(rims, |a, b| if a < b { a } else { b })
 }
 
-/// The greatest of both rims' values (none is NaN), as [`least`].
+/// The greatest of both rims' values (none is NaN).
+#[inline(always)]
 fn greatest(rims: &[[f64; RIM_POINTS]; 2]) -> f64 {
-    let max = |a: f64, b: f64| if a > b { a } else { b };
-    let v: [f64; RIM_POINTS] = std::array::from_fn(|k| max(rims[0][k], rims[1][k]));
-    let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| max(v[k], v[k + RIM_POINTS / 2]));
-    let v: [f64; 2] = std::array::from_fn(|k| max(max(v[k], v[k + 2]), v[k + 4]));
-    max(v[1], v[0])
+    halving(rims, |a, b| if a > b { a } else { b })
+}
+
+/// Both rims' values reduced by `pick` (the lesser or the greater of two):
+/// the lanes halved down to two (12, 6, then 2 of three), which keeps few
+/// registers live.
+#[inline(always)]
+fn halving(rims: &[[f64; RIM_POINTS]; 2], pick: impl Fn(f64, f64) -> f64) -> f64 {
+    let v: [f64; RIM_POINTS] = std::array::from_fn(|k| pick(rims[0][k], rims[1][k]));
+    let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| pick(v[k], v[k + RIM_POINTS / 2]));
+    let v: [f64; 2] = std::array::from_fn(|k| pick(pick(v[k], v[k + 2]), v[k + 4]));
+    pick(v[1], v[0])
 }
 
 /// The first pixel of a span that starts at `v`: `floor(v)` within
