@@ -677,6 +677,10 @@ pub struct ExperimentRunArgs {
     /// the whole run; `host experiment merge` joins the shards.
     #[arg(long)]
     pub shard: Option<Shard>,
+    /// Another run's output directory (repeatable): its trials of the same
+    /// settings (config hash) are copied instead of run.
+    #[arg(long, value_name = "DIR")]
+    pub reuse: Vec<PathBuf>,
 }
 
 impl ExperimentRunArgs {
@@ -689,6 +693,7 @@ impl ExperimentRunArgs {
             seed: self.seed,
             threads: self.threads,
             shard: self.shard,
+            reuse: self.reuse.clone(),
         }
     }
 }

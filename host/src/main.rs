@@ -174,10 +174,11 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             };
             let report = host::experiment::run(&spec, &args.run.options(), &log)?;
             println!(
-                "done in {:.0} s: {} trials run, {} skipped; wrote {}",
+                "done in {:.0} s: {} trials run, {} skipped, {} copied; wrote {}",
                 report.seconds,
                 report.trials_run,
                 report.trials_skipped,
+                report.trials_reused,
                 paths(&report.outputs)
             );
             Ok(())

@@ -227,6 +227,8 @@ fn bad_experiment_inputs_are_refused() {
     assert!(fails(&["experiment", "annulus", "--trials", "0"]).contains("--trials 0"));
     assert!(fails(&["experiment", "annulus", "--scale=-1"]).contains("--scale -1"));
     assert!(fails(&["experiment", "annulus", "--shard", "3/3"]).contains("0 <= K < N"));
+    let e = fails(&["experiment", "annulus", "--reuse", "/no/such/run"]);
+    assert!(e.contains("--reuse /no/such/run: not a directory"), "{e}");
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "title = \"x\"\n[[arms]]\nname = \"a\"\nhasher = \"bits7\"\n").unwrap();
@@ -251,4 +253,46 @@ fn results_do_not_depend_on_the_number_of_threads() {
         trials
     };
     assert_eq!(run("1"), run("2"));
+}
+
+/// The state-bits and obstacle experiments share the arm "8 bits
+/// (Original)" in both columns: with `--reuse` an obstacle run copies those
+/// trials from a state-bits run, renamed as its own, and its trial files
+/// and table are what running them gives.
+#[test]
+fn trials_another_run_made_with_the_same_settings_are_copied_not_run() {
+    let out = tempfile::tempdir().unwrap();
+    let run = |name: &str, dir: &str, more: &[&str]| {
+        let run = host()
+            .args(["experiment", name, "--trials", "2", "--scale", "0.0002", "--out"])
+            .arg(out.path().join(dir))
+            .args(more)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        String::from_utf8(run.stdout).unwrap()
+    };
+    run("state-bits", "state-bits", &[]);
+    let state_bits = out.path().join("state-bits");
+    let reused = run("obstacle", "reused", &["--reuse", state_bits.to_str().unwrap()]);
+    assert!(reused.contains("reuse: 4 trials copied from 12 stored"), "{reused}");
+    assert!(reused.contains("8 trials run, 0 skipped, 4 copied"), "{reused}");
+    let ran = run("obstacle", "ran", &[]);
+    assert!(ran.contains("12 trials run, 0 skipped, 0 copied"), "{ran}");
+
+    let (reused, ran) = (out.path().join("reused"), out.path().join("ran"));
+    assert_eq!(files(&reused), files(&ran));
+    for file in files(&ran).iter().filter(|f| f.starts_with("trials/")) {
+        assert_eq!(untimed(&reused.join(file)), untimed(&ran.join(file)), "{}", file.display());
+    }
+    let copy = untimed(&reused.join("trials/8_bits__Original_/trial-01.json"));
+    assert_eq!((copy["experiment"].as_str(), copy["arm"].as_str(), copy["trial"].as_u64()), (Some("obstacle"), Some("8 bits (Original)"), Some(1)));
+    let table = |dir: &Path| untimed_table(&std::fs::read_to_string(dir.join("table.md")).unwrap());
+    assert_eq!(table(&reused), table(&ran));
+
+    // a rerun finds them finished; a run of other settings copies nothing
+    let again = run("obstacle", "reused", &["--reuse", state_bits.to_str().unwrap()]);
+    assert!(again.contains("0 trials run, 12 skipped, 0 copied"), "{again}");
+    let other = run("obstacle", "other-seed", &["--seed", "9", "--reuse", state_bits.to_str().unwrap()]);
+    assert!(other.contains("reuse: 0 trials copied"), "{other}");
 }

@@ -1,6 +1,6 @@
 //! `host experiment`: the thesis' experiments from TOML files ([`spec`]),
 //! planned into seeded trials ([`plan`]), run in parallel and resumable
-//! ([`runner`], [`trial`]), in shards over machines ([`shard`], [`merge`]),
+//! ([`runner`], [`trial`]), reusing other runs' identical trials ([`reuse`]), in shards over machines ([`shard`], [`merge`]),
 //! and reported ([`metric`], [`figures`], [`outputs`], [`pictures`]); the
 //! published trials ([`published`]) render `docs/reproduction.md`
 //! ([`report`], [`template`]).
@@ -13,6 +13,7 @@ pub mod pictures;
 pub mod plan;
 pub mod published;
 pub mod report;
+pub mod reuse;
 pub mod runner;
 pub mod shard;
 pub mod spec;

@@ -1,7 +1,8 @@
-//! Running an experiment: the pre-trainings its unfinished trials need, then
-//! those trials, in parallel (rayon), each result written atomically when it
-//! finishes and skipped on a rerun when its stored config hash matches; then
-//! the reports. A shard ([`Shard`]) runs every N-th trial of the plan, with
+//! Running an experiment: the trials of the same settings that other runs
+//! made copied (`--reuse`, [`ReusableTrials`]), the pre-trainings its
+//! unfinished trials need, then those trials, in parallel (rayon), each
+//! result written atomically when it finishes and skipped on a rerun when
+//! its stored config hash matches; then the reports. A shard ([`Shard`]) runs every N-th trial of the plan, with
 //! the seeds of the whole run, and leaves the reports to `merge`.
 //!
 //! Layout of the output directory:
@@ -12,6 +13,7 @@
 
 use super::outputs;
 use super::plan::{plans, PretrainPlan, TrialPlan, RESULT_FORMAT};
+use super::reuse::ReusableTrials;
 use super::shard::{Shard, ShardManifest};
 use super::spec::ExperimentSpec;
 use super::trial::{self, TrialResult};
@@ -38,12 +40,16 @@ pub struct RunOptions {
     pub threads: Option<usize>,
     /// Run only this share of the trials; `None` for all.
     pub shard: Option<Shard>,
+    /// Other runs' output directories whose trials of the same settings
+    /// are copied instead of run.
+    pub reuse: Vec<PathBuf>,
 }
 
 impl Default for RunOptions {
-    /// 10 trials at full scale, the default directory, seed and threads, unsharded.
+    /// 10 trials at full scale, the default directory, seed and threads,
+    /// unsharded, nothing reused.
     fn default() -> RunOptions {
-        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None, shard: None }
+        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None, shard: None, reuse: Vec::new() }
     }
 }
 
@@ -54,8 +60,10 @@ pub struct RunReport {
     pub dir: PathBuf,
     /// Trials run now.
     pub trials_run: usize,
-    /// Trials found finished and skipped.
+    /// Trials found finished in the output directory and skipped.
     pub trials_skipped: usize,
+    /// Trials copied from other runs (`--reuse`).
+    pub trials_reused: usize,
     /// Pre-trainings run now.
     pub pretrained_run: usize,
     /// Pre-trainings found finished and skipped.
@@ -105,7 +113,9 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
         Some(shard) => Some(ShardManifest::new(spec, shard, options.trials, options.scale, seed).write(&dir)?),
         None => None,
     };
-    let finished: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
+    let mut finished: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
+    let skipped = finished.iter().flatten().count();
+    let trials_reused = copy_reused(&plans, &mut finished, &options.reuse, &dir, log)?;
     let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &finished, &dir, &workers, log)?;
     let (results, trials_run) = run_trials(&plans, finished, &dir, &workers, log)?;
     let outputs = match manifest {
@@ -115,7 +125,8 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
     Ok(RunReport {
         dir,
         trials_run,
-        trials_skipped: plans.len() - trials_run,
+        trials_skipped: skipped,
+        trials_reused,
         pretrained_run,
         pretrained_skipped,
         outputs,
@@ -160,6 +171,31 @@ impl Workers {
             None => job(),
         }
     }
+}
+
+/// Copies into `dir` the unfinished trials that the runs in `reuse` made
+/// with the same settings, and marks them finished; returns how many.
+fn copy_reused(
+    plans: &[TrialPlan],
+    finished: &mut [Option<TrialResult>],
+    reuse: &[PathBuf],
+    dir: &Path,
+    log: Log<'_>,
+) -> Result<usize> {
+    if reuse.is_empty() {
+        return Ok(0);
+    }
+    let reusable = ReusableTrials::load(reuse)?;
+    let mut copied = 0;
+    for (plan, done) in plans.iter().zip(finished.iter_mut()).filter(|(_, f)| f.is_none()) {
+        if let Some(result) = reusable.result_for(plan) {
+            write_result(&trial_path(dir, plan), &result)?;
+            *done = Some(result);
+            copied += 1;
+        }
+    }
+    log(&format!("reuse: {copied} trials copied from {} stored in the --reuse directories", reusable.len()));
+    Ok(copied)
 }
 
 /// Runs each distinct pre-training that an unfinished trial needs and that
@@ -249,9 +285,14 @@ fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
         None => None,
     };
     let result = trial::run(plan, seed_table).with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
-    let json = serde_json::to_vec_pretty(&result).context("cannot encode a trial result")?;
-    crate::atomic::write(&trial_path(dir, plan), &json)?;
+    write_result(&trial_path(dir, plan), &result)?;
     Ok(result)
+}
+
+/// Writes a trial's result file atomically.
+fn write_result(path: &Path, result: &TrialResult) -> Result<()> {
+    let json = serde_json::to_vec_pretty(result).context("cannot encode a trial result")?;
+    crate::atomic::write(path, &json)
 }
 
 /// Where a pre-trained table is stored in an output directory.

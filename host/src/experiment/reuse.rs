@@ -1,0 +1,101 @@
+//! Trials that other runs already made, copied instead of run again
+//! (`host experiment NAME --reuse DIR`).
+//!
+//! A trial's config hash covers everything that determines it (controller,
+//! every setting, seed, pre-training, result format; `plan`), so a stored
+//! result of the same hash in another run's output directory is the result
+//! this run would produce, but for its timing fields. The state-bits and
+//! obstacle experiments, for one, share the arm "8 bits (Original)" in both
+//! columns. A copy takes this run's experiment, arm and trial names; its
+//! `seconds` and `steps_per_second` stay those of the run that made it.
+//!
+//! Layout read: `<DIR>/trials/<arm>/trial-<NN>.json`, as the runner writes
+//! them. Files of another result format, and files that are not trial
+//! results, are passed over (as a rerun passes over stale trials).
+
+use super::plan::{TrialPlan, RESULT_FORMAT};
+use super::trial::TrialResult;
+use anyhow::{bail, Context, Result};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The stored trials of other runs' output directories, by config hash.
+#[derive(Clone, Debug, Default)]
+pub struct ReusableTrials {
+    by_hash: HashMap<String, TrialResult>,
+}
+
+impl ReusableTrials {
+    /// Reads every trial result under each directory's `trials/`. A
+    /// directory that does not exist is an error (a mistyped path would
+    /// otherwise silently run everything); one without trials holds none.
+    pub fn load(dirs: &[PathBuf]) -> Result<ReusableTrials> {
+        let mut by_hash = HashMap::new();
+        for dir in dirs {
+            if !dir.is_dir() {
+                bail!("--reuse {}: not a directory (another run's output directory was expected)", dir.display());
+            }
+            let trials = dir.join("trials");
+            if !trials.is_dir() {
+                continue;
+            }
+            for arm in sorted_entries(&trials)? {
+                if !arm.is_dir() {
+                    continue;
+                }
+                for file in sorted_entries(&arm)? {
+                    if let Some(result) = read_result(&file) {
+                        by_hash.entry(result.config_hash.clone()).or_insert(result);
+                    }
+                }
+            }
+        }
+        Ok(ReusableTrials { by_hash })
+    }
+
+    /// How many distinct trials were found.
+    pub fn len(&self) -> usize {
+        self.by_hash.len()
+    }
+
+    /// Whether none were found.
+    pub fn is_empty(&self) -> bool {
+        self.by_hash.is_empty()
+    }
+
+    /// The stored result of the trial `plan` describes, named as this run's
+    /// (`experiment`, the plan's arm and trial), if one has its hash, seed
+    /// and step count.
+    pub fn result_for(&self, plan: &TrialPlan) -> Option<TrialResult> {
+        let stored = self.by_hash.get(&plan.hash)?;
+        let same = stored.seed == plan.config.seed && stored.steps == plan.config.steps;
+        same.then(|| TrialResult {
+            experiment: plan.experiment.clone(),
+            arm: plan.arm.clone(),
+            trial: plan.trial,
+            ..stored.clone()
+        })
+    }
+}
+
+/// The entries of a directory, sorted, so that the first of two results of
+/// one hash is always the same file.
+fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut entries = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read {}", dir.display()))?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<std::io::Result<Vec<_>>>()
+        .with_context(|| format!("cannot read {}", dir.display()))?;
+    entries.sort();
+    Ok(entries)
+}
+
+/// A trial result of the current format stored at `path`, if it is one.
+fn read_result(path: &Path) -> Option<TrialResult> {
+    if path.extension().is_none_or(|e| e != "json") {
+        return None;
+    }
+    let bytes = std::fs::read(path).ok()?;
+    let result: TrialResult = serde_json::from_slice(&bytes).ok()?;
+    (result.format == RESULT_FORMAT).then_some(result)
+}
