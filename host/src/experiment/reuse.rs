@@ -54,13 +54,8 @@ impl ReusableTrials {
     }
 
     /// How many distinct trials were found.
-    pub fn len(&self) -> usize {
+    pub fn stored(&self) -> usize {
         self.by_hash.len()
-    }
-
-    /// Whether none were found.
-    pub fn is_empty(&self) -> bool {
-        self.by_hash.is_empty()
     }
 
     /// The stored result of the trial `plan` describes, named as this run's

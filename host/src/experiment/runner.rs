@@ -2,8 +2,9 @@
 //! made copied (`--reuse`, [`ReusableTrials`]), the pre-trainings its
 //! unfinished trials need, then those trials, in parallel (rayon), each
 //! result written atomically when it finishes and skipped on a rerun when
-//! its stored config hash matches; then the reports. A shard ([`Shard`]) runs every N-th trial of the plan, with
-//! the seeds of the whole run, and leaves the reports to `merge`.
+//! its stored config hash matches; then the reports. A shard ([`Shard`])
+//! runs every N-th trial of the plan, with the seeds of the whole run, and
+//! leaves the reports to `merge`.
 //!
 //! Layout of the output directory:
 //! - `pretrained/<hash>.ckpt`: pre-trained tables (checkpoints);
@@ -194,7 +195,7 @@ fn copy_reused(
             copied += 1;
         }
     }
-    log(&format!("reuse: {copied} trials copied from {} stored in the --reuse directories", reusable.len()));
+    log(&format!("reuse: {copied} trials copied from {} stored in the --reuse directories", reusable.stored()));
     Ok(copied)
 }
 
