@@ -111,6 +111,8 @@ impl SensorSetup {
 }
 
 /// The model a [`SensorSetup`] built.
+// One per simulation; the disc model, the common one, stays unboxed.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum SelectedSensors {
     /// The thesis' discs.

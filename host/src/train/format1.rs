@@ -79,7 +79,7 @@ impl WorldConfigV1 {
             && w.puck_mass.is_none()
             && w.field_frame.is_none()
             && w.field_sampling == FieldSampling::Nearest;
-        plain.then(|| WorldConfigV1 {
+        plain.then_some(WorldConfigV1 {
             arena_size: w.arena_width,
             robots: w.robots,
             innies: w.innies,

@@ -141,7 +141,7 @@ pub(super) struct WorldConfigV2 {
 
 impl WorldConfigV2 {
     pub(super) fn of(w: &WorldConfig) -> Option<WorldConfigV2> {
-        w.actuation.is_none().then(|| WorldConfigV2 {
+        w.actuation.is_none().then_some(WorldConfigV2 {
             arena_width: w.arena_width,
             arena_height: w.arena_height,
             unit_mm: w.unit_mm,

@@ -304,7 +304,7 @@ impl ReplayReport {
             let stages: Vec<String> = d.stages.iter().map(|s| s.to_string()).collect();
             writeln!(
                 f,
-                "  tick {} at byte {}: {} diverged; {:?} faults {}; raw {:?} values {:?}{} blobs {:?}; state {} (expected {}), action {} (expected {}), motors {:?} (expected {})",
+                "  tick {} at byte {}: {} diverged; {:?} faults {}; raw {:?} values {:?}{} blobs {:?}; state {} (expected {}), action {} (expected {}), motors {:?} (expected {:?})",
                 d.tick,
                 d.offset,
                 stages.join(", "),
@@ -319,7 +319,7 @@ impl ReplayReport {
                 d.action,
                 d.expected_action,
                 d.motors,
-                format!("{:?}", d.expected_motors),
+                d.expected_motors,
             )?;
         }
         Ok(())
