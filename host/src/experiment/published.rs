@@ -6,7 +6,7 @@
 use super::plan::plans_of_format;
 use super::runner::slug;
 use super::spec::ExperimentSpec;
-use super::trial::TrialResult;
+use super::trial::{stored_files, TrialResult};
 use anyhow::{Context, Result};
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -31,25 +31,13 @@ impl Published {
 /// `seed`; a missing directory has none. Unreadable files are errors.
 pub fn load(spec: &ExperimentSpec, dir: &Path, scale: f64, seed: u64) -> Result<Published> {
     let mut out = Published::default();
-    let trials_dir = dir.join("trials");
-    let Ok(entries) = std::fs::read_dir(&trials_dir) else {
-        return Ok(out);
-    };
-    let mut arm_dirs: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.is_dir()).collect();
-    arm_dirs.sort();
     let mut read: Vec<(std::path::PathBuf, String, TrialResult)> = Vec::new();
-    for arm_dir in arm_dirs {
+    for (arm_dir, files) in stored_files(dir)? {
         let name = arm_dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         if !spec.arms.iter().any(|a| slug(&a.name) == name) {
             out.stale.push(format!("{}: no arm of {} has this directory", arm_dir.display(), spec.name));
             continue;
         }
-        let mut files: Vec<_> = std::fs::read_dir(&arm_dir)
-            .with_context(|| format!("cannot list {}", arm_dir.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|e| e == "json"))
-            .collect();
-        files.sort();
         for file in files {
             let bytes = std::fs::read(&file).with_context(|| format!("cannot read {}", file.display()))?;
             let r: TrialResult =

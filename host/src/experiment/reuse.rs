@@ -13,14 +13,14 @@
 //! them. Files of another result format, and files that are not trial
 //! results, are passed over (as a rerun passes over stale trials).
 
-use super::plan::{TrialPlan, RESULT_FORMAT};
-use super::trial::TrialResult;
-use anyhow::{bail, Context, Result};
+use super::plan::TrialPlan;
+use super::trial::{stored_files, TrialResult};
+use anyhow::{bail, Result};
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The stored trials of other runs' output directories, by config hash.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct ReusableTrials {
     by_hash: HashMap<String, TrialResult>,
 }
@@ -35,18 +35,9 @@ impl ReusableTrials {
             if !dir.is_dir() {
                 bail!("--reuse {}: not a directory (another run's output directory was expected)", dir.display());
             }
-            let trials = dir.join("trials");
-            if !trials.is_dir() {
-                continue;
-            }
-            for arm in sorted_entries(&trials)? {
-                if !arm.is_dir() {
-                    continue;
-                }
-                for file in sorted_entries(&arm)? {
-                    if let Some(result) = read_result(&file) {
-                        by_hash.entry(result.config_hash.clone()).or_insert(result);
-                    }
+            for file in stored_files(dir)?.into_iter().flat_map(|(_, files)| files) {
+                if let Some(result) = TrialResult::read_current(&file) {
+                    by_hash.entry(result.config_hash.clone()).or_insert(result);
                 }
             }
         }
@@ -71,26 +62,4 @@ impl ReusableTrials {
             ..stored.clone()
         })
     }
-}
-
-/// The entries of a directory, sorted, so that the first of two results of
-/// one hash is always the same file.
-fn sorted_entries(dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut entries = std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read {}", dir.display()))?
-        .map(|e| e.map(|e| e.path()))
-        .collect::<std::io::Result<Vec<_>>>()
-        .with_context(|| format!("cannot read {}", dir.display()))?;
-    entries.sort();
-    Ok(entries)
-}
-
-/// A trial result of the current format stored at `path`, if it is one.
-fn read_result(path: &Path) -> Option<TrialResult> {
-    if path.extension().is_none_or(|e| e != "json") {
-        return None;
-    }
-    let bytes = std::fs::read(path).ok()?;
-    let result: TrialResult = serde_json::from_slice(&bytes).ok()?;
-    (result.format == RESULT_FORMAT).then_some(result)
 }

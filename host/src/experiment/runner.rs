@@ -13,7 +13,7 @@
 //!   shard, `shard.json` ([`ShardManifest`]).
 
 use super::outputs;
-use super::plan::{plans, PretrainPlan, TrialPlan, RESULT_FORMAT};
+use super::plan::{plans, PretrainPlan, TrialPlan};
 use super::reuse::ReusableTrials;
 use super::shard::{Shard, ShardManifest};
 use super::spec::ExperimentSpec;
@@ -317,7 +317,5 @@ pub fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
 
 /// The stored result of a trial, if it exists and its hash matches.
 pub fn finished(dir: &Path, plan: &TrialPlan) -> Option<TrialResult> {
-    let bytes = std::fs::read(trial_path(dir, plan)).ok()?;
-    let r: TrialResult = serde_json::from_slice(&bytes).ok()?;
-    (r.format == RESULT_FORMAT && r.config_hash == plan.hash).then_some(r)
+    TrialResult::read_current(&trial_path(dir, plan)).filter(|r| r.config_hash == plan.hash)
 }

@@ -10,6 +10,7 @@ use sim::{EpisodeEnd, Simulation, Totals};
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Steps per collision block (the thesis' chapter 6 metric).
@@ -51,6 +52,38 @@ pub struct TrialResult {
     pub steps_per_second: f64,
     /// Wall time of the trial's run.
     pub seconds: f64,
+}
+
+impl TrialResult {
+    /// The result stored at `path`, if the file is a trial result of the
+    /// current format.
+    pub fn read_current(path: &Path) -> Option<TrialResult> {
+        let bytes = std::fs::read(path).ok()?;
+        let result: TrialResult = serde_json::from_slice(&bytes).ok()?;
+        (result.format == RESULT_FORMAT).then_some(result)
+    }
+}
+
+/// The arm directories under `dir/trials/` with their `.json` files, both
+/// sorted; none if there is no such directory.
+pub fn stored_files(dir: &Path) -> Result<Vec<(PathBuf, Vec<PathBuf>)>> {
+    let Ok(entries) = std::fs::read_dir(dir.join("trials")) else {
+        return Ok(Vec::new());
+    };
+    let mut arm_dirs: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.is_dir()).collect();
+    arm_dirs.sort();
+    arm_dirs
+        .into_iter()
+        .map(|arm_dir| {
+            let mut files: Vec<_> = std::fs::read_dir(&arm_dir)
+                .with_context(|| format!("cannot list {}", arm_dir.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|e| e == "json"))
+                .collect();
+            files.sort();
+            Ok((arm_dir, files))
+        })
+        .collect()
 }
 
 /// Follows a run step by step: formation times and collision blocks.
