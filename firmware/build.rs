@@ -30,15 +30,23 @@ fn main() {
     println!("cargo:rerun-if-env-changed=FIRMWARE_HASHER");
     println!("cargo:rerun-if-env-changed=FIRMWARE_ROBOT_ID");
     println!("cargo:rerun-if-changed=build.rs");
-    let root = PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR")).join("..");
+    let root =
+        PathBuf::from(env::var("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"))
+            .join("..");
     let policy = root.join(env::var("FIRMWARE_POLICY").unwrap_or_else(|_| DEFAULT_POLICY.into()));
     println!("cargo:rerun-if-changed={}", policy.display());
 
-    let bytes = fs::read(&policy).unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
-    let blob = PolicyBlob::decode(&bytes).unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
+    let bytes = fs::read(&policy)
+        .unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
+    let blob = PolicyBlob::decode(&bytes)
+        .unwrap_or_else(|e| fail(&format!("policy file {}: {e}", policy.display())));
     let hasher_name = env::var("FIRMWARE_HASHER").unwrap_or_else(|_| DEFAULT_HASHER.into());
-    let expected = StateHasher::from_name(&hasher_name)
-        .unwrap_or_else(|| fail(&format!("FIRMWARE_HASHER={hasher_name} is not a hasher ({})", StateHasher::NAMES)));
+    let expected = StateHasher::from_name(&hasher_name).unwrap_or_else(|| {
+        fail(&format!(
+            "FIRMWARE_HASHER={hasher_name} is not a hasher ({})",
+            StateHasher::NAMES
+        ))
+    });
     if blob.hasher() != expected {
         fail(&format!(
             "policy file {}: its hasher is {} but the firmware is built for {expected}; \
@@ -50,31 +58,85 @@ fn main() {
     }
 
     let robot_id = match env::var("FIRMWARE_ROBOT_ID") {
-        Ok(v) => v.parse::<u8>().unwrap_or_else(|_| fail(&format!("FIRMWARE_ROBOT_ID={v} is not a robot id (0..=255)"))),
+        Ok(v) => v.parse::<u8>().unwrap_or_else(|_| {
+            fail(&format!(
+                "FIRMWARE_ROBOT_ID={v} is not a robot id (0..=255)"
+            ))
+        }),
         Err(_) => 0,
     };
-    let policy_crc = FirmwareIdentity::policy_crc_of(&bytes).unwrap_or_else(|| fail("policy file too short"));
-    let identity = FirmwareIdentity { robot_id, policy_crc }.to_bytes();
+    let policy_crc =
+        FirmwareIdentity::policy_crc_of(&bytes).unwrap_or_else(|| fail("policy file too short"));
+    let identity = FirmwareIdentity {
+        robot_id,
+        policy_crc,
+    }
+    .to_bytes();
 
     let motors = RobotProfile::ZUMO.action_motors(blob.actions());
     let mut out = String::new();
     let hasher = format!("{:?}", blob.hasher());
     let packed = blob.table().packed();
     writeln!(out, "/// Path of the embedded policy blob.").unwrap();
-    writeln!(out, "pub const POLICY_PATH: &str = {:?};", policy.display().to_string()).unwrap();
-    writeln!(out, "/// The embedded policy blob itself (for host tests; not linked into the AVR image).").unwrap();
-    writeln!(out, "pub const POLICY_BLOB: &[u8] = include_bytes!({:?});", policy.display().to_string()).unwrap();
-    writeln!(out, "/// The image's identity record: robot id {robot_id}, policy CRC-32 {policy_crc:#010x}.").unwrap();
-    writeln!(out, "pub const IDENTITY: [u8; shared::FirmwareIdentity::LEN] = {identity:?};").unwrap();
+    writeln!(
+        out,
+        "pub const POLICY_PATH: &str = {:?};",
+        policy.display().to_string()
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "/// The embedded policy blob itself (for host tests; not linked into the AVR image)."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "pub const POLICY_BLOB: &[u8] = include_bytes!({:?});",
+        policy.display().to_string()
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "/// The image's identity record: robot id {robot_id}, policy CRC-32 {policy_crc:#010x}."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "pub const IDENTITY: [u8; shared::FirmwareIdentity::LEN] = {identity:?};"
+    )
+    .unwrap();
     writeln!(out, "/// The policy's state hasher.").unwrap();
-    writeln!(out, "pub const HASHER: shared::StateHasher = shared::StateHasher::{hasher};").unwrap();
-    writeln!(out, "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout).").unwrap();
-    writeln!(out, "pub const POLICY: [u8; {}] = {:?};", packed.len(), packed).unwrap();
+    writeln!(
+        out,
+        "pub const HASHER: shared::StateHasher = shared::StateHasher::{hasher};"
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout)."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "pub const POLICY: [u8; {}] = {:?};",
+        packed.len(),
+        packed
+    )
+    .unwrap();
     writeln!(out, "/// Each action's motor commands and outputs (`shared::RobotProfile::ZUMO.action_motors`).").unwrap();
-    writeln!(out, "pub const MOTORS: shared::ActionMotors = shared::ActionMotors {{").unwrap();
+    writeln!(
+        out,
+        "pub const MOTORS: shared::ActionMotors = shared::ActionMotors {{"
+    )
+    .unwrap();
     write!(out, "    commands: [").unwrap();
     for c in motors.commands {
-        write!(out, "shared::MotorCommand {{ left: {}, right: {} }}, ", c.left, c.right).unwrap();
+        write!(
+            out,
+            "shared::MotorCommand {{ left: {}, right: {} }}, ",
+            c.left, c.right
+        )
+        .unwrap();
     }
     writeln!(out, "],\n    outputs: [").unwrap();
     for o in motors.outputs {

@@ -52,12 +52,17 @@ fn flash_byte(addr: *const u8) -> u8 {
 
 /// The robot id of this build, from the identity record in flash.
 pub fn robot_id() -> u8 {
-    flash_byte(IDENTITY.as_ptr().wrapping_add(shared::FirmwareIdentity::ROBOT_ID_OFFSET))
+    flash_byte(
+        IDENTITY
+            .as_ptr()
+            .wrapping_add(shared::FirmwareIdentity::ROBOT_ID_OFFSET),
+    )
 }
 
 /// The left and right encoders, updated by their interrupts.
 static LEFT_ENCODER: Mutex<Cell<Quadrature>> = Mutex::new(Cell::new(Quadrature::new(false, false)));
-static RIGHT_ENCODER: Mutex<Cell<Quadrature>> = Mutex::new(Cell::new(Quadrature::new(false, false)));
+static RIGHT_ENCODER: Mutex<Cell<Quadrature>> =
+    Mutex::new(Cell::new(Quadrature::new(false, false)));
 
 /// I/O addresses of the pin registers the encoder interrupts read.
 const PINB: *const u8 = 0x23 as *const u8;
@@ -82,12 +87,20 @@ fn encoder_edge(encoder: &Mutex<Cell<Quadrature>>, xor: bool, b: bool) {
 
 #[avr_device::interrupt(atmega32u4)]
 fn PCINT0() {
-    encoder_edge(&LEFT_ENCODER, pin_high(PINB, ENCODER_LEFT_XOR), pin_high(PINE, ENCODER_LEFT_B));
+    encoder_edge(
+        &LEFT_ENCODER,
+        pin_high(PINB, ENCODER_LEFT_XOR),
+        pin_high(PINE, ENCODER_LEFT_B),
+    );
 }
 
 #[avr_device::interrupt(atmega32u4)]
 fn INT6() {
-    encoder_edge(&RIGHT_ENCODER, pin_high(PINE, ENCODER_RIGHT_XOR), pin_high(PINF, ENCODER_RIGHT_B));
+    encoder_edge(
+        &RIGHT_ENCODER,
+        pin_high(PINE, ENCODER_RIGHT_XOR),
+        pin_high(PINF, ENCODER_RIGHT_B),
+    );
 }
 
 /// The flash-resident policy table, readable by the decision.
@@ -119,7 +132,7 @@ const ENCODER_RIGHT_XOR: u8 = pins::ENCODER_RIGHT_XOR.mask(); // on PORTE
 const ENCODER_RIGHT_B: u8 = pins::ENCODER_RIGHT_B.mask(); // on PORTF
 const SCL: u8 = pins::I2C_SCL.mask(); // on PORTD
 const SDA: u8 = pins::I2C_SDA.mask(); // on PORTD
-// Register bits (ATmega32U4 datasheet).
+                                      // Register bits (ATmega32U4 datasheet).
 const TWINT: u8 = 1 << 7;
 const TWEA: u8 = 1 << 6;
 const TWSTA: u8 = 1 << 5;
@@ -163,8 +176,8 @@ impl Board {
         let dp = unsafe { Peripherals::steal() };
         avr_device::asm::wdr();
         dp.CPU.mcusr().write(|w| unsafe { w.bits(0) }); // WDRF forces WDE on until cleared
-        // SAFETY: timed sequence (<= 4 cycles): set WDCE|WDE, then write 0
-        // (interrupts are not enabled yet).
+                                                        // SAFETY: timed sequence (<= 4 cycles): set WDCE|WDE, then write 0
+                                                        // (interrupts are not enabled yet).
         unsafe {
             asm!(
                 "sts 0x60, {ce}",
@@ -177,7 +190,13 @@ impl Board {
         }
         // SAFETY: `take` runs once, so this is the only reference ever made.
         let scales = unsafe { &mut *core::ptr::addr_of_mut!(FIELD_SCALES) };
-        (Board { dp, period_start: 0 }, scales)
+        (
+            Board {
+                dp,
+                period_start: 0,
+            },
+            scales,
+        )
     }
 
     /// Sets up pins, timers, TWI and the USART.
@@ -189,8 +208,12 @@ impl Board {
         // Motors: outputs low; Timer1 mode 8 (phase and frequency correct,
         // TOP = ICR1 = 400), non-inverting OC1A/OC1B, clk/1: 20 kHz.
         // A and the left encoder's XOR pulled up, red LED off, LEDON low.
-        dp.PORTB.portb().write(|w| unsafe { w.bits(BUTTON_A | LED_RED | ENCODER_LEFT_XOR) });
-        dp.PORTB.ddrb().write(|w| unsafe { w.bits(LED_RED | DIR_RIGHT | DIR_LEFT | PWM_RIGHT | PWM_LEFT | EMITTERS) });
+        dp.PORTB
+            .portb()
+            .write(|w| unsafe { w.bits(BUTTON_A | LED_RED | ENCODER_LEFT_XOR) });
+        dp.PORTB.ddrb().write(|w| unsafe {
+            w.bits(LED_RED | DIR_RIGHT | DIR_LEFT | PWM_RIGHT | PWM_LEFT | EMITTERS)
+        });
         dp.TC1.tccr1a().write(|w| unsafe { w.bits(0b1010_0000) });
         dp.TC1.tccr1b().write(|w| unsafe { w.bits(0b0001_0001) });
         dp.TC1.icr1().write(|w| w.set(400));
@@ -206,17 +229,29 @@ impl Board {
         dp.TWI.twcr().write(|w| unsafe { w.bits(TWEN) });
         // Encoders: pulled-up inputs (PORTE, PF0; PB4 above); pin change
         // interrupt on PB4 only, INT6 on any edge.
-        dp.PORTE.porte().write(|w| unsafe { w.bits(ENCODER_LEFT_B | ENCODER_RIGHT_XOR) });
-        dp.PORTF.portf().modify(|r, w| unsafe { w.bits(r.bits() | ENCODER_RIGHT_B) });
-        dp.EXINT.pcmsk0().write(|w| unsafe { w.bits(ENCODER_LEFT_XOR) });
+        dp.PORTE
+            .porte()
+            .write(|w| unsafe { w.bits(ENCODER_LEFT_B | ENCODER_RIGHT_XOR) });
+        dp.PORTF
+            .portf()
+            .modify(|r, w| unsafe { w.bits(r.bits() | ENCODER_RIGHT_B) });
+        dp.EXINT
+            .pcmsk0()
+            .write(|w| unsafe { w.bits(ENCODER_LEFT_XOR) });
         dp.EXINT.pcicr().write(|w| unsafe { w.bits(1) }); // PCIE0
         dp.EXINT.eicrb().write(|w| unsafe { w.bits(0b01 << 4) }); // ISC61..60 = 01: any edge
         dp.EXINT.pcifr().write(|w| unsafe { w.bits(1) });
         dp.EXINT.eifr().write(|w| unsafe { w.bits(1 << 6) });
         dp.EXINT.eimsk().write(|w| unsafe { w.bits(1 << 6) });
         interrupt::free(|cs| {
-            let left = Quadrature::new(pin_high(PINB, ENCODER_LEFT_XOR), pin_high(PINE, ENCODER_LEFT_B));
-            let right = Quadrature::new(pin_high(PINE, ENCODER_RIGHT_XOR), pin_high(PINF, ENCODER_RIGHT_B));
+            let left = Quadrature::new(
+                pin_high(PINB, ENCODER_LEFT_XOR),
+                pin_high(PINE, ENCODER_LEFT_B),
+            );
+            let right = Quadrature::new(
+                pin_high(PINE, ENCODER_RIGHT_XOR),
+                pin_high(PINF, ENCODER_RIGHT_B),
+            );
             LEFT_ENCODER.borrow(cs).set(left);
             RIGHT_ENCODER.borrow(cs).set(right);
         });
@@ -313,23 +348,33 @@ impl Board {
     #[inline(never)]
     pub fn field_sensors(&self) -> [u16; 3] {
         let (f, d) = (&self.dp.PORTF, &self.dp.PORTD);
-        f.portf().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
-        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
-        d.portd().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
-        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
+        f.portf()
+            .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
+        f.ddrf()
+            .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_LEFT | SENSOR_MID) });
+        d.portd()
+            .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
+        d.ddrd()
+            .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
         let t = self.now();
         self.wait_until(t, RC_CHARGE_US.div_ceil(TICK_US) + 1);
-        f.ddrf().modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        f.portf().modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
-        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        f.ddrf()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+        f.portf()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+        d.ddrd()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        d.portd()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
         // Poll: only sample the pins and the timer; `Discharge` notes when a
         // sensor is first seen low and works the times out afterwards.
         let mut discharge = Discharge::start(self.now());
         loop {
             let (pf, pd) = (f.pinf().read().bits(), d.pind().read().bits());
             let now = self.now();
-            let low = u8::from(pf & SENSOR_LEFT == 0) | u8::from(pf & SENSOR_MID == 0) << 1 | u8::from(pd & SENSOR_RIGHT == 0) << 2;
+            let low = u8::from(pf & SENSOR_LEFT == 0)
+                | u8::from(pf & SENSOR_MID == 0) << 1
+                | u8::from(pd & SENSOR_RIGHT == 0) << 2;
             if discharge.sample(now, low) {
                 break;
             }
@@ -347,7 +392,8 @@ impl Board {
         if out.left.dir_high {
             dir |= DIR_LEFT;
         }
-        b.portb().modify(|r, w| unsafe { w.bits((r.bits() & !(DIR_RIGHT | DIR_LEFT)) | dir) });
+        b.portb()
+            .modify(|r, w| unsafe { w.bits((r.bits() & !(DIR_RIGHT | DIR_LEFT)) | dir) });
         self.dp.TC1.ocr1a().write(|w| w.set(out.right.duty));
         self.dp.TC1.ocr1b().write(|w| w.set(out.left.duty));
     }
@@ -361,9 +407,27 @@ impl Board {
     /// Lights the LEDs.
     pub fn leds(&self, leds: Leds) {
         let (b, c, d) = (&self.dp.PORTB, &self.dp.PORTC, &self.dp.PORTD);
-        c.portc().modify(|r, w| unsafe { w.bits(if leds.yellow { r.bits() | LED_YELLOW } else { r.bits() & !LED_YELLOW }) });
-        b.portb().modify(|r, w| unsafe { w.bits(if leds.red { r.bits() & !LED_RED } else { r.bits() | LED_RED }) });
-        d.portd().modify(|r, w| unsafe { w.bits(if leds.green { r.bits() & !BUTTON_B } else { r.bits() | BUTTON_B }) });
+        c.portc().modify(|r, w| unsafe {
+            w.bits(if leds.yellow {
+                r.bits() | LED_YELLOW
+            } else {
+                r.bits() & !LED_YELLOW
+            })
+        });
+        b.portb().modify(|r, w| unsafe {
+            w.bits(if leds.red {
+                r.bits() & !LED_RED
+            } else {
+                r.bits() | LED_RED
+            })
+        });
+        d.portd().modify(|r, w| unsafe {
+            w.bits(if leds.green {
+                r.bits() & !BUTTON_B
+            } else {
+                r.bits() | BUTTON_B
+            })
+        });
     }
 
     /// Sends bytes on USART1 (blocking).
@@ -417,7 +481,10 @@ impl Board {
     }
 
     fn twi_stop(&self) {
-        self.dp.TWI.twcr().write(|w| unsafe { w.bits(TWINT | TWEN | TWSTO) });
+        self.dp
+            .TWI
+            .twcr()
+            .write(|w| unsafe { w.bits(TWINT | TWEN | TWSTO) });
         let start = self.now();
         while self.dp.TWI.twcr().read().bits() & TWSTO != 0 {
             if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
@@ -439,8 +506,10 @@ impl Board {
     fn twi_recover(&self) -> bool {
         let d = &self.dp.PORTD;
         self.dp.TWI.twcr().write(|w| unsafe { w.bits(0) });
-        d.portd().modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
-        d.ddrd().modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
+        d.portd()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
+        d.ddrd()
+            .modify(|r, w| unsafe { w.bits(r.bits() & !(SCL | SDA)) });
         let half_period = || {
             let t = self.now();
             self.wait_until(t, 2);
@@ -490,7 +559,11 @@ impl Board {
         }
         let mut out = [0u8; N];
         for (i, byte) in out.iter_mut().enumerate() {
-            let (ack, expected) = if i + 1 < N { (TWEA, TW_DATA_ACK) } else { (0, TW_DATA_NACK) };
+            let (ack, expected) = if i + 1 < N {
+                (TWEA, TW_DATA_ACK)
+            } else {
+                (0, TW_DATA_NACK)
+            };
             if self.twi_step(TWINT | TWEN | ack)? != expected {
                 return Err(BusError::Unexpected);
             }

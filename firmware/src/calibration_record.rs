@@ -33,7 +33,10 @@ pub enum RecordError {
 pub fn encode(calibration: &FieldCalibration) -> [u8; RECORD_LEN] {
     let mut out = [0u8; RECORD_LEN];
     out[..2].copy_from_slice(&MAGIC);
-    for (chunk, range) in out[2..14].chunks_exact_mut(4).zip(calibration.ranges.iter()) {
+    for (chunk, range) in out[2..14]
+        .chunks_exact_mut(4)
+        .zip(calibration.ranges.iter())
+    {
         chunk[..2].copy_from_slice(&range.bright.to_le_bytes());
         chunk[2..].copy_from_slice(&range.dark.to_le_bytes());
     }
@@ -55,7 +58,8 @@ pub fn decode(bytes: &[u8; RECORD_LEN]) -> Result<FieldCalibration, RecordError>
     for (range, chunk) in ranges.iter_mut().zip(bytes[2..14].chunks_exact(4)) {
         let bright = u16::from_le_bytes([chunk[0], chunk[1]]);
         let dark = u16::from_le_bytes([chunk[2], chunk[3]]);
-        *range = SensorRange::new(bright, dark, CALIBRATION_MIN_SPAN).ok_or(RecordError::Invalid)?;
+        *range =
+            SensorRange::new(bright, dark, CALIBRATION_MIN_SPAN).ok_or(RecordError::Invalid)?;
     }
     Ok(FieldCalibration { ranges })
 }
@@ -67,9 +71,18 @@ mod tests {
     fn sample() -> FieldCalibration {
         FieldCalibration {
             ranges: [
-                SensorRange { bright: 40, dark: 420 },
-                SensorRange { bright: 35, dark: 500 },
-                SensorRange { bright: 50, dark: 380 },
+                SensorRange {
+                    bright: 40,
+                    dark: 420,
+                },
+                SensorRange {
+                    bright: 35,
+                    dark: 500,
+                },
+                SensorRange {
+                    bright: 50,
+                    dark: 380,
+                },
             ],
         }
     }
@@ -88,10 +101,19 @@ mod tests {
             for bit in 0..8 {
                 let mut bad = good;
                 bad[i] ^= 1 << bit;
-                assert_eq!(decode(&bad), Err(RecordError::Corrupt), "byte {i} bit {bit}");
+                assert_eq!(
+                    decode(&bad),
+                    Err(RecordError::Corrupt),
+                    "byte {i} bit {bit}"
+                );
             }
         }
-        let narrow = FieldCalibration { ranges: [SensorRange { bright: 100, dark: 101 }; 3] };
+        let narrow = FieldCalibration {
+            ranges: [SensorRange {
+                bright: 100,
+                dark: 101,
+            }; 3],
+        };
         assert_eq!(decode(&encode(&narrow)), Err(RecordError::Invalid));
     }
 }

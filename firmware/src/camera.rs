@@ -54,7 +54,19 @@ impl Default for Camera {
 impl Camera {
     /// Nothing seen yet.
     pub const fn new() -> Camera {
-        Camera { parser: PixyParser::new(), blocks: [PixyBlock { signature: 0, x: 0, y: 0, width: 0, height: 0, angle: 0 }; PIXY_MAX_BLOCKS], len: 0, age: PIXY_HOLD_PERIODS }
+        Camera {
+            parser: PixyParser::new(),
+            blocks: [PixyBlock {
+                signature: 0,
+                x: 0,
+                y: 0,
+                width: 0,
+                height: 0,
+                angle: 0,
+            }; PIXY_MAX_BLOCKS],
+            len: 0,
+            age: PIXY_HOLD_PERIODS,
+        }
     }
 
     /// One period's read. On a bus error the kept blocks still age.
@@ -113,7 +125,11 @@ mod tests {
 
     impl Script {
         fn new() -> Script {
-            Script { words: VecDeque::new(), error: None, reads: 0 }
+            Script {
+                words: VecDeque::new(),
+                error: None,
+                reads: 0,
+            }
         }
         fn frame(&mut self, blocks: &[PixyBlock]) {
             let mut buf = [0u16; 128];
@@ -136,7 +152,14 @@ mod tests {
     }
 
     fn block(x: u16) -> PixyBlock {
-        PixyBlock { signature: 1, x, y: 150, width: 10, height: 10, angle: 0 }
+        PixyBlock {
+            signature: 1,
+            x,
+            y: 150,
+            width: 10,
+            height: 10,
+            angle: 0,
+        }
     }
 
     #[test]

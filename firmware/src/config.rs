@@ -39,8 +39,12 @@ pub const CALIBRATION_PERIODS: u16 = 3_000;
 pub const CALIBRATION_MIN_SPAN: u16 = 100 / TICK_US;
 /// The calibration used until a valid one exists (the robot does not drive
 /// then; the values in the log are only indicative): the whole timing range.
-pub const UNCALIBRATED: FieldCalibration =
-    FieldCalibration { ranges: [SensorRange { bright: 0, dark: RC_TIMEOUT_TICKS }; 3] };
+pub const UNCALIBRATED: FieldCalibration = FieldCalibration {
+    ranges: [SensorRange {
+        bright: 0,
+        dark: RC_TIMEOUT_TICKS,
+    }; 3],
+};
 /// How Pixy blocks become puck and obstacle bits.
 pub const CAMERA: CameraConfig = CameraConfig::DEFAULT;
 /// EEPROM address of the calibration record.

@@ -67,18 +67,34 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
         policy: &'a P,
         motors: ActionMotors,
     ) -> Self {
-        Decider { scales, camera, hasher, role, policy, motors }
+        Decider {
+            scales,
+            camera,
+            hasher,
+            role,
+            policy,
+            motors,
+        }
     }
 
     /// Decides for one period's raw times and blocks.
     pub fn decide(&self, times: &[u16; 3], blocks: &[PixyBlock]) -> Decision {
         let values = self.scales.values(times);
         let blobs = self.camera.classify(blocks);
-        let state = self.hasher.hash_as(&SensorReading::from_parts(values, blobs), self.role);
+        let state = self
+            .hasher
+            .hash_as(&SensorReading::from_parts(values, blobs), self.role);
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
         let byte = self.policy.byte(PolicyTable::byte_index(masked));
         let action = PolicyTable::action_in_byte(byte, masked);
-        Decision { values, blobs, state, action, command: self.motors.command(action), outputs: self.motors.outputs(action) }
+        Decision {
+            values,
+            blobs,
+            state,
+            action,
+            command: self.motors.command(action),
+            outputs: self.motors.outputs(action),
+        }
     }
 }
 
@@ -100,9 +116,21 @@ mod tests {
         assert_eq!(blob.hasher(), embedded::HASHER);
         assert_eq!(blob.table().packed(), &embedded::POLICY[..]);
         assert_eq!(motors_of(&blob), embedded::MOTORS);
-        let cal = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+        let cal = FieldCalibration {
+            ranges: [SensorRange {
+                bright: 40,
+                dark: 440,
+            }; 3],
+        };
         let scales = cal.scales();
-        let d = Decider::new(&scales, CAMERA, embedded::HASHER, Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
+        let d = Decider::new(
+            &scales,
+            CAMERA,
+            embedded::HASHER,
+            Role::Outie,
+            &embedded::POLICY[..],
+            embedded::MOTORS,
+        );
         // Walk states through readings: every (left < mid, right < mid, mid bin, pucks) combination.
         let k = embedded::HASHER.mid_bits();
         let curve = scales.0[1];
@@ -118,14 +146,36 @@ mod tests {
                 .unwrap_or_else(|| panic!("no whole-tick time reads bin {bin}"));
             for bits in 0..16u8 {
                 // A longer time is darker: reads less than mid.
-                let left_time = if bits & 4 != 0 { mid_time + 1 } else { mid_time };
-                let right_time = if bits & 8 != 0 { mid_time + 1 } else { mid_time };
+                let left_time = if bits & 4 != 0 {
+                    mid_time + 1
+                } else {
+                    mid_time
+                };
+                let right_time = if bits & 8 != 0 {
+                    mid_time + 1
+                } else {
+                    mid_time
+                };
                 let mut blocks = std::vec::Vec::new();
                 if bits & 1 != 0 {
-                    blocks.push(PixyBlock { signature: 1, x: 10, y: 150, width: 5, height: 5, angle: 0 });
+                    blocks.push(PixyBlock {
+                        signature: 1,
+                        x: 10,
+                        y: 150,
+                        width: 5,
+                        height: 5,
+                        angle: 0,
+                    });
                 }
                 if bits & 2 != 0 {
-                    blocks.push(PixyBlock { signature: 1, x: 300, y: 150, width: 5, height: 5, angle: 0 });
+                    blocks.push(PixyBlock {
+                        signature: 1,
+                        x: 300,
+                        y: 150,
+                        width: 5,
+                        height: 5,
+                        angle: 0,
+                    });
                 }
                 let dec = d.decide(&[left_time, mid_time, right_time], &blocks);
                 let expected_state = State(u16::from(bits) | bin << 4);
@@ -140,13 +190,27 @@ mod tests {
     #[test]
     fn uncalibrated_timeouts_are_dark_and_never_panic() {
         let scales = UNCALIBRATED.scales();
-        let d = Decider::new(&scales, CAMERA, embedded::HASHER, Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
+        let d = Decider::new(
+            &scales,
+            CAMERA,
+            embedded::HASHER,
+            Role::Outie,
+            &embedded::POLICY[..],
+            embedded::MOTORS,
+        );
         let dec = d.decide(&[u16::MAX; 3], &[]);
         assert_eq!(dec.values, [FieldValue::ZERO; 3]);
         assert_eq!(dec.state, State(0));
         // A short policy slice reads zeros instead of panicking.
         let scales = UNCALIBRATED.scales();
-        let d = Decider::new(&scales, CAMERA, StateHasher::OriginalObstacle, Role::Outie, &[0u8; 3][..], embedded::MOTORS);
+        let d = Decider::new(
+            &scales,
+            CAMERA,
+            StateHasher::OriginalObstacle,
+            Role::Outie,
+            &[0u8; 3][..],
+            embedded::MOTORS,
+        );
         assert_eq!(d.decide(&[0; 3], &[]).action, ActionId(0));
     }
 }

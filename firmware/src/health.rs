@@ -20,8 +20,16 @@ pub struct Health {
 impl Health {
     /// Records one period; returns the active runtime faults.
     pub fn update(&mut self, camera_ok: bool, sensors_timed_out: bool) -> Faults {
-        self.camera_bad = if camera_ok { 0 } else { self.camera_bad.saturating_add(1) };
-        self.sensors_bad = if sensors_timed_out { self.sensors_bad.saturating_add(1) } else { 0 };
+        self.camera_bad = if camera_ok {
+            0
+        } else {
+            self.camera_bad.saturating_add(1)
+        };
+        self.sensors_bad = if sensors_timed_out {
+            self.sensors_bad.saturating_add(1)
+        } else {
+            0
+        };
         Faults::NONE
             .set(Faults::CAMERA_SILENT, self.camera_bad >= FAULT_PERIODS)
             .set(Faults::SENSORS_TIMEOUT, self.sensors_bad >= FAULT_PERIODS)
@@ -38,7 +46,10 @@ mod tests {
         for _ in 1..FAULT_PERIODS {
             assert_eq!(h.update(false, true), Faults::NONE);
         }
-        assert_eq!(h.update(false, true), Faults::CAMERA_SILENT.with(Faults::SENSORS_TIMEOUT));
+        assert_eq!(
+            h.update(false, true),
+            Faults::CAMERA_SILENT.with(Faults::SENSORS_TIMEOUT)
+        );
         assert_eq!(h.update(true, true), Faults::SENSORS_TIMEOUT);
         assert_eq!(h.update(true, false), Faults::NONE);
         assert_eq!(h.update(false, false), Faults::NONE);

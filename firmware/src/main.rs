@@ -54,8 +54,16 @@ fn main() -> ! {
         let camera_ok = camera.acquire(&mut board).is_ok();
         let plan = supervisor.period(buttons, &times, camera_ok);
 
-        let decider = Decider::new(scales, CAMERA, embedded::HASHER, role, &policy, embedded::MOTORS);
-        let (decision, command) = decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
+        let decider = Decider::new(
+            scales,
+            CAMERA,
+            embedded::HASHER,
+            role,
+            &policy,
+            embedded::MOTORS,
+        );
+        let (decision, command) =
+            decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;

@@ -26,7 +26,10 @@ const B: u8 = 2;
 impl Quadrature {
     /// An encoder whose pins read `xor` and `b`, no counts yet.
     pub const fn new(xor: bool, b: bool) -> Quadrature {
-        Quadrature { levels: Self::levels(xor, b), count: 0 }
+        Quadrature {
+            levels: Self::levels(xor, b),
+            count: 0,
+        }
     }
 
     const fn levels(xor: bool, b: bool) -> u8 {
@@ -42,7 +45,10 @@ impl Quadrature {
         let old = self.levels;
         let up = (new & A) ^ ((old & B) >> 1);
         let down = (old & A) ^ ((new & B) >> 1);
-        self.count = self.count.wrapping_add(i16::from(up)).wrapping_sub(i16::from(down));
+        self.count = self
+            .count
+            .wrapping_add(i16::from(up))
+            .wrapping_sub(i16::from(down));
         self.levels = new;
     }
 
@@ -84,7 +90,10 @@ mod tests {
         q.edge(true, false);
         assert_eq!(q.take(), 0);
         // The counter wraps instead of overflowing.
-        let mut q = Quadrature { count: i16::MAX, ..Quadrature::new(false, false) };
+        let mut q = Quadrature {
+            count: i16::MAX,
+            ..Quadrature::new(false, false)
+        };
         q.edge(true, false);
         assert_eq!(q.take(), i16::MIN);
     }

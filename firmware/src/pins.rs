@@ -74,7 +74,11 @@ pub const LED_YELLOW: Pin = Pin::new(Port::C, 7);
 pub const BUTTON_B_LED_GREEN: Pin = Pin::new(Port::D, 5);
 /// The field sensors, left, mid, right: the front array's DN1 (PF7), DN3
 /// (PF4) and DN5 (PD6), read by RC discharge timing.
-pub const FIELD_SENSORS: [Pin; 3] = [Pin::new(Port::F, 7), Pin::new(Port::F, 4), Pin::new(Port::D, 6)];
+pub const FIELD_SENSORS: [Pin; 3] = [
+    Pin::new(Port::F, 7),
+    Pin::new(Port::F, 4),
+    Pin::new(Port::D, 6),
+];
 
 /// Left encoder, A XOR B, pin-change interrupt PCINT4 (PB4).
 pub const ENCODER_LEFT_XOR: Pin = Pin::new(Port::B, 4);

@@ -44,7 +44,12 @@ enum Expect {
     /// A block's checksum (or a sync: a frame start).
     Checksum { cc: bool },
     /// A block's data words.
-    Data { cc: bool, checksum: u16, words: [u16; 6], len: u8 },
+    Data {
+        cc: bool,
+        checksum: u16,
+        words: [u16; 6],
+        len: u8,
+    },
     /// The sync of the frame's next block.
     NextSync,
 }
@@ -64,7 +69,9 @@ impl Default for PixyParser {
 impl PixyParser {
     /// A parser looking for a frame start.
     pub const fn new() -> PixyParser {
-        PixyParser { expect: Expect::Sync }
+        PixyParser {
+            expect: Expect::Sync,
+        }
     }
 
     /// Feeds one word.
@@ -88,16 +95,37 @@ impl PixyParser {
                 SYNC => (Expect::Checksum { cc: false }, Some(PixyEvent::FrameStart)),
                 SYNC_CC => (Expect::Checksum { cc: true }, Some(PixyEvent::FrameStart)),
                 0 => (Expect::Sync, Some(PixyEvent::Idle)),
-                checksum => (Expect::Data { cc, checksum, words: [0; 6], len: 0 }, None),
+                checksum => (
+                    Expect::Data {
+                        cc,
+                        checksum,
+                        words: [0; 6],
+                        len: 0,
+                    },
+                    None,
+                ),
             },
-            Expect::Data { cc, checksum, mut words, len } => {
+            Expect::Data {
+                cc,
+                checksum,
+                mut words,
+                len,
+            } => {
                 if let Some(slot) = words.get_mut(usize::from(len)) {
                     *slot = word;
                 }
                 let len = len + 1;
                 let needed = if cc { 6 } else { 5 };
                 if len < needed {
-                    (Expect::Data { cc, checksum, words, len }, None)
+                    (
+                        Expect::Data {
+                            cc,
+                            checksum,
+                            words,
+                            len,
+                        },
+                        None,
+                    )
                 } else {
                     (Expect::NextSync, Some(Self::finish(cc, checksum, &words)))
                 }
@@ -116,12 +144,22 @@ impl PixyParser {
 
     fn finish(cc: bool, checksum: u16, words: &[u16; 6]) -> PixyEvent {
         let count = if cc { 6 } else { 5 };
-        let sum = words.iter().take(count).fold(0u16, |s, w| s.wrapping_add(*w));
+        let sum = words
+            .iter()
+            .take(count)
+            .fold(0u16, |s, w| s.wrapping_add(*w));
         if sum != checksum {
             return PixyEvent::BadChecksum;
         }
         let [signature, x, y, width, height, angle] = *words;
-        PixyEvent::Block(PixyBlock { signature, x, y, width, height, angle: if cc { angle as i16 } else { 0 } })
+        PixyEvent::Block(PixyBlock {
+            signature,
+            x,
+            y,
+            width,
+            height,
+            angle: if cc { angle as i16 } else { 0 },
+        })
     }
 }
 
@@ -142,7 +180,10 @@ pub fn encode_frame(blocks: &[PixyBlock], out: &mut [u16]) -> usize {
         let cc = b.signature > 7;
         let mut data = [b.signature, b.x, b.y, b.width, b.height, b.angle as u16];
         let count = if cc { 6 } else { 5 };
-        let checksum = data.iter().take(count).fold(0u16, |s, w| s.wrapping_add(*w));
+        let checksum = data
+            .iter()
+            .take(count)
+            .fold(0u16, |s, w| s.wrapping_add(*w));
         put(if cc { SYNC_CC } else { SYNC });
         put(checksum);
         for w in data.iter_mut().take(count) {
@@ -159,7 +200,14 @@ mod tests {
     use proptest::prelude::*;
 
     fn block(signature: u16, x: u16, y: u16) -> PixyBlock {
-        PixyBlock { signature, x, y, width: 12, height: 9, angle: 0 }
+        PixyBlock {
+            signature,
+            x,
+            y,
+            width: 12,
+            height: 9,
+            angle: 0,
+        }
     }
 
     fn events(words: &[u16]) -> std::vec::Vec<PixyEvent> {
@@ -180,15 +228,34 @@ mod tests {
         words.push(0);
         assert_eq!(
             events(&words),
-            [PixyEvent::FrameStart, PixyEvent::Block(a), PixyEvent::Block(b), PixyEvent::Idle]
+            [
+                PixyEvent::FrameStart,
+                PixyEvent::Block(a),
+                PixyEvent::Block(b),
+                PixyEvent::Idle
+            ]
         );
     }
 
     #[test]
     fn colour_code_blocks_carry_a_signed_angle() {
-        let cc = PixyBlock { signature: 0o12, x: 5, y: 6, width: 7, height: 8, angle: -90 };
+        let cc = PixyBlock {
+            signature: 0o12,
+            x: 5,
+            y: 6,
+            width: 7,
+            height: 8,
+            angle: -90,
+        };
         let words = frame(&[cc, block(1, 1, 2)]);
-        assert_eq!(events(&words), [PixyEvent::FrameStart, PixyEvent::Block(cc), PixyEvent::Block(block(1, 1, 2))]);
+        assert_eq!(
+            events(&words),
+            [
+                PixyEvent::FrameStart,
+                PixyEvent::Block(cc),
+                PixyEvent::Block(block(1, 1, 2))
+            ]
+        );
     }
 
     #[test]
@@ -198,14 +265,22 @@ mod tests {
         words.extend(frame(&[b]));
         assert_eq!(
             events(&words),
-            [PixyEvent::FrameStart, PixyEvent::Block(a), PixyEvent::FrameStart, PixyEvent::Block(b)]
+            [
+                PixyEvent::FrameStart,
+                PixyEvent::Block(a),
+                PixyEvent::FrameStart,
+                PixyEvent::Block(b)
+            ]
         );
     }
 
     #[test]
     fn zero_block_frames_and_silence() {
         assert_eq!(events(&[0, 0]), [PixyEvent::Idle, PixyEvent::Idle]);
-        assert_eq!(events(&[SYNC, SYNC, 0]), [PixyEvent::FrameStart, PixyEvent::Idle]);
+        assert_eq!(
+            events(&[SYNC, SYNC, 0]),
+            [PixyEvent::FrameStart, PixyEvent::Idle]
+        );
     }
 
     #[test]
@@ -213,7 +288,14 @@ mod tests {
         let (a, b) = (block(1, 10, 10), block(2, 30, 40));
         let mut words = frame(&[a, b]);
         words[3] ^= 1; // a's signature
-        assert_eq!(events(&words), [PixyEvent::FrameStart, PixyEvent::BadChecksum, PixyEvent::Block(b)]);
+        assert_eq!(
+            events(&words),
+            [
+                PixyEvent::FrameStart,
+                PixyEvent::BadChecksum,
+                PixyEvent::Block(b)
+            ]
+        );
     }
 
     #[test]
@@ -227,7 +309,15 @@ mod tests {
         let mut words = frame(&[a]);
         words.push(0x4242);
         words.extend(frame(&[a]));
-        assert_eq!(events(&words), [PixyEvent::FrameStart, PixyEvent::Block(a), PixyEvent::FrameStart, PixyEvent::Block(a)]);
+        assert_eq!(
+            events(&words),
+            [
+                PixyEvent::FrameStart,
+                PixyEvent::Block(a),
+                PixyEvent::FrameStart,
+                PixyEvent::Block(a)
+            ]
+        );
     }
 
     proptest! {

@@ -35,7 +35,12 @@ pub struct Discharge {
 impl Discharge {
     /// Starts timing at timer value `now`.
     pub const fn start(now: u16) -> Discharge {
-        Discharge { start: now, seen: 0, firsts: [(0, 0); 3], count: 0 }
+        Discharge {
+            start: now,
+            seen: 0,
+            firsts: [(0, 0); 3],
+            count: 0,
+        }
     }
 
     /// Records one sample: `now` is the timer, bit i of `low` is set when

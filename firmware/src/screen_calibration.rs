@@ -71,7 +71,13 @@ impl Default for ScreenCalibration {
 impl ScreenCalibration {
     /// Armed: nothing seen yet.
     pub const fn new() -> ScreenCalibration {
-        ScreenCalibration { window: [[0; 3]; WINDOW], filled: 0, next: 0, white: None, periods_left: CALIBRATION_PERIODS }
+        ScreenCalibration {
+            window: [[0; 3]; WINDOW],
+            filled: 0,
+            next: 0,
+            white: None,
+            periods_left: CALIBRATION_PERIODS,
+        }
     }
 
     /// Whether a white candidate has been seen.
@@ -85,7 +91,11 @@ impl ScreenCalibration {
         if let Some(slot) = self.window.get_mut(usize::from(self.next)) {
             *slot = *times;
         }
-        self.next = if usize::from(self.next) + 1 >= WINDOW { 0 } else { self.next + 1 };
+        self.next = if usize::from(self.next) + 1 >= WINDOW {
+            0
+        } else {
+            self.next + 1
+        };
         self.filled = self.filled.saturating_add(1).min(WINDOW as u8);
         if let Some(plateau) = self.plateau() {
             match self.white {
@@ -148,7 +158,9 @@ fn sum(times: &[u16; 3]) -> u32 {
 /// [`CALIBRATION_MIN_SPAN`] darker on every sensor.
 fn calibration_of(white: &[u16; 3], black: &[u16; 3]) -> Option<FieldCalibration> {
     let range = |i: usize| SensorRange::new(white[i], black[i], CALIBRATION_MIN_SPAN);
-    Some(FieldCalibration { ranges: [range(0)?, range(1)?, range(2)?] })
+    Some(FieldCalibration {
+        ranges: [range(0)?, range(1)?, range(2)?],
+    })
 }
 
 #[cfg(test)]
@@ -171,7 +183,12 @@ mod tests {
     }
 
     fn expected() -> FieldCalibration {
-        FieldCalibration { ranges: [0, 1, 2].map(|i| SensorRange { bright: WHITE[i], dark: BLACK[i] }) }
+        FieldCalibration {
+            ranges: [0, 1, 2].map(|i| SensorRange {
+                bright: WHITE[i],
+                dark: BLACK[i],
+            }),
+        }
     }
 
     #[test]
@@ -199,11 +216,19 @@ mod tests {
         for i in 0..WINDOW as u16 {
             last = c.add(&[BLACK[0] + i % 3 * 5, BLACK[1], BLACK[2] - i % 2 * 9]);
         }
-        let Progress::Done(cal) = last else { panic!("{last:?}") };
+        let Progress::Done(cal) = last else {
+            panic!("{last:?}")
+        };
         // The brightest stable window's medians: 38 + {0, 1}: 38 (four 0s), 40 + {0, 1, 2}: 41.
-        assert_eq!(cal.ranges.map(|r| r.bright), [WHITE[0], WHITE[1] + 1, WHITE[2]]);
+        assert_eq!(
+            cal.ranges.map(|r| r.bright),
+            [WHITE[0], WHITE[1] + 1, WHITE[2]]
+        );
         // Black's medians: 425 + {0, 5, 10, 0, 5, 10, 0} -> 430; 455 - {0, 9, 0, 9, 0, 9, 0} -> 455.
-        assert_eq!(cal.ranges.map(|r| r.dark), [BLACK[0] + 5, BLACK[1], BLACK[2]]);
+        assert_eq!(
+            cal.ranges.map(|r| r.dark),
+            [BLACK[0] + 5, BLACK[1], BLACK[2]]
+        );
     }
 
     #[test]
@@ -228,7 +253,9 @@ mod tests {
         let timeout = shared::calibration::RC_TIMEOUT_TICKS;
         let mut c = ScreenCalibration::new();
         hold(&mut c, WHITE, 10);
-        let Progress::Done(cal) = hold(&mut c, [timeout; 3], 10) else { panic!() };
+        let Progress::Done(cal) = hold(&mut c, [timeout; 3], 10) else {
+            panic!()
+        };
         assert!(cal.ranges.iter().all(|r| r.dark == timeout));
         assert_eq!(stable_tolerance(0), 2);
         assert_eq!(stable_tolerance(440), 27);

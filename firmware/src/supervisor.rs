@@ -19,7 +19,7 @@
 use crate::health::Health;
 use crate::rc::all_timed_out;
 use crate::screen_calibration::{Progress, ScreenCalibration};
-use shared::{FieldCalibration, Faults, RunMode};
+use shared::{Faults, FieldCalibration, RunMode};
 
 /// Button levels sampled this period (true = pressed).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -143,9 +143,19 @@ impl Supervisor {
                 RunMode::Calibrating => false,
             },
             green: self.mode == RunMode::Calibrating && (!self.calibration.saw_white() || blink(5)),
-            red: if !runtime.is_empty() { blink(5) } else { !self.sticky.is_empty() },
+            red: if !runtime.is_empty() {
+                blink(5)
+            } else {
+                !self.sticky.is_empty()
+            },
         };
-        Plan { mode: self.mode, faults: self.sticky.with(runtime), motors, save, leds }
+        Plan {
+            mode: self.mode,
+            faults: self.sticky.with(runtime),
+            motors,
+            save,
+            leds,
+        }
     }
 }
 
@@ -195,7 +205,9 @@ mod tests {
             p = s.period(NONE, &[RC_TIMEOUT_TICKS; 3], false);
         }
         assert_eq!(p.motors, MotorSource::Stop);
-        assert!(p.faults.contains(Faults::CAMERA_SILENT.with(Faults::SENSORS_TIMEOUT)));
+        assert!(p
+            .faults
+            .contains(Faults::CAMERA_SILENT.with(Faults::SENSORS_TIMEOUT)));
         assert_eq!(p.mode, RunMode::Driving);
         let p = s.period(NONE, &SEEN, true);
         assert_eq!((p.motors, p.faults), (MotorSource::Policy, Faults::NONE));
@@ -205,18 +217,28 @@ mod tests {
     fn white_then_black_calibrates_standing_still_and_enables_driving() {
         let mut s = Supervisor::new(false);
         let mut p = press(&mut s, B);
-        assert_eq!((p.mode, p.motors), (RunMode::Calibrating, MotorSource::Stop));
+        assert_eq!(
+            (p.mode, p.motors),
+            (RunMode::Calibrating, MotorSource::Stop)
+        );
         assert!(p.leds.green);
         let mut periods = 0;
         while p.mode == RunMode::Calibrating {
-            let t = if periods < 20 { 40 } else { 40 + CALIBRATION_MIN_SPAN + 50 };
+            let t = if periods < 20 {
+                40
+            } else {
+                40 + CALIBRATION_MIN_SPAN + 50
+            };
             p = s.period(NONE, &[t; 3], true);
             assert_eq!(p.motors, MotorSource::Stop);
             periods += 1;
         }
         assert_eq!(periods, 20 + crate::screen_calibration::WINDOW);
         let cal = p.save.expect("a calibration to save");
-        assert_eq!((cal.ranges[0].bright, cal.ranges[0].dark), (40, 40 + CALIBRATION_MIN_SPAN + 50));
+        assert_eq!(
+            (cal.ranges[0].bright, cal.ranges[0].dark),
+            (40, 40 + CALIBRATION_MIN_SPAN + 50)
+        );
         assert!(p.faults.is_empty());
         assert_eq!(press(&mut s, A).mode, RunMode::Driving);
     }
@@ -229,7 +251,9 @@ mod tests {
             p = s.period(NONE, &SEEN, true);
         }
         assert_eq!(p.save, None);
-        assert!(p.faults.contains(Faults::CALIBRATION_FAILED.with(Faults::NO_CALIBRATION)));
+        assert!(p
+            .faults
+            .contains(Faults::CALIBRATION_FAILED.with(Faults::NO_CALIBRATION)));
         assert_eq!(press(&mut s, A).mode, RunMode::Idle);
     }
 
@@ -238,6 +262,9 @@ mod tests {
         let mut s = Supervisor::new(true);
         press(&mut s, B);
         let p = press(&mut s, A);
-        assert_eq!((p.mode, p.save, p.faults), (RunMode::Idle, None, Faults::NONE));
+        assert_eq!(
+            (p.mode, p.save, p.faults),
+            (RunMode::Idle, None, Faults::NONE)
+        );
     }
 }

@@ -7,9 +7,27 @@ use host::bench::BenchVariant;
 fn step(c: &mut Criterion) {
     for (name, variant) in [
         ("standard", BenchVariant::default()),
-        ("naive", BenchVariant { naive: true, ..BenchVariant::default() }),
-        ("scale", BenchVariant { scale: true, ..BenchVariant::default() }),
-        ("robot", BenchVariant { robot_senses: true, ..BenchVariant::default() }),
+        (
+            "naive",
+            BenchVariant {
+                naive: true,
+                ..BenchVariant::default()
+            },
+        ),
+        (
+            "scale",
+            BenchVariant {
+                scale: true,
+                ..BenchVariant::default()
+            },
+        ),
+        (
+            "robot",
+            BenchVariant {
+                robot_senses: true,
+                ..BenchVariant::default()
+            },
+        ),
     ] {
         let (mut sim, mut controller) = match variant.scenario().build() {
             Ok(built) => built,
@@ -17,7 +35,9 @@ fn step(c: &mut Criterion) {
         };
         // warm up past the start, where every body is still unsettled
         sim.run(&mut controller, variant.warm_up().max(2000));
-        c.bench_function(&format!("step/{name}"), |b| b.iter(|| sim.step(&mut controller)));
+        c.bench_function(&format!("step/{name}"), |b| {
+            b.iter(|| sim.step(&mut controller))
+        });
     }
 }
 

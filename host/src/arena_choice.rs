@@ -36,7 +36,10 @@ impl FromStr for ArenaChoice {
         } else if s.ends_with(".toml") {
             Ok(ArenaChoice::File(PathBuf::from(s)))
         } else {
-            Err(format!("unknown arena {s:?}: expected thesis, {} or a FILE.toml", ArenaSpec::NAMES))
+            Err(format!(
+                "unknown arena {s:?}: expected thesis, {} or a FILE.toml",
+                ArenaSpec::NAMES
+            ))
         }
     }
 }
@@ -67,9 +70,12 @@ impl fmt::Display for ArenaChoice {
 
 /// Reads and validates a screen arena file; errors name the file.
 pub fn read_arena(path: &Path) -> Result<ArenaSpec> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read arena file {}", path.display()))?;
-    let spec: ArenaSpec = toml::from_str(&text).with_context(|| format!("arena file {} is not valid", path.display()))?;
-    spec.validate().with_context(|| format!("arena file {}", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read arena file {}", path.display()))?;
+    let spec: ArenaSpec = toml::from_str(&text)
+        .with_context(|| format!("arena file {} is not valid", path.display()))?;
+    spec.validate()
+        .with_context(|| format!("arena file {}", path.display()))?;
     Ok(spec)
 }
 
@@ -79,7 +85,8 @@ impl ArenaChoice {
         Ok(match self {
             ArenaChoice::Thesis => Arena::default(),
             ArenaChoice::Named(name) => {
-                let spec = ArenaSpec::by_name(name).with_context(|| format!("unknown arena {name:?}"))?;
+                let spec =
+                    ArenaSpec::by_name(name).with_context(|| format!("unknown arena {name:?}"))?;
                 Arena::Screen(Box::new(spec))
             }
             ArenaChoice::File(path) => Arena::Screen(Box::new(read_arena(path)?)),
@@ -118,9 +125,15 @@ mod tests {
         for s in ["thesis", "tv75", "lab.toml"] {
             assert_eq!(s.parse::<ArenaChoice>().unwrap().to_string(), s);
         }
-        assert_eq!(ArenaChoice::Named("tv75".into()).screen().unwrap(), ArenaSpec::tv75());
+        assert_eq!(
+            ArenaChoice::Named("tv75".into()).screen().unwrap(),
+            ArenaSpec::tv75()
+        );
         let e = ArenaChoice::Thesis.screen().unwrap_err().to_string();
-        assert!(e.contains("--arena thesis") && e.contains("screen arena"), "{e}");
+        assert!(
+            e.contains("--arena thesis") && e.contains("screen arena"),
+            "{e}"
+        );
         let e = "tv55".parse::<ArenaChoice>().unwrap_err();
         assert!(e.contains("\"tv55\"") && e.contains("tv75"), "{e}");
     }
@@ -131,11 +144,17 @@ mod tests {
         let good = dir.path().join("lab.toml");
         std::fs::write(&good, "robots = 4\nscreen_mm = [1428.0, 804.0]\n").unwrap();
         let spec = read_arena(&good).unwrap();
-        assert_eq!((spec.robots, spec.screen_mm, spec.pucks), (4, [1428.0, 804.0], ArenaSpec::tv75().pucks));
+        assert_eq!(
+            (spec.robots, spec.screen_mm, spec.pucks),
+            (4, [1428.0, 804.0], ArenaSpec::tv75().pucks)
+        );
         let bad = dir.path().join("bad.toml");
         std::fs::write(&bad, "display_gamma = 0\n").unwrap();
         let e = format!("{:#}", read_arena(&bad).unwrap_err());
-        assert!(e.contains("bad.toml") && e.contains("arena.display_gamma"), "{e}");
+        assert!(
+            e.contains("bad.toml") && e.contains("arena.display_gamma"),
+            "{e}"
+        );
         std::fs::write(&bad, "robot_radius = 3\n").unwrap();
         let e = format!("{:#}", read_arena(&bad).unwrap_err());
         assert!(e.contains("bad.toml") && e.contains("robot_radius"), "{e}");

@@ -50,7 +50,11 @@ impl BenchVariant {
     /// the disc sensors or random turns with the robot's senses.
     pub fn scenario(&self) -> Scenario {
         let mut s = Scenario {
-            broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
+            broad_phase: if self.naive {
+                BroadPhase::Naive
+            } else {
+                BroadPhase::Grid
+            },
             ..Scenario::default()
         };
         if self.scale {
@@ -94,7 +98,10 @@ impl fmt::Display for BenchReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{:.0} steps/s", self.steps_per_second)?;
         if let Some(bodies) = self.bodies_in_camera_range {
-            write!(f, "\n{bodies:.2} bodies in the camera's range (mean per robot and step)")?;
+            write!(
+                f,
+                "\n{bodies:.2} bodies in the camera's range (mean per robot and step)"
+            )?;
         }
         Ok(())
     }
@@ -112,11 +119,17 @@ pub fn run(variant: &BenchVariant, steps: u64) -> Result<BenchReport> {
     if !variant.robot_senses {
         let start = Instant::now();
         sim.run(&mut controller, steps);
-        return Ok(BenchReport { steps_per_second: rate(steps, start.elapsed()), bodies_in_camera_range: None });
+        return Ok(BenchReport {
+            steps_per_second: rate(steps, start.elapsed()),
+            bodies_in_camera_range: None,
+        });
     }
     let camera = PixyCameraConfig::default();
     let unit_mm = sim.config().world.unit_mm;
-    let range = CameraRange { forward: camera.forward_mm / unit_mm, max_range: camera.max_range_mm / unit_mm };
+    let range = CameraRange {
+        forward: camera.forward_mm / unit_mm,
+        max_range: camera.max_range_mm / unit_mm,
+    };
     let (mut timed, mut seen) = (Duration::ZERO, 0u64);
     for _ in 0..steps {
         let start = Instant::now();
@@ -155,7 +168,9 @@ impl CameraRange {
             world.any_body_near(lens, self.max_range, |row| {
                 for b in row {
                     let reach = self.max_range + b.radius;
-                    seen += u64::from(b.body as usize != i && (b.pos - lens).length_squared() <= reach * reach);
+                    seen += u64::from(
+                        b.body as usize != i && (b.pos - lens).length_squared() <= reach * reach,
+                    );
                 }
                 false
             });
@@ -171,14 +186,20 @@ mod tests {
 
     #[test]
     fn the_robot_benchmark_counts_the_bodies_a_camera_could_see() {
-        let variant = BenchVariant { robot_senses: true, ..BenchVariant::default() };
+        let variant = BenchVariant {
+            robot_senses: true,
+            ..BenchVariant::default()
+        };
         let report = run(&variant, 50).unwrap();
         let bodies = report.bodies_in_camera_range.unwrap();
         // 257 other bodies in the arena; a range of 250 units from the lens
         // covers a good part of it.
         assert!(bodies > 10.0 && bodies < 257.0, "{bodies}");
         assert!(report.to_string().contains("bodies in the camera's range"));
-        let naive = BenchVariant { naive: true, ..variant };
+        let naive = BenchVariant {
+            naive: true,
+            ..variant
+        };
         assert!(run(&naive, 1).unwrap_err().to_string().contains("--naive"));
     }
 
@@ -188,8 +209,20 @@ mod tests {
         let robots = [(Vec2::new(100.0, 100.0), 0.0, sim::RobotKind::Outie)];
         // Lens at 103 (forward 3); range 250: the puck at 362 reaches to
         // 352 (in), the one at 364 only to 354 (out); one behind is in.
-        let world = World::scene(&config, &robots, &[Vec2::new(362.0, 100.0), Vec2::new(364.5, 100.0), Vec2::new(50.0, 100.0)], 1);
-        let range = CameraRange { forward: 3.0, max_range: 250.0 };
+        let world = World::scene(
+            &config,
+            &robots,
+            &[
+                Vec2::new(362.0, 100.0),
+                Vec2::new(364.5, 100.0),
+                Vec2::new(50.0, 100.0),
+            ],
+            1,
+        );
+        let range = CameraRange {
+            forward: 3.0,
+            max_range: 250.0,
+        };
         assert_eq!(range.bodies_seen(&world), 2);
     }
 }

@@ -225,7 +225,10 @@ fn parse_corners(s: &str) -> Result<Corners, String> {
         .collect::<Option<_>>()
         .ok_or_else(|| format!("{s:?}: the corners are 8 numbers x,y,x,y,x,y,x,y"))?;
     let [a, b, c, d, e, f, g, h] = numbers[..] else {
-        return Err(format!("{s:?} has {} numbers: the corners are 8, x,y of 4 points", numbers.len()));
+        return Err(format!(
+            "{s:?} has {} numbers: the corners are 8, x,y of 4 points",
+            numbers.len()
+        ));
     };
     Ok(Corners([[a, b], [c, d], [e, f], [g, h]]))
 }
@@ -340,12 +343,21 @@ impl BenchArgs {
             ArenaChoice::Thesis => None,
             other => Some(other.arena()?),
         };
-        Ok(BenchVariant { naive: self.naive, scale: self.scale, robot_senses: self.sensors == BenchSensors::Robot, arena })
+        Ok(BenchVariant {
+            naive: self.naive,
+            scale: self.scale,
+            robot_senses: self.sensors == BenchSensors::Robot,
+            arena,
+        })
     }
 
     /// Steps to time.
     pub fn steps(&self) -> u64 {
-        let default = if self.sensors == BenchSensors::Robot { host::bench::ROBOT_STEPS } else { 1_000_000 };
+        let default = if self.sensors == BenchSensors::Robot {
+            host::bench::ROBOT_STEPS
+        } else {
+            1_000_000
+        };
         self.steps.unwrap_or(default)
     }
 }
@@ -391,7 +403,8 @@ pub struct FlashArgs {
 }
 
 fn parse_hasher(s: &str) -> Result<StateHasher, String> {
-    StateHasher::from_name(s).ok_or_else(|| format!("{s:?} is not a hasher ({})", StateHasher::NAMES))
+    StateHasher::from_name(s)
+        .ok_or_else(|| format!("{s:?} is not a hasher ({})", StateHasher::NAMES))
 }
 
 /// What to simulate.
@@ -437,14 +450,20 @@ pub struct ScenarioArgs {
 impl ScenarioArgs {
     /// The scenario, with robot sensor and arena files read and checked.
     pub fn scenario(self) -> Result<Scenario> {
-        let arena = self.arena.unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()));
+        let arena = self
+            .arena
+            .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()));
         Ok(Scenario {
             field: self.field,
             controller: self.controller,
             robots: self.robots,
             pucks: self.pucks,
             seed: self.seed,
-            broad_phase: if self.naive { BroadPhase::Naive } else { BroadPhase::Grid },
+            broad_phase: if self.naive {
+                BroadPhase::Naive
+            } else {
+                BroadPhase::Grid
+            },
             arena: arena.arena()?,
             sensors: self.sensors.setup()?,
             noise: self.noise,
@@ -516,7 +535,10 @@ impl TrainArgs {
                 robots: o.robots,
                 pucks: o.pucks,
                 noise: if o.randomise { Some(1.0) } else { o.noise },
-                select: o.select_every.zip(o.select_steps).map(|(every, steps)| SelectConfig { every, steps }),
+                select: o
+                    .select_every
+                    .zip(o.select_steps)
+                    .map(|(every, steps)| SelectConfig { every, steps }),
                 distil_oc: o.distil_oc,
                 seed: o.seed,
                 hasher: o.hasher,
@@ -601,7 +623,6 @@ pub struct TrainOverrideArgs {
     #[arg(long)]
     pub epsilon: Option<f64>,
 }
-
 
 /// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
 #[derive(Clone, Debug, Args)]

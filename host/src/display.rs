@@ -71,7 +71,9 @@ impl Display {
             f64::from(MAX_HOLD_MS) / 1000.0
         );
         let arena = &settings.arena;
-        arena.validate().with_context(|| format!("arena {}", arena.name))?;
+        arena
+            .validate()
+            .with_context(|| format!("arena {}", arena.name))?;
         let image = panel_file::panel_image(arena, &settings.field)?;
         let png = panel_file::encode_png(&image)?;
         let page = PageSettings {
@@ -81,13 +83,21 @@ impl Display {
             hold_ms: hold,
             display_gamma: arena.display_gamma,
         };
-        let settings_json = serde_json::to_string(&page).context("cannot encode the page's settings")?;
-        let listener =
-            TcpListener::bind(settings.bind).with_context(|| format!("cannot listen on {}", settings.bind))?;
-        let address = listener.local_addr().with_context(|| format!("cannot read the address of {}", settings.bind))?;
+        let settings_json =
+            serde_json::to_string(&page).context("cannot encode the page's settings")?;
+        let listener = TcpListener::bind(settings.bind)
+            .with_context(|| format!("cannot listen on {}", settings.bind))?;
+        let address = listener
+            .local_addr()
+            .with_context(|| format!("cannot read the address of {}", settings.bind))?;
         let server = Server::from_listener(listener, None)
             .map_err(|e| anyhow::anyhow!("cannot serve on {address}: {e}"))?;
-        Ok(Display { server, address, png, settings_json })
+        Ok(Display {
+            server,
+            address,
+            png,
+            settings_json,
+        })
     }
 
     /// Where it listens.
@@ -113,20 +123,26 @@ impl Display {
             let text = format!("{} is not served: only GET and HEAD\n", request.method());
             return request.respond(Response::from_string(text).with_status_code(405));
         }
-        let path = request.url().split(['?', '#']).next().unwrap_or("").to_string();
+        let path = request
+            .url()
+            .split(['?', '#'])
+            .next()
+            .unwrap_or("")
+            .to_string();
         let (body, kind) = match path.as_str() {
             "/" | "/index.html" => (PAGE.as_bytes().to_vec(), "text/html; charset=utf-8"),
             "/field.png" => (self.png.clone(), "image/png"),
             "/settings.json" => (self.settings_json.as_bytes().to_vec(), "application/json"),
             _ => {
-                let text = format!("not found: {path} (this server has /, /field.png and /settings.json)\n");
+                let text = format!(
+                    "not found: {path} (this server has /, /field.png and /settings.json)\n"
+                );
                 return request.respond(Response::from_string(text).with_status_code(404));
             }
         };
-        let response = Response::from_data(body).with_header(header("Content-Type", kind)).with_header(header(
-            "Cache-Control",
-            "no-store",
-        ));
+        let response = Response::from_data(body)
+            .with_header(header("Content-Type", kind))
+            .with_header(header("Cache-Control", "no-store"));
         request.respond(response)
     }
 }

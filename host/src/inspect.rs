@@ -9,8 +9,18 @@ pub fn render(blob: &PolicyBlob) -> String {
     let p = blob.provenance();
     let a = blob.actions();
     let _ = writeln!(out, "format     QPOL v{}", PolicyBlob::VERSION);
-    let _ = writeln!(out, "hasher     {} ({} states)", blob.hasher(), blob.hasher().num_states());
-    let _ = writeln!(out, "actions    {:?} rad/step, forward {} units/step", a.angular_speeds(), a.forward_speed());
+    let _ = writeln!(
+        out,
+        "hasher     {} ({} states)",
+        blob.hasher(),
+        blob.hasher().num_states()
+    );
+    let _ = writeln!(
+        out,
+        "actions    {:?} rad/step, forward {} units/step",
+        a.angular_speeds(),
+        a.forward_speed()
+    );
     let _ = writeln!(out, "field      {}", p.field);
     let _ = writeln!(out, "name       {}", p.name);
     let _ = writeln!(out, "trained    {} steps, seed {}", p.trainer_steps, p.seed);
@@ -18,7 +28,11 @@ pub fn render(blob: &PolicyBlob) -> String {
     for (_, action) in blob.table().entries() {
         histogram[action.index()] += 1;
     }
-    let _ = writeln!(out, "histogram  {:?} states per action", &histogram[..a.len()]);
+    let _ = writeln!(
+        out,
+        "histogram  {:?} states per action",
+        &histogram[..a.len()]
+    );
     let _ = writeln!(out);
     let obstacle = blob.hasher() == StateHasher::OriginalObstacle;
     let _ = writeln!(
@@ -27,7 +41,9 @@ pub fn render(blob: &PolicyBlob) -> String {
         if obstacle { "  obsL obsR" } else { "" }
     );
     for (state, action) in blob.table().entries() {
-        let Some(i) = blob.hasher().unpack(state) else { continue };
+        let Some(i) = blob.hasher().unpack(state) else {
+            continue;
+        };
         let flag = |b: bool| if b { "  x  " } else { "  .  " };
         let _ = write!(
             out,
@@ -40,9 +56,19 @@ pub fn render(blob: &PolicyBlob) -> String {
             i.mid_bin
         );
         if obstacle {
-            let _ = write!(out, "  {} {}", flag(i.obstacle_left), flag(i.obstacle_right));
+            let _ = write!(
+                out,
+                "  {} {}",
+                flag(i.obstacle_left),
+                flag(i.obstacle_right)
+            );
         }
-        let _ = writeln!(out, "  {:>6}  {:+.3}", action.0, a.angular(action).unwrap_or(f32::NAN));
+        let _ = writeln!(
+            out,
+            "  {:>6}  {:+.3}",
+            action.0,
+            a.angular(action).unwrap_or(f32::NAN)
+        );
     }
     out
 }

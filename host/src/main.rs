@@ -4,7 +4,9 @@ mod cli;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use cli::{Cli, Command, ExperimentAction, ExperimentArgs, FieldCommand, MonitorArgs, PolicyCommand};
+use cli::{
+    Cli, Command, ExperimentAction, ExperimentArgs, FieldCommand, MonitorArgs, PolicyCommand,
+};
 use host::run_summary::run_timed;
 use sim::render::RenderOptions;
 use std::io::Write;
@@ -38,17 +40,32 @@ fn end_quietly_on_a_closed_pipe() {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Run { scenario, steps, json } => {
+        Command::Run {
+            scenario,
+            steps,
+            json,
+        } => {
             let (mut sim, mut controller) = scenario.scenario()?.build()?;
             let summary = run_timed(&mut sim, &mut controller, steps);
             if json {
-                println!("{}", serde_json::to_string(&summary).context("cannot encode the summary")?);
+                println!(
+                    "{}",
+                    serde_json::to_string(&summary).context("cannot encode the summary")?
+                );
             } else {
                 println!("{summary}");
             }
             Ok(())
         }
-        Command::Render { scenario, steps, out, gif, every, size, footprints } => {
+        Command::Render {
+            scenario,
+            steps,
+            out,
+            gif,
+            every,
+            size,
+            footprints,
+        } => {
             let (mut sim, mut controller) = scenario.scenario()?.build()?;
             let options = RenderOptions { size, footprints };
             if let Some(path) = gif {
@@ -88,30 +105,54 @@ fn run(cli: Cli) -> Result<()> {
             let report = replay_files(&args.log, &args.policy, args.visits.as_deref(), settings)?;
             if let Some(path) = &args.fit_profile {
                 let file = odometry::merge_into_file(path, &report.motion)?;
-                eprintln!("replay: wrote {} ({} robots)", path.display(), file.robots.len());
+                eprintln!(
+                    "replay: wrote {} ({} robots)",
+                    path.display(),
+                    file.robots.len()
+                );
             }
             let text = if args.json {
                 serde_json::to_string(&report).context("cannot encode the report")? + "\n"
             } else {
                 report.to_string()
             };
-            std::io::stdout().write_all(text.as_bytes()).context("cannot write the report")
+            std::io::stdout()
+                .write_all(text.as_bytes())
+                .context("cannot write the report")
         }
         Command::Flash(args) => {
             use host::robot::flash;
             let cwd = std::env::current_dir().context("cannot read the current directory")?;
-            let plan = flash::FlashPlan::new(&args.policy, args.hasher, args.port, args.repo.as_deref(), &cwd)?
-                .for_robot(args.robot_id);
+            let plan = flash::FlashPlan::new(
+                &args.policy,
+                args.hasher,
+                args.port,
+                args.repo.as_deref(),
+                &cwd,
+            )?
+            .for_robot(args.robot_id);
             if args.dry_run {
-                return std::io::stdout().write_all(plan.describe().as_bytes()).context("cannot write the commands");
+                return std::io::stdout()
+                    .write_all(plan.describe().as_bytes())
+                    .context("cannot write the commands");
             }
             let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
-            flash::flash(&plan, avrdude.as_deref(), flash::PORT_WAIT, &mut std::io::stdout())
+            flash::flash(
+                &plan,
+                avrdude.as_deref(),
+                flash::PORT_WAIT,
+                &mut std::io::stdout(),
+            )
         }
         Command::Field(FieldCommand::Export(args)) => {
             let arena = args.screen.arena.screen()?;
             let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
-            println!("wrote {} ({w} x {h}: {} on {})", args.out.display(), args.screen.field, arena.name);
+            println!(
+                "wrote {} ({w} x {h}: {} on {})",
+                args.out.display(),
+                args.screen.field,
+                arena.name
+            );
             Ok(())
         }
         Command::Display(args) => {
@@ -121,7 +162,9 @@ fn run(cli: Cli) -> Result<()> {
             println!("display: serving {url}");
             println!("  field: {url}   calibration: {url}?mode=calibrate   grey patches: {url}?mode=grey");
             println!("  keys: c calibration, f field, g grey patches, Enter or click full-screen, h help; Ctrl-C stops");
-            std::io::stdout().flush().context("cannot write to stdout")?;
+            std::io::stdout()
+                .flush()
+                .context("cannot write to stdout")?;
             display.serve();
             Ok(())
         }
@@ -133,13 +176,21 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 observation.to_string()
             };
-            std::io::stdout().write_all(text.as_bytes()).context("cannot write the observation")
+            std::io::stdout()
+                .write_all(text.as_bytes())
+                .context("cannot write the observation")
         }
     }
 }
 
 fn experiment(args: ExperimentArgs) -> Result<()> {
-    let paths = |paths: &[std::path::PathBuf]| paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ");
+    let paths = |paths: &[std::path::PathBuf]| {
+        paths
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
     match args.action {
         Some(ExperimentAction::Merge { dirs, out }) => {
             let report = host::experiment::merge::merge(&dirs, out.as_deref())?;
@@ -153,7 +204,12 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             );
             Ok(())
         }
-        Some(ExperimentAction::Report { docs, check, scale, documents }) => {
+        Some(ExperimentAction::Report {
+            docs,
+            check,
+            scale,
+            documents,
+        }) => {
             let log = |line: &str| eprintln!("{line}");
             let documents = host::experiment::report::documents(&documents)?;
             if check {
@@ -200,11 +256,20 @@ fn monitor(args: MonitorArgs) -> Result<()> {
     let mut log = host::robot::log_file::LogWriter::create(&out, args.append)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
-    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst)).context("cannot install the Ctrl-C handler")?;
+    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
+        .context("cannot install the Ctrl-C handler")?;
     let mut printer = StatusPrinter::new(std::io::stderr(), &port);
-    let options = MonitorOptions { max_frames: args.frames, ..MonitorOptions::default() };
-    let mut opener = SerialOpener { port, baud: args.baud };
-    let status = monitor::run(&mut opener, &mut log, &options, &stop, &mut |e| printer.show(&e))?;
+    let options = MonitorOptions {
+        max_frames: args.frames,
+        ..MonitorOptions::default()
+    };
+    let mut opener = SerialOpener {
+        port,
+        baud: args.baud,
+    };
+    let status = monitor::run(&mut opener, &mut log, &options, &stop, &mut |e| {
+        printer.show(&e)
+    })?;
     printer.finish(&status);
     Ok(())
 }

@@ -21,8 +21,11 @@ pub fn panel_image(arena: &ArenaSpec, source: &FieldSource) -> Result<GrayImage>
 /// `image` encoded as a PNG.
 pub fn encode_png(image: &GrayImage) -> Result<Vec<u8>> {
     let mut bytes = Vec::new();
-    let encoder = PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Adaptive);
-    image.write_with_encoder(encoder).context("cannot encode the panel image as PNG")?;
+    let encoder =
+        PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Adaptive);
+    image
+        .write_with_encoder(encoder)
+        .context("cannot encode the panel image as PNG")?;
     Ok(bytes)
 }
 
@@ -42,12 +45,18 @@ mod tests {
     fn an_exported_panel_reads_back_as_the_simulators_image() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("panel.png");
-        let arena = ArenaSpec { screen_px: [96, 54], ..ArenaSpec::tv75() };
+        let arena = ArenaSpec {
+            screen_px: [96, 54],
+            ..ArenaSpec::tv75()
+        };
         let source = FieldSource::Letter(sim::Letter::T);
         assert_eq!(export(&arena, &source, &out).unwrap(), (96, 54));
         let back = image::open(&out).unwrap();
         assert_eq!(back.color(), image::ColorType::L8);
-        assert_eq!(back.into_luma8(), sim::panel::panel_image(&arena, &source.load_for(&arena).unwrap()));
+        assert_eq!(
+            back.into_luma8(),
+            sim::panel::panel_image(&arena, &source.load_for(&arena).unwrap())
+        );
         let missing = FieldSource::Image("/no/such/field.png".into());
         let e = format!("{:#}", export(&arena, &missing, &out).unwrap_err());
         assert!(e.contains("/no/such/field.png"), "{e}");

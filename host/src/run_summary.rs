@@ -2,9 +2,9 @@
 //! measured speed.
 
 use serde::Serialize;
+use sim::control::Controller;
 use sim::sensor_model::SensorModel;
 use sim::simulation::{Simulation, Totals};
-use sim::control::Controller;
 use std::fmt;
 use std::time::Instant;
 
@@ -33,7 +33,11 @@ impl RunSummary {
             stuck: totals.stuck,
             collisions_per_1000: totals.collisions_per_1000(),
             mean_eval: totals.mean_eval(),
-            steps_per_second: if seconds > 0.0 { totals.steps as f64 / seconds } else { f64::INFINITY },
+            steps_per_second: if seconds > 0.0 {
+                totals.steps as f64 / seconds
+            } else {
+                f64::INFINITY
+            },
         }
     }
 }
@@ -50,7 +54,11 @@ impl fmt::Display for RunSummary {
 }
 
 /// Runs `steps` steps and summarises them with the measured speed.
-pub fn run_timed<S: SensorModel, C: Controller + ?Sized>(sim: &mut Simulation<S>, controller: &mut C, steps: u64) -> RunSummary {
+pub fn run_timed<S: SensorModel, C: Controller + ?Sized>(
+    sim: &mut Simulation<S>,
+    controller: &mut C,
+    steps: u64,
+) -> RunSummary {
     let start = Instant::now();
     sim.run(controller, steps);
     RunSummary::new(sim.totals(), start.elapsed().as_secs_f64())

@@ -9,8 +9,8 @@
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use sim::robot_sensors::RobotSensorConfig;
 use sim::config::SimConfig;
+use sim::robot_sensors::RobotSensorConfig;
 use sim::sensor_setup::{SelectedSensors, SensorSetup};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -37,7 +37,10 @@ impl FromStr for SensorChoice {
 
     fn from_str(s: &str) -> Result<SensorChoice, String> {
         if let Some(mix) = s.strip_prefix("mix:") {
-            let parts = mix.split('+').map(str::parse).collect::<Result<Vec<SensorChoice>, String>>()?;
+            let parts = mix
+                .split('+')
+                .map(str::parse)
+                .collect::<Result<Vec<SensorChoice>, String>>()?;
             return match <[SensorChoice; 2]>::try_from(parts.clone()) {
                 Ok([field, objects]) => Ok(SensorChoice::Mixed(Box::new([field, objects.clone(), objects]))),
                 Err(_) => <[SensorChoice; 3]>::try_from(parts).map(|p| SensorChoice::Mixed(Box::new(p))).map_err(|_| {
@@ -88,11 +91,13 @@ impl fmt::Display for SensorChoice {
 
 /// Reads and validates a robot sensor config file; errors name the file.
 pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read robot sensor config {}", path.display()))?;
-    let config: RobotSensorConfig =
-        serde_json::from_str(&text).with_context(|| format!("robot sensor config {} is not valid", path.display()))?;
-    config.validate().with_context(|| format!("robot sensor config {}", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read robot sensor config {}", path.display()))?;
+    let config: RobotSensorConfig = serde_json::from_str(&text)
+        .with_context(|| format!("robot sensor config {} is not valid", path.display()))?;
+    config
+        .validate()
+        .with_context(|| format!("robot sensor config {}", path.display()))?;
     Ok(config)
 }
 
@@ -103,7 +108,9 @@ impl SensorChoice {
             SensorChoice::Disc => SensorSetup::Disc,
             SensorChoice::DiscThesis => SensorSetup::DiscThesis,
             SensorChoice::Robot(None) => SensorSetup::Robot(Box::default()),
-            SensorChoice::Robot(Some(path)) => SensorSetup::Robot(Box::new(read_robot_config(path)?)),
+            SensorChoice::Robot(Some(path)) => {
+                SensorSetup::Robot(Box::new(read_robot_config(path)?))
+            }
             SensorChoice::Mixed(parts) => SensorSetup::Mixed {
                 field: Box::new(parts[0].setup()?),
                 pucks: Box::new(parts[1].setup()?),
@@ -133,16 +140,32 @@ mod tests {
 
     #[test]
     fn choices_parse_print_and_errors_name_the_input() {
-        for s in ["disc", "disc-thesis", "robot", "robot:cam.json", "mix:robot+disc+disc-thesis", "mix:disc+robot:cam.json+disc"] {
+        for s in [
+            "disc",
+            "disc-thesis",
+            "robot",
+            "robot:cam.json",
+            "mix:robot+disc+disc-thesis",
+            "mix:disc+robot:cam.json+disc",
+        ] {
             assert_eq!(s.parse::<SensorChoice>().unwrap().to_string(), s);
         }
-        assert_eq!("mix:robot+disc".parse::<SensorChoice>().unwrap().to_string(), "mix:robot+disc+disc");
+        assert_eq!(
+            "mix:robot+disc"
+                .parse::<SensorChoice>()
+                .unwrap()
+                .to_string(),
+            "mix:robot+disc+disc"
+        );
         let e = "pixy".parse::<SensorChoice>().unwrap_err();
         assert!(e.contains("\"pixy\""), "{e}");
         assert!("robot:".parse::<SensorChoice>().is_err());
         let e = "mix:robot".parse::<SensorChoice>().unwrap_err();
         assert!(e.contains("mix:FIELD+PUCKS+OBSTACLES"), "{e}");
-        assert!("mix:robot+sonar".parse::<SensorChoice>().unwrap_err().contains("\"sonar\""));
+        assert!("mix:robot+sonar"
+            .parse::<SensorChoice>()
+            .unwrap_err()
+            .contains("\"sonar\""));
     }
 
     #[test]
@@ -154,8 +177,14 @@ mod tests {
         let bad = dir.path().join("bad.json");
         std::fs::write(&bad, r#"{"camera": {"height_mm": 0}}"#).unwrap();
         let e = format!("{:#}", read_robot_config(&bad).unwrap_err());
-        assert!(e.contains("bad.json") && e.contains("camera.height_mm"), "{e}");
-        let e = format!("{:#}", read_robot_config(&dir.path().join("none.json")).unwrap_err());
+        assert!(
+            e.contains("bad.json") && e.contains("camera.height_mm"),
+            "{e}"
+        );
+        let e = format!(
+            "{:#}",
+            read_robot_config(&dir.path().join("none.json")).unwrap_err()
+        );
         assert!(e.contains("none.json"), "{e}");
     }
 }

@@ -15,15 +15,40 @@ fn fails(args: &[&str]) -> String {
 
 #[test]
 fn run_prints_one_json_object_with_the_summary_keys() {
-    let out = host().args(["run", "--steps", "2000", "--json", "--seed", "3"]).output().unwrap();
+    let out = host()
+        .args(["run", "--steps", "2000", "--json", "--seed", "3"])
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for key in ["formations", "stuck", "collisions_per_1000", "mean_eval", "steps_per_second"] {
-        assert!(v.get(key).is_some_and(|x| x.is_number()), "missing {key}: {v}");
+    for key in [
+        "formations",
+        "stuck",
+        "collisions_per_1000",
+        "mean_eval",
+        "steps_per_second",
+    ] {
+        assert!(
+            v.get(key).is_some_and(|x| x.is_number()),
+            "missing {key}: {v}"
+        );
     }
-    let text = host().args(["run", "--steps", "500", "--controller", "random", "--field", "letter:L"]).output().unwrap();
+    let text = host()
+        .args([
+            "run",
+            "--steps",
+            "500",
+            "--controller",
+            "random",
+            "--field",
+            "letter:L",
+        ])
+        .output()
+        .unwrap();
     assert!(text.status.success());
-    assert!(String::from_utf8(text.stdout).unwrap().contains("formations"));
+    assert!(String::from_utf8(text.stdout)
+        .unwrap()
+        .contains("formations"));
 }
 
 #[test]
@@ -41,7 +66,10 @@ fn bad_inputs_are_rejected_with_the_offending_value() {
     let garbage = dir.path().join("garbage.png");
     std::fs::write(&garbage, b"not an image").unwrap();
     let e = fails(&["run", "--steps", "10", "--field", garbage.to_str().unwrap()]);
-    assert!(e.contains("garbage.png") && e.contains("cannot load field image"), "{e}");
+    assert!(
+        e.contains("garbage.png") && e.contains("cannot load field image"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -50,19 +78,37 @@ fn render_writes_a_png_and_a_gif() {
     let png = dir.path().join("world.png");
     let gif = dir.path().join("episode.gif");
     let ok = host()
-        .args(["render", "--steps", "50", "--size", "200", "--footprints", "--out"])
+        .args([
+            "render",
+            "--steps",
+            "50",
+            "--size",
+            "200",
+            "--footprints",
+            "--out",
+        ])
         .arg(&png)
         .output()
         .unwrap();
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     let img = image::open(&png).unwrap();
     assert_eq!((img.width(), img.height()), (200, 200));
     let ok = host()
-        .args(["render", "--steps", "200", "--every", "100", "--size", "100", "--gif"])
+        .args([
+            "render", "--steps", "200", "--every", "100", "--size", "100", "--gif",
+        ])
         .arg(&gif)
         .output()
         .unwrap();
-    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
 }
 
@@ -81,7 +127,11 @@ fn host_run_takes_the_robot_sensor_model_and_names_a_bad_config() {
         .args(["run", "--sensors", "robot", "--steps", "300", "--json"])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(v.get("mean_eval").is_some_and(|x| x.is_number()));
 
@@ -89,12 +139,21 @@ fn host_run_takes_the_robot_sensor_model_and_names_a_bad_config() {
     let config = dir.path().join("robot.json");
     std::fs::write(&config, r#"{"camera": {"fov_h_deg": 200}}"#).unwrap();
     let out = host()
-        .args(["run", "--sensors", &format!("robot:{}", config.display()), "--steps", "10"])
+        .args([
+            "run",
+            "--sensors",
+            &format!("robot:{}", config.display()),
+            "--steps",
+            "10",
+        ])
         .output()
         .unwrap();
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(!out.status.success());
-    assert!(err.contains("robot.json") && err.contains("camera.fov_h_deg = 200"), "{err}");
+    assert!(
+        err.contains("robot.json") && err.contains("camera.fov_h_deg = 200"),
+        "{err}"
+    );
     let out = host().args(["run", "--sensors", "sonar"]).output().unwrap();
     assert!(String::from_utf8(out.stderr).unwrap().contains("\"sonar\""));
 }
@@ -103,7 +162,10 @@ fn host_run_takes_the_robot_sensor_model_and_names_a_bad_config() {
 fn output_into_a_closed_pipe_ends_quietly_without_a_panic() {
     let (reader, writer) = std::io::pipe().unwrap();
     drop(reader);
-    let policy = concat!(env!("CARGO_MANIFEST_DIR"), "/../policies/oc-heuristic.policy");
+    let policy = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../policies/oc-heuristic.policy"
+    );
     let out = std::process::Command::new(assert_cmd::cargo::cargo_bin("host"))
         .args(["policy", "inspect", policy])
         .stdout(writer)

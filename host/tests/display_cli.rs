@@ -52,8 +52,15 @@ fn display(args: &[&str]) -> Display {
     let mut stdout = BufReader::new(child.stdout.take().unwrap());
     let mut first = String::new();
     stdout.read_line(&mut first).unwrap();
-    let url = first.trim().strip_prefix("display: serving ").unwrap_or_else(|| panic!("first line: {first:?}"));
-    Display { url: url.to_string(), child, _stdout: stdout }
+    let url = first
+        .trim()
+        .strip_prefix("display: serving ")
+        .unwrap_or_else(|| panic!("first line: {first:?}"));
+    Display {
+        url: url.to_string(),
+        child,
+        _stdout: stdout,
+    }
 }
 
 /// Headless Chromium, or a failure saying what to install.
@@ -99,9 +106,19 @@ fn browse(url: &str, (width, height): (u32, u32), budget_ms: u32, take: Take) ->
         Take::Screenshot(path) => command.arg(format!("--screenshot={}", path.display())),
         Take::Dom => command.arg("--dump-dom"),
     };
-    let mut child = command.arg(url).stdout(Stdio::piped()).stderr(Stdio::null()).spawn().expect("cannot start chromium");
+    let mut child = command
+        .arg(url)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start chromium");
     let mut out = String::new();
-    child.stdout.take().unwrap().read_to_string(&mut out).unwrap();
+    child
+        .stdout
+        .take()
+        .unwrap()
+        .read_to_string(&mut out)
+        .unwrap();
     // A guard against a browser that hangs, not a measurement.
     let deadline = Instant::now() + Duration::from_secs(120);
     loop {
@@ -122,7 +139,11 @@ fn screenshot(url: &str, size: (u32, u32), budget_ms: u32) -> RgbImage {
     let path = dir.path().join("shot.png");
     browse(url, size, budget_ms, Take::Screenshot(&path));
     let shot = image::open(&path).unwrap().into_rgb8();
-    assert_eq!(shot.dimensions(), size, "the screenshot is not the panel's size");
+    assert_eq!(
+        shot.dimensions(),
+        size,
+        "the screenshot is not the panel's size"
+    );
     shot
 }
 
@@ -137,7 +158,12 @@ fn attribute(dom: &str, name: &str) -> Option<String> {
 /// Writes the panel image with `host field export` and reads it as RGB.
 fn export(dir: &Path, args: &[&str]) -> RgbImage {
     let out = dir.join("panel.png");
-    let status = Command::new(HOST).args(["field", "export", "--out"]).arg(&out).args(args).status().unwrap();
+    let status = Command::new(HOST)
+        .args(["field", "export", "--out"])
+        .arg(&out)
+        .args(args)
+        .status()
+        .unwrap();
     assert!(status.success(), "host field export {args:?}");
     image::open(&out).unwrap().into_rgb8()
 }
@@ -157,7 +183,10 @@ fn differences(a: &RgbImage, b: &RgbImage) -> (usize, Option<(u32, u32)>) {
 
 fn assert_same(shot: &RgbImage, expected: &RgbImage, what: &str) {
     let (count, first) = differences(shot, expected);
-    assert_eq!(count, 0, "{what}: {count} pixels differ, the first at {first:?}");
+    assert_eq!(
+        count, 0,
+        "{what}: {count} pixels differ, the first at {first:?}"
+    );
 }
 
 fn uniform(img: &RgbImage, level: u8) -> bool {
@@ -184,7 +213,11 @@ fn a_pre_compensated_letter_on_a_small_screen_is_shown_pixel_for_pixel() {
     // middle values brighter than 255 v (v^(2.2 / 1.8) > v).
     assert!(expected.pixels().any(|p| p.0 == [255; 3]) && expected.pixels().any(|p| p.0 == [0; 3]));
     let server = display(&["--arena", arena, "--field", "letter:T"]);
-    assert_same(&screenshot(&server.url, (640, 360), 500), &expected, "small, letter:T");
+    assert_same(
+        &screenshot(&server.url, (640, 360), 500),
+        &expected,
+        "small, letter:T",
+    );
 }
 
 #[test]
@@ -197,7 +230,11 @@ fn the_calibration_sequence_holds_white_then_black_then_shows_the_field() {
 
     // The page's own record, in virtual time: each screen and when it began.
     let dom = browse(&url, (640, 360), 6000, Take::Dom);
-    assert_eq!(attribute(&dom, "data-ready").as_deref(), Some("true"), "{dom}");
+    assert_eq!(
+        attribute(&dom, "data-ready").as_deref(),
+        Some("true"),
+        "{dom}"
+    );
     let log = attribute(&dom, "data-log").expect("the page reports its screens");
     let screens: Vec<(&str, f64)> = log
         .split(' ')
@@ -206,19 +243,33 @@ fn the_calibration_sequence_holds_white_then_black_then_shows_the_field() {
             (screen, at.parse().unwrap())
         })
         .collect();
-    assert_eq!(screens.iter().map(|s| s.0).collect::<Vec<_>>(), ["white", "black", "field"], "{log}");
+    assert_eq!(
+        screens.iter().map(|s| s.0).collect::<Vec<_>>(),
+        ["white", "black", "field"],
+        "{log}"
+    );
     let (white, black) = (screens[1].1 - screens[0].1, screens[2].1 - screens[1].1);
     // The page times both switches from the sequence's start; its clock
     // reads to a tenth of a millisecond, so a hold may read 0.1 ms short.
     for (name, held) in [("white", white), ("black", black)] {
-        assert!((1499.5..1520.0).contains(&held), "{name} held {held} ms, not the 1.5 s asked: {log}");
+        assert!(
+            (1499.5..1520.0).contains(&held),
+            "{name} held {held} ms, not the 1.5 s asked: {log}"
+        );
     }
-    assert!(screens[0].1 < 1.0, "white did not start the sequence: {log}");
+    assert!(
+        screens[0].1 < 1.0,
+        "white did not start the sequence: {log}"
+    );
 
     // What the browser shows mid-way through each screen.
     assert!(uniform(&screenshot(&url, (640, 360), 700), 255), "white");
     assert!(uniform(&screenshot(&url, (640, 360), 2200), 0), "black");
-    assert_same(&screenshot(&url, (640, 360), 3800), &field, "the field after the sequence");
+    assert_same(
+        &screenshot(&url, (640, 360), 3800),
+        &field,
+        "the field after the sequence",
+    );
 }
 
 #[test]
@@ -229,10 +280,21 @@ fn grey_patches_show_their_levels_unchanged() {
     let levels = [0, 32, 64, 96, 128, 160, 192, 224, 255];
     for (k, level) in levels.into_iter().enumerate() {
         // The middle of patch k of a 3 x 3 grid, row by row.
-        let (x, y) = ((k % 3) as u32 * 640 / 3 + 107, (k / 3) as u32 * 360 / 3 + 60);
-        assert_eq!(patches.get_pixel(x, y).0, [level; 3], "patch {k} at ({x}, {y})");
+        let (x, y) = (
+            (k % 3) as u32 * 640 / 3 + 107,
+            (k / 3) as u32 * 360 / 3 + 60,
+        );
+        assert_eq!(
+            patches.get_pixel(x, y).0,
+            [level; 3],
+            "patch {k} at ({x}, {y})"
+        );
     }
-    let one = screenshot(&format!("{}?mode=grey&level=77", server.url), (640, 360), 500);
+    let one = screenshot(
+        &format!("{}?mode=grey&level=77", server.url),
+        (640, 360),
+        500,
+    );
     assert!(uniform(&one, 77), "level 77 full-screen");
 }
 
@@ -240,12 +302,23 @@ fn grey_patches_show_their_levels_unchanged() {
 fn request(url: &str, method: &str, path: &str) -> (u16, Vec<u8>) {
     let address = url.trim_start_matches("http://").trim_end_matches('/');
     let mut stream = TcpStream::connect(address).unwrap();
-    write!(stream, "{method} {path} HTTP/1.0\r\nHost: {address}\r\n\r\n").unwrap();
+    write!(
+        stream,
+        "{method} {path} HTTP/1.0\r\nHost: {address}\r\n\r\n"
+    )
+    .unwrap();
     let mut reply = Vec::new();
     stream.read_to_end(&mut reply).unwrap();
-    let split = reply.windows(4).position(|w| w == b"\r\n\r\n").expect("headers end");
+    let split = reply
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .expect("headers end");
     let head = String::from_utf8_lossy(&reply[..split]).to_string();
-    let status = head.split(' ').nth(1).and_then(|s| s.parse().ok()).unwrap_or_else(|| panic!("{head}"));
+    let status = head
+        .split(' ')
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("{head}"));
     (status, reply[split + 4..].to_vec())
 }
 
@@ -254,12 +327,20 @@ fn the_server_listens_on_loopback_and_serves_only_its_page_and_images() {
     let dir = tempfile::tempdir().unwrap();
     let arena = &small_arena(dir.path());
     let server = display(&["--arena", arena, "--field", "letter:L"]);
-    assert!(server.url.starts_with("http://127.0.0.1:"), "{}", server.url);
+    assert!(
+        server.url.starts_with("http://127.0.0.1:"),
+        "{}",
+        server.url
+    );
     let (status, page) = request(&server.url, "GET", "/");
     assert_eq!(status, 200);
     let page = String::from_utf8(page).unwrap();
-    let loads_elsewhere = page.contains("src=\"http") || page.contains("href=\"http") || page.contains("//cdn");
-    assert!(page.contains("<script>") && !loads_elsewhere, "the page loads nothing from elsewhere");
+    let loads_elsewhere =
+        page.contains("src=\"http") || page.contains("href=\"http") || page.contains("//cdn");
+    assert!(
+        page.contains("<script>") && !loads_elsewhere,
+        "the page loads nothing from elsewhere"
+    );
     let (status, png) = request(&server.url, "GET", "/field.png");
     assert_eq!(status, 200);
     let exported = export(dir.path(), &["--arena", arena, "--field", "letter:L"]);
@@ -267,8 +348,16 @@ fn the_server_listens_on_loopback_and_serves_only_its_page_and_images() {
     let (status, settings) = request(&server.url, "GET", "/settings.json?x=1");
     assert_eq!(status, 200);
     let settings: serde_json::Value = serde_json::from_slice(&settings).unwrap();
-    assert_eq!((settings["panel"][0].as_u64(), settings["hold_ms"].as_u64()), (Some(640), Some(3000)));
-    for path in ["/../Cargo.toml", "/etc/passwd", "/field.png.bak", "/display.html"] {
+    assert_eq!(
+        (settings["panel"][0].as_u64(), settings["hold_ms"].as_u64()),
+        (Some(640), Some(3000))
+    );
+    for path in [
+        "/../Cargo.toml",
+        "/etc/passwd",
+        "/field.png.bak",
+        "/display.html",
+    ] {
         assert_eq!(request(&server.url, "GET", path).0, 404, "{path}");
     }
     assert_eq!(request(&server.url, "POST", "/").0, 405);
@@ -284,14 +373,31 @@ fn bad_settings_are_refused_naming_the_input() {
     let e = fails(&["display", "--hold", "0.1", "--port", "0"]);
     assert!(e.contains("--hold 0.1 s") && e.contains("140 ms"), "{e}");
     let e = fails(&["display", "--arena", "thesis", "--port", "0"]);
-    assert!(e.contains("--arena thesis") && e.contains("screen arena"), "{e}");
+    assert!(
+        e.contains("--arena thesis") && e.contains("screen arena"),
+        "{e}"
+    );
     let e = fails(&["display", "--bind", "localhost:x"]);
     assert!(e.contains("localhost:x"), "{e}");
-    let e = fails(&["field", "export", "--field", "/no/such.png", "--out", "/tmp/never-written.png"]);
+    let e = fails(&[
+        "field",
+        "export",
+        "--field",
+        "/no/such.png",
+        "--out",
+        "/tmp/never-written.png",
+    ]);
     assert!(e.contains("/no/such.png"), "{e}");
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");
     std::fs::write(&bad, "screen_px = [0, 10]\n").unwrap();
-    let e = fails(&["field", "export", "--arena", bad.to_str().unwrap(), "--out", "/tmp/never-written.png"]);
+    let e = fails(&[
+        "field",
+        "export",
+        "--arena",
+        bad.to_str().unwrap(),
+        "--out",
+        "/tmp/never-written.png",
+    ]);
     assert!(e.contains("bad.toml") && e.contains("screen_px[0]"), "{e}");
 }

@@ -21,9 +21,14 @@ fn experiment_files() -> Vec<PathBuf> {
 
 #[test]
 fn every_experiment_file_is_built_in() {
-    let mut stems: Vec<String> =
-        experiment_files().iter().map(|p| p.file_stem().unwrap().to_string_lossy().into_owned()).collect();
-    let mut built_in: Vec<String> = host::experiment::spec::BUILT_IN.iter().map(|(n, _)| n.to_string()).collect();
+    let mut stems: Vec<String> = experiment_files()
+        .iter()
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    let mut built_in: Vec<String> = host::experiment::spec::BUILT_IN
+        .iter()
+        .map(|(n, _)| n.to_string())
+        .collect();
     stems.sort();
     built_in.sort();
     assert_eq!(stems, built_in);
@@ -38,25 +43,51 @@ fn quick_runs_of_every_experiment_produce_tables_and_figures() {
         // from the repository root, against which files name sensor configs and policies
         let run = host()
             .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
-            .args(["experiment", file.to_str().unwrap(), "--trials", "2", "--scale", "0.0004", "--out"])
+            .args([
+                "experiment",
+                file.to_str().unwrap(),
+                "--trials",
+                "2",
+                "--scale",
+                "0.0004",
+                "--out",
+            ])
             .arg(&dir)
             .output()
             .unwrap();
         let stdout = String::from_utf8_lossy(&run.stdout);
-        assert!(run.status.success(), "{}: {}", file.display(), String::from_utf8_lossy(&run.stderr));
-        assert!(stdout.contains(&format!("writing to {}", dir.display())), "{stdout}");
+        assert!(
+            run.status.success(),
+            "{}: {}",
+            file.display(),
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(
+            stdout.contains(&format!("writing to {}", dir.display())),
+            "{stdout}"
+        );
         assert!(stdout.contains("0 already done (skipped)"), "{stdout}");
 
         let table = std::fs::read_to_string(dir.join("table.md")).unwrap();
         assert!(table.contains(&format!("# {}", spec.title)), "{table}");
         for arm in &spec.arms {
-            assert!(table.contains(&format!("| {} |", arm.row)), "{}: row {} missing", spec.name, arm.row);
-            let trials = std::fs::read_dir(dir.join("trials").join(host::experiment::runner::slug(&arm.name))).unwrap();
+            assert!(
+                table.contains(&format!("| {} |", arm.row)),
+                "{}: row {} missing",
+                spec.name,
+                arm.row
+            );
+            let trials = std::fs::read_dir(
+                dir.join("trials")
+                    .join(host::experiment::runner::slug(&arm.name)),
+            )
+            .unwrap();
             assert_eq!(trials.count(), 2, "{} {}", spec.name, arm.name);
         }
         let csv = std::fs::read_to_string(dir.join("trials.csv")).unwrap();
         assert_eq!(csv.lines().count(), 1 + 2 * spec.arms.len());
-        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("trials.json")).unwrap()).unwrap();
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("trials.json")).unwrap()).unwrap();
         assert_eq!(json.as_array().unwrap().len(), 2 * spec.arms.len());
         for figure in &spec.figures {
             let png = image::open(dir.join(&figure.file)).unwrap();
@@ -70,28 +101,55 @@ fn a_rerun_skips_finished_trials_and_reuses_pretrained_tables() {
     let out = tempfile::tempdir().unwrap();
     let args = ["experiment", "transfer", "--scale", "0.0002", "--out"];
     let run = |more: &[&str]| {
-        let run = host().args(args).arg(out.path()).args(more).output().unwrap();
-        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let run = host()
+            .args(args)
+            .arg(out.path())
+            .args(more)
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         String::from_utf8(run.stdout).unwrap()
     };
     // one table per trial and column (text, author), shared by the column's six arms
     let first = run(&["--trials", "2"]);
-    assert!(first.contains("pre-training: 4 tables for the trials to run, 0 already done"), "{first}");
+    assert!(
+        first.contains("pre-training: 4 tables for the trials to run, 0 already done"),
+        "{first}"
+    );
 
     // a third trial needs only its own tables
     let again = run(&["--trials", "3"]);
-    assert!(again.contains("pre-training: 2 tables for the trials to run, 0 already done"), "{again}");
-    assert!(again.contains("trials: 36, 24 already done (skipped)"), "{again}");
+    assert!(
+        again.contains("pre-training: 2 tables for the trials to run, 0 already done"),
+        "{again}"
+    );
+    assert!(
+        again.contains("trials: 36, 24 already done (skipped)"),
+        "{again}"
+    );
 
     // a lost trial reruns from its stored table
     std::fs::remove_file(out.path().join("trials/1_robot/trial-00.json")).unwrap();
     let lost = run(&["--trials", "3"]);
-    assert!(lost.contains("pre-training: 1 tables for the trials to run, 1 already done (skipped)"), "{lost}");
-    assert!(lost.contains("trials: 36, 35 already done (skipped)"), "{lost}");
+    assert!(
+        lost.contains("pre-training: 1 tables for the trials to run, 1 already done (skipped)"),
+        "{lost}"
+    );
+    assert!(
+        lost.contains("trials: 36, 35 already done (skipped)"),
+        "{lost}"
+    );
 
     // another seed changes every trial's config hash: nothing is reused
     let reseeded = run(&["--trials", "2", "--seed", "7"]);
-    assert!(reseeded.contains("trials: 24, 0 already done"), "{reseeded}");
+    assert!(
+        reseeded.contains("trials: 24, 0 already done"),
+        "{reseeded}"
+    );
 }
 
 /// A trial file without its timing fields, which differ between runs.
@@ -131,7 +189,12 @@ fn untimed_table(text: &str) -> String {
             drop = Some(i);
         }
         let kept: Vec<&str> = match drop {
-            Some(i) if line.starts_with('|') && cells.len() > i => cells.iter().enumerate().filter(|(k, _)| *k != i).map(|(_, c)| *c).collect(),
+            Some(i) if line.starts_with('|') && cells.len() > i => cells
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != i)
+                .map(|(_, c)| *c)
+                .collect(),
             _ => cells,
         };
         out.push_str(&kept.join("|"));
@@ -142,25 +205,67 @@ fn untimed_table(text: &str) -> String {
 
 fn untimed_csv(text: &str) -> String {
     // the last two columns are steps_per_second and seconds
-    text.lines().map(|l| l.rsplitn(3, ',').last().unwrap().to_string() + "\n").collect()
+    text.lines()
+        .map(|l| l.rsplitn(3, ',').last().unwrap().to_string() + "\n")
+        .collect()
 }
 
 #[test]
 fn three_shards_merged_give_the_unsharded_runs_trials_and_tables() {
     let out = tempfile::tempdir().unwrap();
-    let common = ["experiment", "transfer", "--trials", "2", "--scale", "0.0002", "--threads", "1", "--out"];
+    let common = [
+        "experiment",
+        "transfer",
+        "--trials",
+        "2",
+        "--scale",
+        "0.0002",
+        "--threads",
+        "1",
+        "--out",
+    ];
     let whole = out.path().join("whole");
-    assert!(host().args(common).arg(&whole).output().unwrap().status.success());
-    let shards: Vec<PathBuf> = (0..3).map(|k| out.path().join(format!("shard-{k}"))).collect();
+    assert!(host()
+        .args(common)
+        .arg(&whole)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    let shards: Vec<PathBuf> = (0..3)
+        .map(|k| out.path().join(format!("shard-{k}")))
+        .collect();
     for (k, dir) in shards.iter().enumerate() {
-        let run = host().args(common).arg(dir).args(["--shard", &format!("{k}/3")]).output().unwrap();
-        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let run = host()
+            .args(common)
+            .arg(dir)
+            .args(["--shard", &format!("{k}/3")])
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         assert!(String::from_utf8_lossy(&run.stdout).contains(&format!("shard {k}/3: 8 trials")));
-        assert!(!dir.join("table.md").exists(), "a shard leaves the reports to the merge");
+        assert!(
+            !dir.join("table.md").exists(),
+            "a shard leaves the reports to the merge"
+        );
     }
     let merged = out.path().join("merged");
-    let run = host().args(["experiment", "merge"]).args(&shards).arg("--out").arg(&merged).output().unwrap();
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let run = host()
+        .args(["experiment", "merge"])
+        .args(&shards)
+        .arg("--out")
+        .arg(&merged)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 
     assert_eq!(files(&merged), files(&whole));
     for f in files(&whole) {
@@ -175,7 +280,10 @@ fn three_shards_merged_give_the_unsharded_runs_trials_and_tables() {
             let read = |p: &Path| untimed_csv(&std::fs::read_to_string(p).unwrap());
             assert_eq!(read(&a), read(&b));
         } else if name.starts_with("pretrained/") {
-            assert!(std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(), "{name}");
+            assert!(
+                std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+                "{name}"
+            );
         }
     }
 }
@@ -185,24 +293,57 @@ fn a_merge_refuses_missing_foreign_or_disagreeing_shards() {
     let out = tempfile::tempdir().unwrap();
     let shard = |k: usize, n: usize, seed: &str| {
         let dir = out.path().join(format!("s{k}of{n}-{seed}"));
-        let args = ["experiment", "transfer", "--trials", "1", "--scale", "0.0002", "--seed", seed, "--out"];
-        let run = host().args(args).arg(&dir).args(["--shard", &format!("{k}/{n}")]).output().unwrap();
-        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        let args = [
+            "experiment",
+            "transfer",
+            "--trials",
+            "1",
+            "--scale",
+            "0.0002",
+            "--seed",
+            seed,
+            "--out",
+        ];
+        let run = host()
+            .args(args)
+            .arg(&dir)
+            .args(["--shard", &format!("{k}/{n}")])
+            .output()
+            .unwrap();
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         dir
     };
     let merge = |dirs: &[&PathBuf]| {
-        let run = host().args(["experiment", "merge"]).args(dirs).arg("--out").arg(out.path().join("m")).output().unwrap();
+        let run = host()
+            .args(["experiment", "merge"])
+            .args(dirs)
+            .arg("--out")
+            .arg(out.path().join("m"))
+            .output()
+            .unwrap();
         assert!(!run.status.success());
         String::from_utf8(run.stderr).unwrap()
     };
     let (a, b) = (shard(0, 2, "1"), shard(1, 2, "1"));
     let e = merge(&[&a]);
-    assert!(e.contains("shard 1/2 is missing") && e.contains("--shard 1/2"), "{e}");
+    assert!(
+        e.contains("shard 1/2 is missing") && e.contains("--shard 1/2"),
+        "{e}"
+    );
     let other = shard(1, 2, "5");
     assert!(merge(&[&a, &other]).contains("shards of different runs"));
     assert!(merge(&[&a, &a]).contains("shard 0/2 is given twice"));
     // both shards pre-train the table of trial 0 of each column: the copies must agree
-    let table = std::fs::read_dir(a.join("pretrained")).unwrap().next().unwrap().unwrap().path();
+    let table = std::fs::read_dir(a.join("pretrained"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
     let copy = b.join("pretrained").join(table.file_name().unwrap());
     let mut bytes = std::fs::read(&copy).unwrap();
     bytes[40] ^= 1;
@@ -222,7 +363,10 @@ fn bad_experiment_inputs_are_refused() {
         String::from_utf8(out.stderr).unwrap()
     };
     let e = fails(&["experiment", "nonsense"]);
-    assert!(e.contains("unknown experiment \"nonsense\"") && e.contains("annulus"), "{e}");
+    assert!(
+        e.contains("unknown experiment \"nonsense\"") && e.contains("annulus"),
+        "{e}"
+    );
     assert!(fails(&["experiment", "/no/such/file.toml"]).contains("/no/such/file.toml"));
     assert!(fails(&["experiment", "annulus", "--trials", "0"]).contains("--trials 0"));
     assert!(fails(&["experiment", "annulus", "--scale=-1"]).contains("--scale -1"));
@@ -231,9 +375,16 @@ fn bad_experiment_inputs_are_refused() {
     assert!(e.contains("--reuse /no/such/run: not a directory"), "{e}");
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");
-    std::fs::write(&bad, "title = \"x\"\n[[arms]]\nname = \"a\"\nhasher = \"bits7\"\n").unwrap();
+    std::fs::write(
+        &bad,
+        "title = \"x\"\n[[arms]]\nname = \"a\"\nhasher = \"bits7\"\n",
+    )
+    .unwrap();
     let e = fails(&["experiment", bad.to_str().unwrap()]);
-    assert!(e.contains("bad.toml") && e.contains("arm \"a\"") && e.contains("hasher"), "{e}");
+    assert!(
+        e.contains("bad.toml") && e.contains("arm \"a\"") && e.contains("hasher"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -241,9 +392,26 @@ fn results_do_not_depend_on_the_number_of_threads() {
     let out = tempfile::tempdir().unwrap();
     let run = |threads: &str| {
         let dir = out.path().join(threads);
-        let args = ["experiment", "annulus", "--trials", "3", "--scale", "0.0006", "--threads", threads, "--out"];
-        assert!(host().args(args).arg(&dir).output().unwrap().status.success());
-        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("trials.json")).unwrap()).unwrap();
+        let args = [
+            "experiment",
+            "annulus",
+            "--trials",
+            "3",
+            "--scale",
+            "0.0006",
+            "--threads",
+            threads,
+            "--out",
+        ];
+        assert!(host()
+            .args(args)
+            .arg(&dir)
+            .output()
+            .unwrap()
+            .status
+            .success());
+        let json: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("trials.json")).unwrap()).unwrap();
         let mut trials = json.as_array().unwrap().clone();
         for t in &mut trials {
             let t = t.as_object_mut().unwrap();
@@ -264,35 +432,80 @@ fn trials_another_run_made_with_the_same_settings_are_copied_not_run() {
     let out = tempfile::tempdir().unwrap();
     let run = |name: &str, dir: &str, more: &[&str]| {
         let run = host()
-            .args(["experiment", name, "--trials", "2", "--scale", "0.0002", "--out"])
+            .args([
+                "experiment",
+                name,
+                "--trials",
+                "2",
+                "--scale",
+                "0.0002",
+                "--out",
+            ])
             .arg(out.path().join(dir))
             .args(more)
             .output()
             .unwrap();
-        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
         String::from_utf8(run.stdout).unwrap()
     };
     run("state-bits", "state-bits", &[]);
     let state_bits = out.path().join("state-bits");
-    let reused = run("obstacle", "reused", &["--reuse", state_bits.to_str().unwrap()]);
-    assert!(reused.contains("reuse: 4 trials copied from 12 stored"), "{reused}");
-    assert!(reused.contains("8 trials run, 0 skipped, 4 copied"), "{reused}");
+    let reused = run(
+        "obstacle",
+        "reused",
+        &["--reuse", state_bits.to_str().unwrap()],
+    );
+    assert!(
+        reused.contains("reuse: 4 trials copied from 12 stored"),
+        "{reused}"
+    );
+    assert!(
+        reused.contains("8 trials run, 0 skipped, 4 copied"),
+        "{reused}"
+    );
     let ran = run("obstacle", "ran", &[]);
     assert!(ran.contains("12 trials run, 0 skipped, 0 copied"), "{ran}");
 
     let (reused, ran) = (out.path().join("reused"), out.path().join("ran"));
     assert_eq!(files(&reused), files(&ran));
     for file in files(&ran).iter().filter(|f| f.starts_with("trials/")) {
-        assert_eq!(untimed(&reused.join(file)), untimed(&ran.join(file)), "{}", file.display());
+        assert_eq!(
+            untimed(&reused.join(file)),
+            untimed(&ran.join(file)),
+            "{}",
+            file.display()
+        );
     }
     let copy = untimed(&reused.join("trials/8_bits__Original_/trial-01.json"));
-    assert_eq!((copy["experiment"].as_str(), copy["arm"].as_str(), copy["trial"].as_u64()), (Some("obstacle"), Some("8 bits (Original)"), Some(1)));
+    assert_eq!(
+        (
+            copy["experiment"].as_str(),
+            copy["arm"].as_str(),
+            copy["trial"].as_u64()
+        ),
+        (Some("obstacle"), Some("8 bits (Original)"), Some(1))
+    );
     let table = |dir: &Path| untimed_table(&std::fs::read_to_string(dir.join("table.md")).unwrap());
     assert_eq!(table(&reused), table(&ran));
 
     // a rerun finds them finished; a run of other settings copies nothing
-    let again = run("obstacle", "reused", &["--reuse", state_bits.to_str().unwrap()]);
-    assert!(again.contains("0 trials run, 12 skipped, 0 copied"), "{again}");
-    let other = run("obstacle", "other-seed", &["--seed", "9", "--reuse", state_bits.to_str().unwrap()]);
+    let again = run(
+        "obstacle",
+        "reused",
+        &["--reuse", state_bits.to_str().unwrap()],
+    );
+    assert!(
+        again.contains("0 trials run, 12 skipped, 0 copied"),
+        "{again}"
+    );
+    let other = run(
+        "obstacle",
+        "other-seed",
+        &["--seed", "9", "--reuse", state_bits.to_str().unwrap()],
+    );
     assert!(other.contains("reuse: 0 trials copied"), "{other}");
 }

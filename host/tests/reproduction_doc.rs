@@ -13,8 +13,14 @@ fn the_rendered_pages_are_what_the_committed_trials_give() {
     let docs = Path::new("docs");
     let stale = std::cell::RefCell::new(Vec::new());
     let log = |line: &str| stale.borrow_mut().push(line.to_string());
-    if let Err(e) = host::experiment::report::check(docs, &host::experiment::report::DOCUMENTS, &log) {
+    if let Err(e) =
+        host::experiment::report::check(docs, &host::experiment::report::DOCUMENTS, &log)
+    {
         panic!("{e:#}");
     }
-    assert!(stale.borrow().is_empty(), "published trials the experiment files no longer plan: {:?}", stale.borrow());
+    assert!(
+        stale.borrow().is_empty(),
+        "published trials the experiment files no longer plan: {:?}",
+        stale.borrow()
+    );
 }

@@ -6,14 +6,22 @@ use host::robot::log_file::{encode_record, MAGIC, VERSION};
 use shared::{FieldCalibration, LogFrame, PolicyBlob, RunMode, SensorRange};
 use std::path::{Path, PathBuf};
 
-const CAL: FieldCalibration = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+const CAL: FieldCalibration = FieldCalibration {
+    ranges: [SensorRange {
+        bright: 40,
+        dark: 440,
+    }; 3],
+};
 
 fn host() -> Command {
     Command::cargo_bin("host").unwrap()
 }
 
 fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").canonicalize().unwrap()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .canonicalize()
+        .unwrap()
 }
 
 fn policy_path() -> PathBuf {
@@ -30,7 +38,12 @@ fn write_log(path: &Path) -> u64 {
     for tick in 1..=5u32 {
         let raw = [100 + tick as u16 * 50, 240, 300];
         let values = CAL.scales().values(&raw);
-        let reading = shared::SensorReading { left: values[0], mid: values[1], right: values[2], ..Default::default() };
+        let reading = shared::SensorReading {
+            left: values[0],
+            mid: values[1],
+            right: values[2],
+            ..Default::default()
+        };
         let state = blob.hasher().hash(&reading);
         let frame = LogFrame {
             tick,
@@ -60,16 +73,42 @@ fn replay_reports_in_text_and_json_and_names_damaged_records() {
     let dir = tempfile::tempdir().unwrap();
     let log = dir.path().join("run.log");
     let damaged_at = write_log(&log);
-    let out = host().args(["replay", "--log"]).arg(&log).arg("--policy").arg(policy_path()).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = host()
+        .args(["replay", "--log"])
+        .arg(&log)
+        .arg("--policy")
+        .arg(policy_path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.contains("5 entries, 4 frames decoded"), "{text}");
-    assert!(text.contains(&format!("at byte {damaged_at}")) && text.contains("divergences: 0 frames"), "{text}");
+    assert!(
+        text.contains(&format!("at byte {damaged_at}")) && text.contains("divergences: 0 frames"),
+        "{text}"
+    );
 
-    let out = host().args(["replay", "--json", "--log"]).arg(&log).arg("--policy").arg(policy_path()).output().unwrap();
+    let out = host()
+        .args(["replay", "--json", "--log"])
+        .arg(&log)
+        .arg("--policy")
+        .arg(policy_path())
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert_eq!((v["frames"].as_u64(), v["damaged"].as_u64(), v["diverged"].as_u64()), (Some(4), Some(1), Some(0)));
+    assert_eq!(
+        (
+            v["frames"].as_u64(),
+            v["damaged"].as_u64(),
+            v["diverged"].as_u64()
+        ),
+        (Some(4), Some(1), Some(0))
+    );
     assert_eq!(v["first_damaged"][0]["offset"].as_u64(), Some(damaged_at));
     assert_eq!(v["modes"]["idle"].as_u64(), Some(4));
     assert_eq!(v["calibration_checked"].as_u64(), Some(4));
@@ -81,7 +120,12 @@ fn driving_capture(id: u8, motors: shared::MotorCommand, counts: [i16; 2]) -> Ve
     let mut bytes = Vec::new();
     for tick in 1..=20u32 {
         let values = CAL.scales().values(&[240; 3]);
-        let reading = shared::SensorReading { left: values[0], mid: values[1], right: values[2], ..Default::default() };
+        let reading = shared::SensorReading {
+            left: values[0],
+            mid: values[1],
+            right: values[2],
+            ..Default::default()
+        };
         let state = blob.hasher().hash(&reading);
         let frame = LogFrame {
             tick,
@@ -106,14 +150,24 @@ fn driving_capture(id: u8, motors: shared::MotorCommand, counts: [i16; 2]) -> Ve
 fn replay_fits_each_robots_wheel_speed_and_turn_bias_into_one_file_for_the_swarm() {
     let dir = tempfile::tempdir().unwrap();
     let fit = dir.path().join("fit.json");
-    let straight = shared::MotorCommand { left: 150, right: 150 }; // 2 units per step
-    // Robot 1: 2 units x 6.5 mm x 2 counts/mm = 26 counts per track: as intended, drifting right.
-    // Robot 2: 10 % slow.
+    let straight = shared::MotorCommand {
+        left: 150,
+        right: 150,
+    }; // 2 units per step
+       // Robot 1: 2 units x 6.5 mm x 2 counts/mm = 26 counts per track: as intended, drifting right.
+       // Robot 2: 10 % slow.
     for (id, counts) in [(1u8, [27i16, 25]), (2, [23, 24])] {
         let log = dir.path().join(format!("robot{id}.bin"));
         std::fs::write(&log, driving_capture(id, straight, counts)).unwrap();
         let out = host()
-            .args(["replay", "--counts-per-mm", "2", "--track-mm", "100", "--fit-profile"])
+            .args([
+                "replay",
+                "--counts-per-mm",
+                "2",
+                "--track-mm",
+                "100",
+                "--fit-profile",
+            ])
             .arg(&fit)
             .arg("--log")
             .arg(&log)
@@ -121,9 +175,16 @@ fn replay_fits_each_robots_wheel_speed_and_turn_bias_into_one_file_for_the_swarm
             .arg(policy_path())
             .output()
             .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let text = String::from_utf8(out.stdout).unwrap();
-        assert!(text.contains(&format!("motion of robot {id}")) && text.contains("intended 2.000"), "{text}");
+        assert!(
+            text.contains(&format!("motion of robot {id}")) && text.contains("intended 2.000"),
+            "{text}"
+        );
     }
     let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&fit).unwrap()).unwrap();
     let robots = v["robots"].as_array().unwrap();
@@ -133,9 +194,15 @@ fn replay_fits_each_robots_wheel_speed_and_turn_bias_into_one_file_for_the_swarm
     assert!((get(0, "wheel_speed_factor") - 1.0).abs() < 1e-3, "{v}");
     // (27 - 25) counts / 2 per mm / 100 mm = 0.01 rad per step to the right.
     assert!((get(0, "turn_bias") - 0.01).abs() < 1e-4, "{v}");
-    assert!((get(1, "wheel_speed_factor") - 23.5 / 26.0).abs() < 1e-3, "{v}");
+    assert!(
+        (get(1, "wheel_speed_factor") - 23.5 / 26.0).abs() < 1e-3,
+        "{v}"
+    );
     assert!((get(1, "turn_bias") + 0.005).abs() < 1e-4, "{v}");
-    assert_eq!(robots[0].as_object().unwrap().keys().collect::<Vec<_>>(), ["id", "turn_bias", "wheel_speed_factor"]);
+    assert_eq!(
+        robots[0].as_object().unwrap().keys().collect::<Vec<_>>(),
+        ["id", "turn_bias", "wheel_speed_factor"]
+    );
 }
 
 #[test]
@@ -148,30 +215,78 @@ fn replay_and_monitor_errors_name_the_input() {
         assert!(!out.status.success());
         String::from_utf8(out.stderr).unwrap()
     };
-    let e = fails(host().args(["replay", "--log", "/no/such.log", "--policy"]).arg(policy_path()));
+    let e = fails(
+        host()
+            .args(["replay", "--log", "/no/such.log", "--policy"])
+            .arg(policy_path()),
+    );
     assert!(e.contains("/no/such.log"), "{e}");
-    let e = fails(host().args(["replay", "--log"]).arg(&log).args(["--policy", "/no/such.policy"]));
+    let e = fails(
+        host()
+            .args(["replay", "--log"])
+            .arg(&log)
+            .args(["--policy", "/no/such.policy"]),
+    );
     assert!(e.contains("/no/such.policy"), "{e}");
     let visits = dir.path().join("visits.json");
-    std::fs::write(&visits, format!(r#"{{"hasher": "bits7", "visits": {:?}}}"#, vec![1; 128])).unwrap();
-    let e = fails(host().args(["replay", "--log"]).arg(&log).arg("--policy").arg(policy_path()).arg("--visits").arg(&visits));
+    std::fs::write(
+        &visits,
+        format!(r#"{{"hasher": "bits7", "visits": {:?}}}"#, vec![1; 128]),
+    )
+    .unwrap();
+    let e = fails(
+        host()
+            .args(["replay", "--log"])
+            .arg(&log)
+            .arg("--policy")
+            .arg(policy_path())
+            .arg("--visits")
+            .arg(&visits),
+    );
     assert!(e.contains("visits.json") && e.contains("bits7"), "{e}");
     let mut other_version = MAGIC.to_vec();
     other_version.push(VERSION + 1);
     let future = dir.path().join("future.log");
     std::fs::write(&future, other_version).unwrap();
-    let e = fails(host().args(["replay", "--log"]).arg(&future).arg("--policy").arg(policy_path()));
-    assert!(e.contains("future.log") && e.contains("format version 2 is not supported"), "{e}");
+    let e = fails(
+        host()
+            .args(["replay", "--log"])
+            .arg(&future)
+            .arg("--policy")
+            .arg(policy_path()),
+    );
+    assert!(
+        e.contains("future.log") && e.contains("format version 2 is not supported"),
+        "{e}"
+    );
 
     // 5,000 random bytes: no frame decodes, which is an error.
     let noise = dir.path().join("noise.bin");
     let mut x = 12345u32;
-    let bytes: Vec<u8> = (0..5000).map(|_| { x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345); (x >> 16) as u8 }).collect();
+    let bytes: Vec<u8> = (0..5000)
+        .map(|_| {
+            x = x.wrapping_mul(1_103_515_245).wrapping_add(12_345);
+            (x >> 16) as u8
+        })
+        .collect();
     std::fs::write(&noise, bytes).unwrap();
-    let e = fails(host().args(["replay", "--log"]).arg(&noise).arg("--policy").arg(policy_path()));
-    assert!(e.contains("no frame in") && e.contains("noise.bin") && e.contains("decodes"), "{e}");
+    let e = fails(
+        host()
+            .args(["replay", "--log"])
+            .arg(&noise)
+            .arg("--policy")
+            .arg(policy_path()),
+    );
+    assert!(
+        e.contains("no frame in") && e.contains("noise.bin") && e.contains("decodes"),
+        "{e}"
+    );
 
-    let e = fails(host().args(["monitor", "--port", "/dev/null-port", "--out"]).arg(&log));
+    let e = fails(
+        host()
+            .args(["monitor", "--port", "/dev/null-port", "--out"])
+            .arg(&log),
+    );
     assert!(e.contains("already exists") && e.contains("run.log"), "{e}");
     let e = fails(host().args(["monitor", "--out", "x.log"]));
     assert!(e.contains("--port"), "{e}");
@@ -181,13 +296,26 @@ fn replay_and_monitor_errors_name_the_input() {
 fn flash_dry_run_prints_the_exact_commands_and_validates_first() {
     let out = host()
         .current_dir(repo().join("host"))
-        .args(["flash", "--dry-run", "--port", "/dev/ttyACM0", "--robot-id", "3", "--policy"])
+        .args([
+            "flash",
+            "--dry-run",
+            "--port",
+            "/dev/ttyACM0",
+            "--robot-id",
+            "3",
+            "--policy",
+        ])
         .arg(policy_path())
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let repo = repo();
-    let crc = shared::FirmwareIdentity::policy_crc_of(&std::fs::read(policy_path()).unwrap()).unwrap();
+    let crc =
+        shared::FirmwareIdentity::policy_crc_of(&std::fs::read(policy_path()).unwrap()).unwrap();
     let expected = format!(
         "env -u CARGO_TARGET_DIR FIRMWARE_POLICY={} FIRMWARE_HASHER=original FIRMWARE_ROBOT_ID=3 \
          FIRMWARE_OUT={}/target/flash/{crc:08x}-robot3 {}/scripts/build-firmware\n\
@@ -207,14 +335,46 @@ fn flash_dry_run_prints_the_exact_commands_and_validates_first() {
         assert!(!out.status.success());
         String::from_utf8(out.stderr).unwrap()
     };
-    let e = fails(host().current_dir(dir.path()).args(["flash", "--dry-run", "--policy"]).arg(policy_path()));
+    let e = fails(
+        host()
+            .current_dir(dir.path())
+            .args(["flash", "--dry-run", "--policy"])
+            .arg(policy_path()),
+    );
     assert!(e.contains("must run inside a zumo-swarm checkout"), "{e}");
-    let e = fails(host().current_dir(&repo).args(["flash", "--dry-run", "--hasher", "original-obstacle", "--policy"]).arg(policy_path()));
-    assert!(e.contains("uses hasher original") && e.contains("original-obstacle"), "{e}");
+    let e = fails(
+        host()
+            .current_dir(&repo)
+            .args([
+                "flash",
+                "--dry-run",
+                "--hasher",
+                "original-obstacle",
+                "--policy",
+            ])
+            .arg(policy_path()),
+    );
+    assert!(
+        e.contains("uses hasher original") && e.contains("original-obstacle"),
+        "{e}"
+    );
     let bad = dir.path().join("bad.policy");
     std::fs::write(&bad, b"not a policy").unwrap();
-    let e = fails(host().current_dir(&repo).args(["flash", "--dry-run", "--policy"]).arg(&bad));
-    assert!(e.contains("bad.policy") && e.contains("not a policy blob"), "{e}");
-    let e = fails(host().current_dir(&repo).args(["flash", "--hasher", "eleven", "--policy"]).arg(policy_path()));
+    let e = fails(
+        host()
+            .current_dir(&repo)
+            .args(["flash", "--dry-run", "--policy"])
+            .arg(&bad),
+    );
+    assert!(
+        e.contains("bad.policy") && e.contains("not a policy blob"),
+        "{e}"
+    );
+    let e = fails(
+        host()
+            .current_dir(&repo)
+            .args(["flash", "--hasher", "eleven", "--policy"])
+            .arg(policy_path()),
+    );
     assert!(e.contains("\"eleven\""), "{e}");
 }

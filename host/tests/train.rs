@@ -1,21 +1,27 @@
 //! Training: determinism, exact resume from checkpoints, torn writes, and
 //! the one-sensing-per-step contract a learner relies on.
 
-use sim::{Controller, Perception};
 use host::learn::QLearner;
-use sim::Reward;
 use host::sensor_choice::SensorChoice;
-use sim::{EpisodeStart, SimRng, StepOutcome};
 use host::train::checkpoint::{self, CheckpointError};
 use host::train::{TrainConfig, Trainer, TrainingState};
 use shared::SensorReading;
+use sim::Reward;
+use sim::{Controller, Perception};
+use sim::{EpisodeStart, SimRng, StepOutcome};
 use std::io::Write;
 use std::sync::Arc;
 
 /// A small, quick run: 4 robots, 60 pucks, a short stuck limit so that
 /// episodes end and reset within the test.
 fn small(seed: u64) -> TrainConfig {
-    TrainConfig { robots: Some(4), pucks: Some(60), seed, stuck_limit: Some(700), ..TrainConfig::default() }
+    TrainConfig {
+        robots: Some(4),
+        pucks: Some(60),
+        seed,
+        stuck_limit: Some(700),
+        ..TrainConfig::default()
+    }
 }
 
 fn trainer(config: TrainConfig) -> Trainer<sim::SelectedSensors> {
@@ -34,12 +40,19 @@ fn resumes_exactly(config: TrainConfig, first: u64, steps: u64) -> u16 {
     checkpoint::write_to(&mut bytes, &head.state()).unwrap();
     drop(head);
     let state = checkpoint::decode(&bytes).unwrap();
-    assert_eq!(state.config.scenario().unwrap(), config.scenario().unwrap(), "the checkpoint keeps the run's settings");
+    assert_eq!(
+        state.config.scenario().unwrap(),
+        config.scenario().unwrap(),
+        "the checkpoint keeps the run's settings"
+    );
     let mut resumed = Trainer::restart(state).unwrap();
     resumed.run(steps - first);
     assert_eq!(resumed.learner().table(), straight.learner().table());
     assert_eq!(resumed.totals(), straight.totals());
-    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+    assert!(
+        evolving(&resumed.state()) == evolving(&straight.state()),
+        "world, generators or counters differ"
+    );
     assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
     u16::from_le_bytes([bytes[8], bytes[9]])
 }
@@ -61,8 +74,16 @@ fn same_seed_same_q_table() {
     let (a, b, c) = (run(4), run(4), run(5));
     assert_eq!(a.learner.table(), b.learner.table());
     assert_eq!(evolving(&a), evolving(&b));
-    assert_ne!(a.learner.table(), c.learner.table(), "another seed learns another table");
-    assert!(a.sim.totals.stuck >= 3, "episodes ended and reset: {:?}", a.sim.totals);
+    assert_ne!(
+        a.learner.table(),
+        c.learner.table(),
+        "another seed learns another table"
+    );
+    assert!(
+        a.sim.totals.stuck >= 3,
+        "episodes ended and reset: {:?}",
+        a.sim.totals
+    );
     assert!(a.learner.table().states_visited() > 20);
 }
 
@@ -83,19 +104,32 @@ fn train_then_resume_equals_one_long_run() {
     resumed.run(1100);
     assert_eq!(resumed.learner().table(), straight.learner().table());
     assert_eq!(resumed.totals(), straight.totals());
-    assert!(evolving(&resumed.state()) == evolving(&straight.state()), "world, generators or counters differ");
+    assert!(
+        evolving(&resumed.state()) == evolving(&straight.state()),
+        "world, generators or counters differ"
+    );
     assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
 }
 
 #[test]
 fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkpoint() {
     let authors = TrainConfig {
-        formation_check: host::train::config::FormationCheck { every: 300, stale: true },
+        formation_check: host::train::config::FormationCheck {
+            every: 300,
+            stale: true,
+        },
         success: sim::SuccessSignal::EvalPrime,
-        obstacle_discs: Some(host::train::config::ObstacleDiscs { radius: 2.0, sees: sim::ObstacleTargets::AnyBody }),
+        obstacle_discs: Some(host::train::config::ObstacleDiscs {
+            radius: 2.0,
+            sees: sim::ObstacleTargets::AnyBody,
+        }),
         ..small(11)
     };
-    assert_eq!(resumes_exactly(authors, 1400, 2500), 2, "format 1 cannot hold these settings");
+    assert_eq!(
+        resumes_exactly(authors, 1400, 2500),
+        2,
+        "format 1 cannot hold these settings"
+    );
 }
 
 #[test]
@@ -119,18 +153,32 @@ fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_b
     let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");
     let mut files: Vec<_> = std::fs::read_dir(&docs)
         .unwrap()
-        .flat_map(|e| std::fs::read_dir(e.unwrap().path().join("pretrained")).into_iter().flatten())
+        .flat_map(|e| {
+            std::fs::read_dir(e.unwrap().path().join("pretrained"))
+                .into_iter()
+                .flatten()
+        })
         .map(|e| e.unwrap().path())
         .collect();
     files.sort();
     let mut versions = std::collections::BTreeMap::new();
     for path in files {
         let bytes = std::fs::read(&path).unwrap();
-        versions.entry(u16::from_le_bytes([bytes[8], bytes[9]])).or_insert((path, bytes));
+        versions
+            .entry(u16::from_le_bytes([bytes[8], bytes[9]]))
+            .or_insert((path, bytes));
     }
-    assert!(versions.contains_key(&1), "no published format-1 checkpoint under {}", docs.display());
+    assert!(
+        versions.contains_key(&1),
+        "no published format-1 checkpoint under {}",
+        docs.display()
+    );
     for (version, (path, bytes)) in &versions {
-        assert!(*version < checkpoint::VERSION, "{} is of format {version}", path.display());
+        assert!(
+            *version < checkpoint::VERSION,
+            "{} is of format {version}",
+            path.display()
+        );
         let state = checkpoint::decode(bytes).unwrap();
         let mut again = Vec::new();
         checkpoint::write_to(&mut again, &state).unwrap();
@@ -143,8 +191,14 @@ fn a_resume_refuses_a_changed_field() {
     let t = trainer(small(1));
     let letter = Arc::new(sim::Letter::T.field());
     let sensors = SensorChoice::Disc.build(&t.state().sim.config).unwrap();
-    let e = Trainer::resume(t.state(), letter, sensors).err().unwrap().to_string();
-    assert!(e.contains("differs from the one the checkpoint trained on"), "{e}");
+    let e = Trainer::resume(t.state(), letter, sensors)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("differs from the one the checkpoint trained on"),
+        "{e}"
+    );
 }
 
 /// Fails after `budget` bytes, like a full disk or a killed process.
@@ -179,10 +233,20 @@ fn a_failing_writer_leaves_the_previous_checkpoint() {
     t.run(500);
     let newer = t.state();
     for budget in [0, 10, 100, 5000] {
-        let r = host::atomic::write_with(&path, |w| checkpoint::write_to(&mut FailingWriter { inner: w, budget }, &newer));
+        let r = host::atomic::write_with(&path, |w| {
+            checkpoint::write_to(&mut FailingWriter { inner: w, budget }, &newer)
+        });
         assert!(r.is_err());
-        assert_eq!(std::fs::read(&path).unwrap(), before, "torn after {budget} bytes");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1, "temporary file left behind");
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            before,
+            "torn after {budget} bytes"
+        );
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            1,
+            "temporary file left behind"
+        );
     }
     assert_eq!(checkpoint::load(&path).unwrap().sim.totals.steps, 500);
 }
@@ -194,19 +258,43 @@ fn damaged_or_foreign_checkpoints_are_refused_with_the_reason() {
     assert!(checkpoint::decode(&bytes).is_ok());
 
     let short = checkpoint::decode(&bytes[..bytes.len() - 9]).unwrap_err();
-    assert!(matches!(short, CheckpointError::Truncated { .. }), "{short}");
-    assert!(matches!(checkpoint::decode(&bytes[..5]), Err(CheckpointError::Truncated { needed: 18, found: 5 })));
+    assert!(
+        matches!(short, CheckpointError::Truncated { .. }),
+        "{short}"
+    );
+    assert!(matches!(
+        checkpoint::decode(&bytes[..5]),
+        Err(CheckpointError::Truncated {
+            needed: 18,
+            found: 5
+        })
+    ));
     let mut long = bytes.clone();
     long.push(0);
-    assert!(matches!(checkpoint::decode(&long), Err(CheckpointError::TrailingBytes { .. })));
+    assert!(matches!(
+        checkpoint::decode(&long),
+        Err(CheckpointError::TrailingBytes { .. })
+    ));
     let mut flipped = bytes.clone();
     flipped[40] ^= 1;
-    assert!(matches!(checkpoint::decode(&flipped), Err(CheckpointError::CrcMismatch { .. })));
+    assert!(matches!(
+        checkpoint::decode(&flipped),
+        Err(CheckpointError::CrcMismatch { .. })
+    ));
     let mut version = bytes.clone();
     version[8] = 9;
-    assert_eq!(checkpoint::decode(&version).unwrap_err(), CheckpointError::UnsupportedVersion(9));
-    assert_eq!(checkpoint::decode(b"PNG\x89 not a checkpoint at all").unwrap_err(), CheckpointError::WrongMagic);
-    assert_eq!(checkpoint::decode(b"QPOL\x01").unwrap_err(), CheckpointError::PolicyBlob);
+    assert_eq!(
+        checkpoint::decode(&version).unwrap_err(),
+        CheckpointError::UnsupportedVersion(9)
+    );
+    assert_eq!(
+        checkpoint::decode(b"PNG\x89 not a checkpoint at all").unwrap_err(),
+        CheckpointError::WrongMagic
+    );
+    assert_eq!(
+        checkpoint::decode(b"QPOL\x01").unwrap_err(),
+        CheckpointError::PolicyBlob
+    );
 
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("cut.ckpt");
@@ -243,7 +331,11 @@ fn the_state_reached_is_the_state_decided_on_next() {
     let config = small(6).prepare().unwrap().config().clone();
     let field = Arc::new(sim::ScalarField::annulus());
     let mut sim = sim::Simulation::new(config, field, 6).unwrap();
-    let mut probe = Probe { decided: Vec::new(), after: Vec::new(), starts: 0 };
+    let mut probe = Probe {
+        decided: Vec::new(),
+        after: Vec::new(),
+        starts: 0,
+    };
     sim.run(&mut probe, 2000);
     let ends = probe.after.iter().filter(|a| a.1).count();
     assert!(ends >= 2, "the test needs episode ends");
@@ -251,7 +343,11 @@ fn the_state_reached_is_the_state_decided_on_next() {
     for t in 0..1999 {
         let (reached, ended) = &probe.after[t];
         if *ended {
-            assert_ne!(reached, &probe.decided[t + 1], "after a reset the next decision sees the new world");
+            assert_ne!(
+                reached,
+                &probe.decided[t + 1],
+                "after a reset the next decision sees the new world"
+            );
         } else {
             assert_eq!(reached, &probe.decided[t + 1], "step {t}");
         }
@@ -272,24 +368,50 @@ fn every_reward_variant_learns_something() {
 }
 
 #[test]
-fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_and_resumes_exactly() {
-    let select = host::train::selection::SelectConfig { every: 600, steps: 400 };
-    let selecting = TrainConfig { select: Some(select), ..small(21) };
+fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_and_resumes_exactly(
+) {
+    let select = host::train::selection::SelectConfig {
+        every: 600,
+        steps: 400,
+    };
+    let selecting = TrainConfig {
+        select: Some(select),
+        ..small(21)
+    };
     let mut with = trainer(selecting.clone());
     let mut without = trainer(small(21));
     with.run(2400);
     without.run(2400);
-    assert_eq!(with.learner().table(), without.learner().table(), "evaluations do not touch the training world");
-    assert!(evolving(&with.state()).starts_with(&postcard::to_stdvec(&without.state().sim).unwrap()));
+    assert_eq!(
+        with.learner().table(),
+        without.learner().table(),
+        "evaluations do not touch the training world"
+    );
+    assert!(
+        evolving(&with.state()).starts_with(&postcard::to_stdvec(&without.state().sim).unwrap())
+    );
 
     let best = with.selected().expect("four evaluations ran").clone();
     assert!(best.step % 600 == 0 && best.step <= 2400);
-    assert_eq!(with.policy().unwrap().table().packed(), &best.packed[..], "the run's policy is the selected one");
+    assert_eq!(
+        with.policy().unwrap().table().packed(),
+        &best.packed[..],
+        "the run's policy is the selected one"
+    );
     assert_eq!(with.policy().unwrap().provenance().trainer_steps, best.step);
     // the selected policy formed at least as much as the last greedy one in the evaluation world
     let last = with.greedy_policy().unwrap();
-    let evaluation = host::train::selection::Evaluation::new(select, &selecting.prepare().unwrap(), selecting.seed).unwrap();
+    let evaluation = host::train::selection::Evaluation::new(
+        select,
+        &selecting.prepare().unwrap(),
+        selecting.seed,
+    )
+    .unwrap();
     assert!(evaluation.formations(last) <= best.formations);
 
-    assert_eq!(resumes_exactly(selecting, 1500, 2400), 3, "formats 1 and 2 hold no selection");
+    assert_eq!(
+        resumes_exactly(selecting, 1500, 2400),
+        3,
+        "formats 1 and 2 hold no selection"
+    );
 }

@@ -11,7 +11,11 @@ fn host() -> Command {
 /// Runs `host` in `dir` with `args`, expects success, returns stdout.
 fn ok(dir: &Path, args: &[&str]) -> String {
     let out = host().current_dir(dir).args(args).output().unwrap();
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     String::from_utf8(out.stdout).unwrap()
 }
 
@@ -22,23 +26,51 @@ fn fails(dir: &Path, args: &[&str]) -> String {
     String::from_utf8(out.stderr).unwrap()
 }
 
-const QUICK: [&str; 6] = ["train", "--robots", "4", "--pucks", "60", "--checkpoint-every=1000"];
+const QUICK: [&str; 6] = [
+    "train",
+    "--robots",
+    "4",
+    "--pucks",
+    "60",
+    "--checkpoint-every=1000",
+];
 
 #[test]
 fn train_writes_policy_and_checkpoint_under_out_and_summarises() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let text = ok(d, &[&QUICK[..], &["--steps", "3000"]].concat());
-    for key in ["formations", "stuck episodes", "steps per second", "states visited", "of 256"] {
+    for key in [
+        "formations",
+        "stuck episodes",
+        "steps per second",
+        "states visited",
+        "of 256",
+    ] {
         assert!(text.contains(key), "missing {key}: {text}");
     }
     let policy = d.join("out/annulus-original.policy");
     assert!(policy.is_file() && d.join("out/annulus-original.ckpt").is_file());
-    assert!(!d.join("policies").exists(), "training never writes policies/ by default");
+    assert!(
+        !d.join("policies").exists(),
+        "training never writes policies/ by default"
+    );
 
     let inspect = ok(d, &["policy", "inspect", policy.to_str().unwrap()]);
-    assert!(inspect.contains("annulus") && inspect.contains("annulus-original"), "{inspect}");
-    let run = ok(d, &["run", "--steps", "500", "--controller", &format!("policy:{}", policy.display())]);
+    assert!(
+        inspect.contains("annulus") && inspect.contains("annulus-original"),
+        "{inspect}"
+    );
+    let run = ok(
+        d,
+        &[
+            "run",
+            "--steps",
+            "500",
+            "--controller",
+            &format!("policy:{}", policy.display()),
+        ],
+    );
     assert!(run.contains("formations"), "{run}");
 }
 
@@ -46,18 +78,65 @@ fn train_writes_policy_and_checkpoint_under_out_and_summarises() {
 fn resuming_continues_exactly_where_the_run_stopped() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    ok(d, &[&QUICK[..], &["--steps", "5000", "--name", "long"]].concat());
-    ok(d, &[&QUICK[..], &["--steps", "3000", "--name", "split"]].concat());
-    let resumed = ok(d, &["train", "--resume", "out/split.ckpt", "--steps", "2000", "--name", "long", "--out", "again"]);
+    ok(
+        d,
+        &[&QUICK[..], &["--steps", "5000", "--name", "long"]].concat(),
+    );
+    ok(
+        d,
+        &[&QUICK[..], &["--steps", "3000", "--name", "split"]].concat(),
+    );
+    let resumed = ok(
+        d,
+        &[
+            "train",
+            "--resume",
+            "out/split.ckpt",
+            "--steps",
+            "2000",
+            "--name",
+            "long",
+            "--out",
+            "again",
+        ],
+    );
     assert!(resumed.contains("run total 5000"), "{resumed}");
     let a = std::fs::read(d.join("out/long.policy")).unwrap();
     let b = std::fs::read(d.join("again/long.policy")).unwrap();
     assert_eq!(a, b, "train(3000) + resume(2000) differs from train(5000)");
 
     // RL2: a new run seeded with the table
-    let seeded = ok(d, &[&QUICK[..], &["--steps", "1000", "--init-from", "out/long.ckpt", "--name", "rl2"]].concat());
+    let seeded = ok(
+        d,
+        &[
+            &QUICK[..],
+            &[
+                "--steps",
+                "1000",
+                "--init-from",
+                "out/long.ckpt",
+                "--name",
+                "rl2",
+            ],
+        ]
+        .concat(),
+    );
     assert!(seeded.contains("run total 1000"));
-    let from_blob = ok(d, &[&QUICK[..], &["--steps", "1000", "--init-from", "out/long.policy", "--name", "b"]].concat());
+    let from_blob = ok(
+        d,
+        &[
+            &QUICK[..],
+            &[
+                "--steps",
+                "1000",
+                "--init-from",
+                "out/long.policy",
+                "--name",
+                "b",
+            ],
+        ]
+        .concat(),
+    );
     assert!(from_blob.contains("run total 1000"));
 }
 
@@ -71,7 +150,10 @@ fn a_config_file_sets_everything_and_flags_override_it() {
     )
     .unwrap();
     let text = ok(d, &["train", "--config", "run.toml", "--hasher", "bits9"]);
-    assert!(text.contains("run total 1500") && text.contains("of 512"), "{text}");
+    assert!(
+        text.contains("run total 1500") && text.contains("of 512"),
+        "{text}"
+    );
     let inspect = ok(d, &["policy", "inspect", "res/ell.policy"]);
     assert!(inspect.contains("letter:L"), "{inspect}");
 }
@@ -93,10 +175,20 @@ fn bad_inputs_are_refused_with_a_clear_error() {
     let e = fails(d, &["train", "--config", "typo.toml"]);
     assert!(e.contains("alpah") && e.contains("line 3"), "{e}");
 
-    ok(d, &[&QUICK[..], &["--steps", "500", "--hasher", "bits7", "--name", "seven"]].concat());
+    ok(
+        d,
+        &[
+            &QUICK[..],
+            &["--steps", "500", "--hasher", "bits7", "--name", "seven"],
+        ]
+        .concat(),
+    );
     for file in ["out/seven.ckpt", "out/seven.policy"] {
         let e = fails(d, &["train", "--steps", "10", "--init-from", file]);
-        assert!(e.contains("bits7") && e.contains("original") && e.contains(file), "{e}");
+        assert!(
+            e.contains("bits7") && e.contains("original") && e.contains(file),
+            "{e}"
+        );
     }
 
     let ckpt = std::fs::read(d.join("out/seven.ckpt")).unwrap();
@@ -105,7 +197,16 @@ fn bad_inputs_are_refused_with_a_clear_error() {
     assert!(e.contains("cut.ckpt") && e.contains("truncated"), "{e}");
     let e = fails(d, &["train", "--resume", "out/seven.policy"]);
     assert!(e.contains("policy blob, not a checkpoint"), "{e}");
-    let e = fails(d, &["train", "--resume", "out/seven.ckpt", "--hasher", "original"]);
+    let e = fails(
+        d,
+        &[
+            "train",
+            "--resume",
+            "out/seven.ckpt",
+            "--hasher",
+            "original",
+        ],
+    );
     assert!(e.contains("--hasher cannot change"), "{e}");
     let e = fails(d, &["train", "--resume", "/no/such.ckpt"]);
     assert!(e.contains("/no/such.ckpt"), "{e}");

@@ -125,18 +125,33 @@ impl std::error::Error for BatchError {}
 impl Batch {
     /// `num_worlds` worlds seeded `settings.seed`, `seed + 1`, ...;
     /// stepped by `threads` threads (one thread: the caller's).
-    pub fn new(settings: EnvSettings, num_worlds: usize, autoreset: Autoreset, threads: usize) -> Result<Batch, BatchError> {
+    pub fn new(
+        settings: EnvSettings,
+        num_worlds: usize,
+        autoreset: Autoreset,
+        threads: usize,
+    ) -> Result<Batch, BatchError> {
         let worlds = (0..num_worlds as u64)
             .map(|i| WorldEnv::new(&settings, settings.seed.wrapping_add(i)))
             .collect::<Result<Vec<_>, _>>()
             .map_err(BatchError::Scenario)?;
         let threads = threads.min(num_worlds).max(1);
         let pool = if threads > 1 {
-            Some(rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(BatchError::Threads)?)
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .map_err(BatchError::Threads)?,
+            )
         } else {
             None
         };
-        Ok(Batch { settings, autoreset, worlds, pool })
+        Ok(Batch {
+            settings,
+            autoreset,
+            worlds,
+            pool,
+        })
     }
 
     /// The settings.
@@ -249,9 +264,15 @@ impl Batch {
         let one = |(i, (world, obs)): (usize, (&mut WorldEnv, &mut [T]))| {
             let own = match actions {
                 Actions::Discrete(a) => WorldActions::Discrete(&a[i * robots..(i + 1) * robots]),
-                Actions::Continuous(a) => WorldActions::Continuous(&a[i * robots..(i + 1) * robots]),
+                Actions::Continuous(a) => {
+                    WorldActions::Continuous(&a[i * robots..(i + 1) * robots])
+                }
             };
-            let step = if world.ended() { world.start_episode(settings) } else { world.advance(settings, own) };
+            let step = if world.ended() {
+                world.start_episode(settings)
+            } else {
+                world.advance(settings, own)
+            };
             let ended_now = autoreset == Autoreset::SameStep && step.ended();
             // A world that ended with same-step autoreset leaves its last
             // observation here; it is moved aside and replaced below.
@@ -260,22 +281,44 @@ impl Batch {
         };
         let results: Vec<(WorldStep, bool)> = match &self.pool {
             Some(pool) => pool.install(|| {
-                self.worlds.par_iter_mut().zip(observations.par_chunks_exact_mut(per_world)).enumerate().map(one).collect()
+                self.worlds
+                    .par_iter_mut()
+                    .zip(observations.par_chunks_exact_mut(per_world))
+                    .enumerate()
+                    .map(one)
+                    .collect()
             }),
-            None => self.worlds.iter_mut().zip(observations.chunks_exact_mut(per_world)).enumerate().map(one).collect(),
+            None => self
+                .worlds
+                .iter_mut()
+                .zip(observations.chunks_exact_mut(per_world))
+                .enumerate()
+                .map(one)
+                .collect(),
         };
         let (steps, final_mask): (Vec<WorldStep>, Vec<bool>) = results.into_iter().unzip();
         let final_observations = final_mask.contains(&true).then(|| {
             let mut finals = vec![T::default(); observations.len()];
-            let chunks = finals.chunks_exact_mut(per_world).zip(observations.chunks_exact_mut(per_world));
-            for (((last, obs), world), _) in chunks.zip(&mut self.worlds).zip(&final_mask).filter(|(_, &ended)| ended) {
+            let chunks = finals
+                .chunks_exact_mut(per_world)
+                .zip(observations.chunks_exact_mut(per_world));
+            for (((last, obs), world), _) in chunks
+                .zip(&mut self.worlds)
+                .zip(&final_mask)
+                .filter(|(_, &ended)| ended)
+            {
                 last.copy_from_slice(obs);
                 world.start_episode(settings);
                 write_all(kind, world.readings(), obs);
             }
             T::wrap(finals)
         });
-        StepOutput { observations: T::wrap(observations), steps, final_observations, final_mask }
+        StepOutput {
+            observations: T::wrap(observations),
+            steps,
+            final_observations,
+            final_mask,
+        }
     }
 }
 
@@ -285,7 +328,13 @@ mod tests {
     use crate::settings::EnvArgs;
 
     fn batch(worlds: usize, autoreset: Autoreset, threads: usize, max_steps: Option<i64>) -> Batch {
-        let args = EnvArgs { robots: Some(3), pucks: Some(20), max_steps, observation: "state".into(), ..EnvArgs::default() };
+        let args = EnvArgs {
+            robots: Some(3),
+            pucks: Some(20),
+            max_steps,
+            observation: "state".into(),
+            ..EnvArgs::default()
+        };
         Batch::new(args.settings().unwrap(), worlds, autoreset, threads).unwrap()
     }
 
@@ -299,10 +348,25 @@ mod tests {
         let mut two = batch(4, Autoreset::NextStep, 2, Some(30));
         for step in 0..100 {
             let a = actions_of(step, 12);
-            assert_eq!(one.step(Actions::Discrete(&a)).unwrap(), two.step(Actions::Discrete(&a)).unwrap());
+            assert_eq!(
+                one.step(Actions::Discrete(&a)).unwrap(),
+                two.step(Actions::Discrete(&a)).unwrap()
+            );
         }
-        let positions = |b: &Batch, w: usize| b.worlds()[w].sim().world().bodies().iter().map(|b| b.pos).collect::<Vec<_>>();
-        assert_ne!(positions(&one, 0), positions(&one, 1), "worlds of different seeds differ");
+        let positions = |b: &Batch, w: usize| {
+            b.worlds()[w]
+                .sim()
+                .world()
+                .bodies()
+                .iter()
+                .map(|b| b.pos)
+                .collect::<Vec<_>>()
+        };
+        assert_ne!(
+            positions(&one, 0),
+            positions(&one, 1),
+            "worlds of different seeds differ"
+        );
     }
 
     #[test]
@@ -315,9 +379,15 @@ mod tests {
         }
         let out = b.step(Actions::Discrete(&[3, 3, 3])).unwrap();
         let s = out.steps[0];
-        assert!(s.reset && !s.ended() && s.reward == 0.0 && s.episode_step == 0, "{s:?}");
+        assert!(
+            s.reset && !s.ended() && s.reward == 0.0 && s.episode_step == 0,
+            "{s:?}"
+        );
         assert_eq!(out.observations, b.observations());
-        assert_eq!(b.step(Actions::Discrete(&[0, 0, 0])).unwrap().steps[0].episode_step, 1);
+        assert_eq!(
+            b.step(Actions::Discrete(&[0, 0, 0])).unwrap().steps[0].episode_step,
+            1
+        );
     }
 
     #[test]
@@ -342,16 +412,34 @@ mod tests {
         let mut b = batch(2, Autoreset::Off, 2, Some(2));
         let before = b.observations();
         let e = b.step(Actions::Discrete(&[0, 0, 0, 0, 9, 0])).unwrap_err();
-        assert_eq!(e.to_string(), "actions[1, 1] = 9: must be an action index in 0..4");
-        assert!(matches!(b.step(Actions::Discrete(&[0, 0])), Err(StepError::WrongCount { expected: 6, found: 2 })));
-        assert!(matches!(b.step(Actions::Continuous(&[0.0; 6])), Err(StepError::WrongKind { .. })));
+        assert_eq!(
+            e.to_string(),
+            "actions[1, 1] = 9: must be an action index in 0..4"
+        );
+        assert!(matches!(
+            b.step(Actions::Discrete(&[0, 0])),
+            Err(StepError::WrongCount {
+                expected: 6,
+                found: 2
+            })
+        ));
+        assert!(matches!(
+            b.step(Actions::Continuous(&[0.0; 6])),
+            Err(StepError::WrongKind { .. })
+        ));
         assert_eq!(b.observations(), before);
         assert_eq!(b.worlds()[0].totals().steps, 0);
         b.step(Actions::Discrete(&[0; 6])).unwrap();
         b.step(Actions::Discrete(&[0; 6])).unwrap();
-        assert_eq!(b.step(Actions::Discrete(&[0; 6])).unwrap_err(), StepError::Ended { world: 0 });
+        assert_eq!(
+            b.step(Actions::Discrete(&[0; 6])).unwrap_err(),
+            StepError::Ended { world: 0 }
+        );
         b.reset(None).unwrap();
-        assert_eq!(b.step(Actions::Discrete(&[0; 6])).unwrap().steps[0].episode_step, 1);
+        assert_eq!(
+            b.step(Actions::Discrete(&[0; 6])).unwrap().steps[0].episode_step,
+            1
+        );
     }
 
     #[test]
@@ -362,6 +450,10 @@ mod tests {
             b.step(Actions::Discrete(&actions_of(step, 3))).unwrap();
         }
         assert_eq!(b.reset(Some(&[1])).unwrap(), fresh);
-        assert_eq!(b.reset(None).unwrap(), fresh, "a reset right after a reseed keeps the seed's first episode");
+        assert_eq!(
+            b.reset(None).unwrap(),
+            fresh,
+            "a reset right after a reseed keeps the seed's first episode"
+        );
     }
 }

@@ -48,7 +48,11 @@ pub struct PyBatch {
     batch: Batch,
 }
 
-fn observations_array<'py>(py: Python<'py>, obs: Observations, shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+fn observations_array<'py>(
+    py: Python<'py>,
+    obs: Observations,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
     Ok(match obs {
         Observations::Readings(v) => PyArray1::from_vec(py, v).reshape(shape)?.into_any(),
         Observations::States(v) => PyArray1::from_vec(py, v).reshape(shape)?.into_any(),
@@ -129,25 +133,34 @@ impl PyBatch {
             forward_speed,
         };
         if num_worlds < 1 {
-            return Err(value_error(format!("num_worlds = {num_worlds}: must be a whole number of at least 1")));
+            return Err(value_error(format!(
+                "num_worlds = {num_worlds}: must be a whole number of at least 1"
+            )));
         }
         let autoreset = match autoreset.as_str() {
             "off" => Autoreset::Off,
             "next-step" => Autoreset::NextStep,
             "same-step" => Autoreset::SameStep,
             other => {
-                return Err(value_error(format!("autoreset = {other:?}: expected \"off\", \"next-step\" or \"same-step\"")))
+                return Err(value_error(format!(
+                    "autoreset = {other:?}: expected \"off\", \"next-step\" or \"same-step\""
+                )))
             }
         };
         let threads = match threads {
             None => std::thread::available_parallelism().map_or(1, |n| n.get()),
             Some(t) if t >= 1 => t as usize,
-            Some(t) => return Err(value_error(format!("threads = {t}: must be a whole number of at least 1"))),
+            Some(t) => {
+                return Err(value_error(format!(
+                    "threads = {t}: must be a whole number of at least 1"
+                )))
+            }
         };
         let batch = py
             .detach(|| {
                 let settings = args.settings().map_err(|e| e.to_string())?;
-                Batch::new(settings, num_worlds as usize, autoreset, threads).map_err(|e| e.to_string())
+                Batch::new(settings, num_worlds as usize, autoreset, threads)
+                    .map_err(|e| e.to_string())
             })
             .map_err(PyValueError::new_err)?;
         Ok(PyBatch { batch })
@@ -237,7 +250,12 @@ impl PyBatch {
     /// Steps between formation checks.
     #[getter]
     fn check_interval(&self) -> u64 {
-        self.batch.settings().prepared.config().episode.check_interval
+        self.batch
+            .settings()
+            .prepared
+            .config()
+            .episode
+            .check_interval
     }
 
     /// The reward's name.
@@ -251,25 +269,44 @@ impl PyBatch {
     /// one per world, each world starts afresh from its seed. Returns the
     /// observations.
     #[pyo3(signature = (seeds = None))]
-    fn reset<'py>(&mut self, py: Python<'py>, seeds: Option<Vec<i64>>) -> PyResult<Bound<'py, PyAny>> {
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seeds: Option<Vec<i64>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let n = self.batch.worlds().len();
         let seeds = match seeds {
-            Some(s) if s.len() != n => return Err(value_error(format!("seed: got {} seeds for {n} worlds", s.len()))),
+            Some(s) if s.len() != n => {
+                return Err(value_error(format!(
+                    "seed: got {} seeds for {n} worlds",
+                    s.len()
+                )))
+            }
             Some(s) => Some(
                 s.iter()
-                    .map(|&x| u64::try_from(x).map_err(|_| value_error(format!("seed = {x}: must be a whole number of at least 0"))))
+                    .map(|&x| {
+                        u64::try_from(x).map_err(|_| {
+                            value_error(format!("seed = {x}: must be a whole number of at least 0"))
+                        })
+                    })
                     .collect::<PyResult<Vec<u64>>>()?,
             ),
             None => None,
         };
         let batch = &mut self.batch;
-        let obs = py.detach(|| batch.reset(seeds.as_deref())).map_err(value_error)?;
+        let obs = py
+            .detach(|| batch.reset(seeds.as_deref()))
+            .map_err(value_error)?;
         observations_array(py, obs, &self.observation_shape(n))
     }
 
     /// Every world's current observations.
     fn observations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        observations_array(py, self.batch.observations(), &self.observation_shape(self.batch.worlds().len()))
+        observations_array(
+            py,
+            self.batch.observations(),
+            &self.observation_shape(self.batch.worlds().len()),
+        )
     }
 
     /// One step of every world with a flat array of worlds x robots
@@ -277,7 +314,11 @@ impl PyBatch {
     /// (observations, reward per world, terminated, truncated, info), info
     /// a dict of per-world arrays; with same-step autoreset it holds
     /// `final_obs` (zeros for worlds that did not end) and `_final_obs`.
-    fn step<'py>(&mut self, py: Python<'py>, actions: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let out = if let Ok(a) = actions.extract::<PyReadonlyArray1<'py, i64>>() {
             let a = a.as_slice()?;
             let batch = &mut self.batch;
@@ -287,49 +328,96 @@ impl PyBatch {
             let batch = &mut self.batch;
             py.detach(|| batch.step(Actions::Continuous(a)))
         } else {
-            return Err(PyTypeError::new_err("actions must be a one-dimensional int64 or float64 NumPy array"));
+            return Err(PyTypeError::new_err(
+                "actions must be a one-dimensional int64 or float64 NumPy array",
+            ));
         }
         .map_err(step_error)?;
         let n = out.steps.len();
         let shape = self.observation_shape(n);
-        let column = |f: &dyn Fn(&world_env::WorldStep) -> f64| out.steps.iter().map(f).collect::<Vec<f64>>();
+        let column = |f: &dyn Fn(&world_env::WorldStep) -> f64| {
+            out.steps.iter().map(f).collect::<Vec<f64>>()
+        };
         let info = PyDict::new(py);
         info.set_item("eval", PyArray1::from_vec(py, column(&|s| s.eval)))?;
-        let ints = |f: &dyn Fn(usize) -> i64| PyArray1::from_vec(py, (0..n).map(f).collect::<Vec<i64>>());
+        let ints =
+            |f: &dyn Fn(usize) -> i64| PyArray1::from_vec(py, (0..n).map(f).collect::<Vec<i64>>());
         info.set_item("episode_step", ints(&|i| out.steps[i].episode_step as i64))?;
-        info.set_item("robot_contacts", ints(&|i| out.steps[i].robot_contacts as i64))?;
+        info.set_item(
+            "robot_contacts",
+            ints(&|i| out.steps[i].robot_contacts as i64),
+        )?;
         let worlds = self.batch.worlds();
-        info.set_item("formations", ints(&|i| worlds[i].totals().formations as i64))?;
+        info.set_item(
+            "formations",
+            ints(&|i| worlds[i].totals().formations as i64),
+        )?;
         info.set_item("stuck_episodes", ints(&|i| worlds[i].totals().stuck as i64))?;
         info.set_item("total_steps", ints(&|i| worlds[i].totals().steps as i64))?;
-        info.set_item("mean_eval", PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().mean_eval()).collect()))?;
+        info.set_item(
+            "mean_eval",
+            PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().mean_eval()).collect()),
+        )?;
         info.set_item(
             "collisions_per_1000",
-            PyArray1::from_vec(py, worlds.iter().map(|w| w.totals().collisions_per_1000()).collect()),
+            PyArray1::from_vec(
+                py,
+                worlds
+                    .iter()
+                    .map(|w| w.totals().collisions_per_1000())
+                    .collect(),
+            ),
         )?;
-        info.set_item("reset", PyArray1::from_vec(py, out.steps.iter().map(|s| s.reset).collect::<Vec<bool>>()))?;
+        info.set_item(
+            "reset",
+            PyArray1::from_vec(py, out.steps.iter().map(|s| s.reset).collect::<Vec<bool>>()),
+        )?;
         if let Some(finals) = out.final_observations {
             info.set_item("final_obs", observations_array(py, finals, &shape)?)?;
             info.set_item("_final_obs", PyArray1::from_vec(py, out.final_mask))?;
         }
         let rewards = PyArray1::from_vec(py, column(&|s| s.reward));
-        let terminated = PyArray1::from_vec(py, out.steps.iter().map(|s| s.terminated).collect::<Vec<bool>>());
-        let truncated = PyArray1::from_vec(py, out.steps.iter().map(|s| s.truncated).collect::<Vec<bool>>());
+        let terminated = PyArray1::from_vec(
+            py,
+            out.steps
+                .iter()
+                .map(|s| s.terminated)
+                .collect::<Vec<bool>>(),
+        );
+        let truncated = PyArray1::from_vec(
+            py,
+            out.steps.iter().map(|s| s.truncated).collect::<Vec<bool>>(),
+        );
         let obs = observations_array(py, out.observations, &shape)?;
-        Ok((obs, rewards, terminated, truncated, info).into_pyobject(py)?.into_any())
+        Ok((obs, rewards, terminated, truncated, info)
+            .into_pyobject(py)?
+            .into_any())
     }
 
     /// World `world` drawn as `host render` draws it: an RGB array of
     /// `size` x `size` pixels (field grey, pucks red, robots blue).
     #[pyo3(signature = (world = 0, size = 800, footprints = false))]
-    fn render<'py>(&self, py: Python<'py>, world: usize, size: u32, footprints: bool) -> PyResult<Bound<'py, PyAny>> {
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        world: usize,
+        size: u32,
+        footprints: bool,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let world = self.world_index(world)?;
         if !(16..=4096).contains(&size) {
-            return Err(value_error(format!("render_size = {size}: must be 16 to 4096 pixels")));
+            return Err(value_error(format!(
+                "render_size = {size}: must be 16 to 4096 pixels"
+            )));
         }
-        let image = sim::render::draw(self.batch.worlds()[world].sim(), RenderOptions { size, footprints });
+        let image = sim::render::draw(
+            self.batch.worlds()[world].sim(),
+            RenderOptions { size, footprints },
+        );
         let (w, h) = (image.width() as usize, image.height() as usize);
-        Ok(PyArray1::from_vec(py, image.into_raw()).reshape([h, w, 3])?.into_any())
+        Ok(PyArray1::from_vec(py, image.into_raw())
+            .reshape([h, w, 3])?
+            .into_any())
     }
 
     /// World `world`'s bodies (robots first, then pucks): an array of
@@ -338,9 +426,18 @@ impl PyBatch {
     fn positions<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyAny>> {
         let w = self.batch.worlds()[self.world_index(world)?].sim().world();
         let xy: Vec<f64> = w.bodies().iter().flat_map(|b| [b.pos.x, b.pos.y]).collect();
-        let headings: Vec<f64> = w.robots().iter().map(|r| r.direction.y.atan2(r.direction.x)).collect();
+        let headings: Vec<f64> = w
+            .robots()
+            .iter()
+            .map(|r| r.direction.y.atan2(r.direction.x))
+            .collect();
         let n = w.bodies().len();
-        Ok((PyArray1::from_vec(py, xy).reshape([n, 2])?, PyArray1::from_vec(py, headings)).into_pyobject(py)?.into_any())
+        Ok((
+            PyArray1::from_vec(py, xy).reshape([n, 2])?,
+            PyArray1::from_vec(py, headings),
+        )
+            .into_pyobject(py)?
+            .into_any())
     }
 }
 
@@ -359,7 +456,15 @@ fn encode_policy<'py>(
     trainer_steps: u64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyBytes>> {
-    let header = PolicyHeader { hasher, actions: &actions, forward_speed, field, name, trainer_steps, seed };
+    let header = PolicyHeader {
+        hasher,
+        actions: &actions,
+        forward_speed,
+        field,
+        name,
+        trainer_steps,
+        seed,
+    };
     let bytes = policy_codec::encode(&table, &header).map_err(value_error)?;
     Ok(PyBytes::new(py, &bytes))
 }
@@ -374,7 +479,10 @@ fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Boun
     d.set_item("hasher", blob.hasher().name())?;
     d.set_item("actions", blob.actions().angular_speeds().to_vec())?;
     d.set_item("forward_speed", blob.actions().forward_speed())?;
-    d.set_item("table", PyArray1::from_vec(py, policy_codec::table_of(&blob)))?;
+    d.set_item(
+        "table",
+        PyArray1::from_vec(py, policy_codec::table_of(&blob)),
+    )?;
     let p = blob.provenance();
     d.set_item("field", p.field.as_str())?;
     d.set_item("name", p.name.as_str())?;
@@ -390,11 +498,31 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBatch>()?;
     m.add_function(wrap_pyfunction!(encode_policy, m)?)?;
     m.add_function(wrap_pyfunction!(decode_policy, m)?)?;
-    m.add("HASHERS", StateHasher::ALL.iter().map(|h| h.name()).collect::<Vec<_>>())?;
-    m.add("REWARDS", Reward::ALL.iter().map(|r| r.name()).collect::<Vec<_>>())?;
+    m.add(
+        "HASHERS",
+        StateHasher::ALL
+            .iter()
+            .map(|h| h.name())
+            .collect::<Vec<_>>(),
+    )?;
+    m.add(
+        "REWARDS",
+        Reward::ALL.iter().map(|r| r.name()).collect::<Vec<_>>(),
+    )?;
     m.add("SENSORS", SensorSetup::NAMES)?;
     m.add("DEFAULT_ANGULAR", ActionTable::DEFAULT_ANGULAR.to_vec())?;
     m.add("DEFAULT_FORWARD_SPEED", ActionTable::DEFAULT_FORWARD_SPEED)?;
-    m.add("READING_FIELDS", ["left", "mid", "right", "puck_left", "puck_right", "obstacle_left", "obstacle_right"])?;
+    m.add(
+        "READING_FIELDS",
+        [
+            "left",
+            "mid",
+            "right",
+            "puck_left",
+            "puck_right",
+            "obstacle_left",
+            "obstacle_right",
+        ],
+    )?;
     Ok(())
 }

@@ -64,7 +64,11 @@ impl ObservationValue for i64 {
 }
 
 /// Writes the observations of `readings` (one world's robots) into `out`.
-pub fn write_all<T: ObservationValue>(kind: ObservationKind, readings: &[SensorReading], out: &mut [T]) {
+pub fn write_all<T: ObservationValue>(
+    kind: ObservationKind,
+    readings: &[SensorReading],
+    out: &mut [T],
+) {
     let per = T::per_robot(kind);
     for (reading, chunk) in readings.iter().zip(out.chunks_exact_mut(per)) {
         T::write(kind, reading, chunk);
@@ -90,7 +94,11 @@ mod tests {
         assert_eq!(floats[3..], [1.0, 0.0, 0.0, 0.0]);
         assert!((floats[1] - 0.4).abs() < 1e-4);
         let mut state = [0i64];
-        write_all(ObservationKind::State(StateHasher::Original), &[r], &mut state);
+        write_all(
+            ObservationKind::State(StateHasher::Original),
+            &[r],
+            &mut state,
+        );
         // The thesis' worked example (docs/state-hash.md).
         assert_eq!(state, [101]);
     }

@@ -27,15 +27,24 @@ pub struct PolicyHeader<'a> {
 /// Encodes `table` (the action of every state, in state order) as a blob.
 pub fn encode(table: &[i64], header: &PolicyHeader<'_>) -> Result<Vec<u8>, ArgumentError> {
     let hasher = StateHasher::from_name(header.hasher).ok_or_else(|| {
-        ArgumentError::new("hasher", format!("{:?}", header.hasher), format!("unknown hasher; expected {}", StateHasher::NAMES))
+        ArgumentError::new(
+            "hasher",
+            format!("{:?}", header.hasher),
+            format!("unknown hasher; expected {}", StateHasher::NAMES),
+        )
     })?;
-    let actions = ActionTable::new(header.actions, header.forward_speed)
-        .map_err(|e| ArgumentError::new("actions", format!("{:?}", header.actions), e.to_string()))?;
+    let actions = ActionTable::new(header.actions, header.forward_speed).map_err(|e| {
+        ArgumentError::new("actions", format!("{:?}", header.actions), e.to_string())
+    })?;
     if table.len() != hasher.num_states() {
         return Err(ArgumentError::new(
             "table",
             format!("<{} entries>", table.len()),
-            format!("hasher {} has {} states: give one action per state", hasher.name(), hasher.num_states()),
+            format!(
+                "hasher {} has {} states: give one action per state",
+                hasher.name(),
+                hasher.num_states()
+            ),
         ));
     }
     let mut policy = PolicyTable::new(hasher);
@@ -50,7 +59,13 @@ pub fn encode(table: &[i64], header: &PolicyHeader<'_>) -> Result<Vec<u8>, Argum
         policy.set(State(state as u16), ActionId(action as u8));
     }
     let provenance = Provenance::new(header.field, header.name, header.trainer_steps, header.seed)
-        .map_err(|e| ArgumentError::new("field, name", format!("{:?}, {:?}", header.field, header.name), e.to_string()))?;
+        .map_err(|e| {
+            ArgumentError::new(
+                "field, name",
+                format!("{:?}, {:?}", header.field, header.name),
+                e.to_string(),
+            )
+        })?;
     let blob = PolicyBlob::new(actions, policy, provenance)
         .map_err(|e| ArgumentError::new("table", "<table>", e.to_string()))?;
     Ok(blob.encode().to_vec())
@@ -58,7 +73,10 @@ pub fn encode(table: &[i64], header: &PolicyHeader<'_>) -> Result<Vec<u8>, Argum
 
 /// The action of every state of a decoded blob, in state order.
 pub fn table_of(blob: &PolicyBlob) -> Vec<i64> {
-    blob.table().entries().map(|(_, a)| i64::from(a.0)).collect()
+    blob.table()
+        .entries()
+        .map(|(_, a)| i64::from(a.0))
+        .collect()
 }
 
 #[cfg(test)]
@@ -88,12 +106,26 @@ mod tests {
     #[test]
     fn a_wrong_table_is_refused_with_the_entry_named() {
         let e = encode(&[0; 10], &HEADER).unwrap_err().to_string();
-        assert!(e.starts_with("table = <10 entries>: hasher bits7 has 128 states"), "{e}");
+        assert!(
+            e.starts_with("table = <10 entries>: hasher bits7 has 128 states"),
+            "{e}"
+        );
         let mut table = vec![0; 128];
         table[5] = 4;
-        assert_eq!(encode(&table, &HEADER).unwrap_err().to_string(), "table[5] = 4: must be an action index in 0..4");
+        assert_eq!(
+            encode(&table, &HEADER).unwrap_err().to_string(),
+            "table[5] = 4: must be an action index in 0..4"
+        );
         let long = "x".repeat(40);
-        let e = encode(&[0; 128], &PolicyHeader { name: &long, ..HEADER }).unwrap_err().to_string();
+        let e = encode(
+            &[0; 128],
+            &PolicyHeader {
+                name: &long,
+                ..HEADER
+            },
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.starts_with("field, name = "), "{e}");
     }
 }

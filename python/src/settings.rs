@@ -30,8 +30,16 @@ pub struct ArgumentError {
 
 impl ArgumentError {
     /// The error of `argument` with `value`.
-    pub fn new(argument: &str, value: impl fmt::Display, problem: impl Into<String>) -> ArgumentError {
-        ArgumentError { argument: argument.to_string(), value: value.to_string(), problem: problem.into() }
+    pub fn new(
+        argument: &str,
+        value: impl fmt::Display,
+        problem: impl Into<String>,
+    ) -> ArgumentError {
+        ArgumentError {
+            argument: argument.to_string(),
+            value: value.to_string(),
+            problem: problem.into(),
+        }
     }
 }
 
@@ -162,22 +170,43 @@ pub struct EnvSettings {
 
 fn count(name: &str, value: i64, min: i64) -> Result<usize, ArgumentError> {
     if value < min {
-        return Err(ArgumentError::new(name, value, format!("must be a whole number of at least {min}")));
+        return Err(ArgumentError::new(
+            name,
+            value,
+            format!("must be a whole number of at least {min}"),
+        ));
     }
     usize::try_from(value).map_err(|_| ArgumentError::new(name, value, "is too large"))
 }
 
 fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, ArgumentError> {
     let setup = SensorSetup::from_name(name).ok_or_else(|| {
-        ArgumentError::new("sensors", format!("{name:?}"), format!("unknown sensor model; expected {}", SensorSetup::NAMES))
+        ArgumentError::new(
+            "sensors",
+            format!("{name:?}"),
+            format!("unknown sensor model; expected {}", SensorSetup::NAMES),
+        )
     })?;
-    let Some(json) = robot_config else { return Ok(setup) };
+    let Some(json) = robot_config else {
+        return Ok(setup);
+    };
     if !matches!(setup, SensorSetup::Robot(_)) {
-        return Err(ArgumentError::new("robot_config", json, "is only for sensors=\"robot\""));
+        return Err(ArgumentError::new(
+            "robot_config",
+            json,
+            "is only for sensors=\"robot\"",
+        ));
     }
-    let config: RobotSensorConfig = serde_json::from_str(json)
-        .map_err(|e| ArgumentError::new("robot_config", json, format!("is not a valid robot sensor config: {e}")))?;
-    config.validate().map_err(|e| ArgumentError::new("robot_config", json, e.to_string()))?;
+    let config: RobotSensorConfig = serde_json::from_str(json).map_err(|e| {
+        ArgumentError::new(
+            "robot_config",
+            json,
+            format!("is not a valid robot sensor config: {e}"),
+        )
+    })?;
+    config
+        .validate()
+        .map_err(|e| ArgumentError::new("robot_config", json, e.to_string()))?;
     Ok(SensorSetup::Robot(Box::new(config)))
 }
 
@@ -213,20 +242,31 @@ impl EnvArgs {
     /// Checks every argument, then builds and validates the scenario and
     /// loads its field.
     pub fn settings(&self) -> Result<EnvSettings, SettingsError> {
-        let field: FieldSource =
-            self.field.parse().map_err(|e| ArgumentError::new("field", format!("{:?}", self.field), format!("{e}")))?;
+        let field: FieldSource = self.field.parse().map_err(|e| {
+            ArgumentError::new("field", format!("{:?}", self.field), format!("{e}"))
+        })?;
         let robots = self.robots.map(|r| count("robots", r, 1)).transpose()?;
         let pucks = self.pucks.map(|p| count("pucks", p, 0)).transpose()?;
-        let seed = u64::try_from(self.seed)
-            .map_err(|_| ArgumentError::new("seed", self.seed, "must be a whole number of at least 0"))?;
-        let max_steps = self.max_steps.map(|m| count("max_steps", m, 1).map(|m| m as u64)).transpose()?;
-        let reward: Reward =
-            self.reward.parse().map_err(|e: String| ArgumentError::new("reward", format!("{:?}", self.reward), e))?;
+        let seed = u64::try_from(self.seed).map_err(|_| {
+            ArgumentError::new("seed", self.seed, "must be a whole number of at least 0")
+        })?;
+        let max_steps = self
+            .max_steps
+            .map(|m| count("max_steps", m, 1).map(|m| m as u64))
+            .transpose()?;
+        let reward: Reward = self
+            .reward
+            .parse()
+            .map_err(|e: String| ArgumentError::new("reward", format!("{:?}", self.reward), e))?;
         let observation = match self.observation.as_str() {
             "reading" => ObservationKind::Reading,
             "state" => {
                 let hasher = StateHasher::from_name(&self.hasher).ok_or_else(|| {
-                    ArgumentError::new("hasher", format!("{:?}", self.hasher), format!("unknown hasher; expected {}", StateHasher::NAMES))
+                    ArgumentError::new(
+                        "hasher",
+                        format!("{:?}", self.hasher),
+                        format!("unknown hasher; expected {}", StateHasher::NAMES),
+                    )
                 })?;
                 if hasher.has_role_bit() {
                     // The environments have no innies yet, so every state
@@ -241,44 +281,81 @@ impl EnvArgs {
                 ObservationKind::State(hasher)
             }
             other => {
-                return Err(ArgumentError::new("observation", format!("{other:?}"), "expected \"reading\" or \"state\"").into())
+                return Err(ArgumentError::new(
+                    "observation",
+                    format!("{other:?}"),
+                    "expected \"reading\" or \"state\"",
+                )
+                .into())
             }
         };
         let action = match self.action.as_str() {
             "discrete" => ActionKind::Discrete,
             "continuous" => ActionKind::Continuous,
             other => {
-                return Err(ArgumentError::new("action", format!("{other:?}"), "expected \"discrete\" or \"continuous\"").into())
+                return Err(ArgumentError::new(
+                    "action",
+                    format!("{other:?}"),
+                    "expected \"discrete\" or \"continuous\"",
+                )
+                .into())
             }
         };
         if !(self.forward_speed.is_finite() && self.forward_speed >= 0.0) {
-            return Err(ArgumentError::new("forward_speed", self.forward_speed, "must be a finite number, not negative").into());
+            return Err(ArgumentError::new(
+                "forward_speed",
+                self.forward_speed,
+                "must be a finite number, not negative",
+            )
+            .into());
         }
-        let actions = ActionTable::new(&self.actions, self.forward_speed)
-            .map_err(|e| ArgumentError::new("actions", format!("{:?}", self.actions), e.to_string()))?;
+        let actions = ActionTable::new(&self.actions, self.forward_speed).map_err(|e| {
+            ArgumentError::new("actions", format!("{:?}", self.actions), e.to_string())
+        })?;
         let sensors = sensors(&self.sensors, self.robot_config.as_deref())?;
 
         let arena = match self.arena.as_deref() {
-            None if matches!(sensors, SensorSetup::Robot(_)) => Arena::Screen(Box::new(ArenaSpec::tv75())),
+            None if matches!(sensors, SensorSetup::Robot(_)) => {
+                Arena::Screen(Box::new(ArenaSpec::tv75()))
+            }
             None | Some("thesis") => Arena::default(),
             Some(name) => Arena::Screen(Box::new(ArenaSpec::by_name(name).ok_or_else(|| {
-                ArgumentError::new("arena", format!("{name:?}"), format!("expected \"thesis\" or one of {}", ArenaSpec::NAMES))
+                ArgumentError::new(
+                    "arena",
+                    format!("{name:?}"),
+                    format!("expected \"thesis\" or one of {}", ArenaSpec::NAMES),
+                )
             })?)),
         };
 
         // Random is the controller whose settings leave every robot an
         // outie, as the trainer has them; the environment never uses it.
-        let scenario =
-            Scenario { field, controller: ControllerChoice::Random, robots, pucks, seed, sensors, arena, ..Scenario::default() };
+        let scenario = Scenario {
+            field,
+            controller: ControllerChoice::Random,
+            robots,
+            pucks,
+            seed,
+            sensors,
+            arena,
+            ..Scenario::default()
+        };
         // The arena's counts where none are given.
         let (default_robots, default_pucks) = match &scenario.arena {
-            Arena::Square(_) => (SimConfig::default().world.robots, SimConfig::default().world.pucks),
+            Arena::Square(_) => (
+                SimConfig::default().world.robots,
+                SimConfig::default().world.pucks,
+            ),
             Arena::Screen(spec) => (spec.robots, spec.pucks),
         };
         let mut prepared = scenario.prepare().map_err(|e| match e {
             // The one combination no single argument decides.
             ScenarioError::Config(c @ ConfigError::TooManyBodies { .. }) => {
-                let counts = format!("{}, {}", robots.unwrap_or(default_robots), pucks.unwrap_or(default_pucks));
+                let counts = format!(
+                    "{}, {}",
+                    robots.unwrap_or(default_robots),
+                    pucks.unwrap_or(default_pucks)
+                );
                 SettingsError::Argument(ArgumentError::new("robots, pucks", counts, c.to_string()))
             }
             other => SettingsError::Scenario(other),
@@ -289,12 +366,27 @@ impl EnvArgs {
             let shown = format!("({outie}, {innie})");
             let unit = |v: f64| (0.0..=1.0).contains(&v);
             if !(unit(outie) && unit(innie) && outie <= innie) {
-                return Err(ArgumentError::new("thresholds", shown, "must be (outie, innie) with 0 <= outie <= innie <= 1").into());
+                return Err(ArgumentError::new(
+                    "thresholds",
+                    shown,
+                    "must be (outie, innie) with 0 <= outie <= innie <= 1",
+                )
+                .into());
             }
             config.thresholds = Thresholds { outie, innie };
         }
-        config.validate().map_err(|e| SettingsError::Scenario(ScenarioError::Config(e)))?;
-        Ok(EnvSettings { prepared, seed, max_steps, reward, observation, action, actions })
+        config
+            .validate()
+            .map_err(|e| SettingsError::Scenario(ScenarioError::Config(e)))?;
+        Ok(EnvSettings {
+            prepared,
+            seed,
+            max_steps,
+            reward,
+            observation,
+            action,
+            actions,
+        })
     }
 }
 
@@ -306,7 +398,10 @@ impl EnvSettings {
 
     /// The continuous action's bound: the table's largest angular speed.
     pub fn max_turn(&self) -> f32 {
-        self.actions.angular_speeds().iter().fold(0.0f32, |m, a| m.max(a.abs()))
+        self.actions
+            .angular_speeds()
+            .iter()
+            .fold(0.0f32, |m, a| m.max(a.abs()))
     }
 }
 
@@ -329,24 +424,58 @@ mod tests {
 
     #[test]
     fn each_bad_argument_is_named_with_its_value_and_problem() {
-        let e = error_of(EnvArgs { robots: Some(0), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            robots: Some(0),
+            ..EnvArgs::default()
+        });
         assert_eq!(e, "robots = 0: must be a whole number of at least 1");
-        let e = error_of(EnvArgs { pucks: Some(-3), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            pucks: Some(-3),
+            ..EnvArgs::default()
+        });
         assert!(e.starts_with("pucks = -3: "), "{e}");
-        let e = error_of(EnvArgs { sensors: "pixy".into(), ..EnvArgs::default() });
-        assert!(e.starts_with("sensors = \"pixy\": unknown sensor model"), "{e}");
-        let e = error_of(EnvArgs { field: "letter:Q".into(), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            sensors: "pixy".into(),
+            ..EnvArgs::default()
+        });
+        assert!(
+            e.starts_with("sensors = \"pixy\": unknown sensor model"),
+            "{e}"
+        );
+        let e = error_of(EnvArgs {
+            field: "letter:Q".into(),
+            ..EnvArgs::default()
+        });
         assert!(e.starts_with("field = \"letter:Q\""), "{e}");
-        let e = error_of(EnvArgs { thresholds: Some((0.9, 0.2)), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            thresholds: Some((0.9, 0.2)),
+            ..EnvArgs::default()
+        });
         assert!(e.starts_with("thresholds = (0.9, 0.2)"), "{e}");
-        let e = error_of(EnvArgs { actions: vec![0.1], ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            actions: vec![0.1],
+            ..EnvArgs::default()
+        });
         assert!(e.starts_with("actions = [0.1]: action count 1"), "{e}");
-        let e = error_of(EnvArgs { pucks: Some(100_000), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            pucks: Some(100_000),
+            ..EnvArgs::default()
+        });
         assert!(e.starts_with("robots, pucks = 8, 100000: "), "{e}");
-        let e = error_of(EnvArgs { robot_config: Some("{}".into()), ..EnvArgs::default() });
-        assert!(e.starts_with("robot_config = {}: is only for sensors=\"robot\""), "{e}");
+        let e = error_of(EnvArgs {
+            robot_config: Some("{}".into()),
+            ..EnvArgs::default()
+        });
+        assert!(
+            e.starts_with("robot_config = {}: is only for sensors=\"robot\""),
+            "{e}"
+        );
         let bad_camera = r#"{"camera": {"height_mm": 0}}"#;
-        let e = error_of(EnvArgs { sensors: "robot".into(), robot_config: Some(bad_camera.into()), ..EnvArgs::default() });
+        let e = error_of(EnvArgs {
+            sensors: "robot".into(),
+            robot_config: Some(bad_camera.into()),
+            ..EnvArgs::default()
+        });
         assert!(e.contains("camera.height_mm"), "{e}");
     }
 }

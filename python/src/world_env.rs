@@ -64,7 +64,13 @@ impl WorldEnv {
     pub fn new(settings: &EnvSettings, seed: u64) -> Result<WorldEnv, ScenarioError> {
         let sim = settings.prepared.simulation(seed)?;
         let turns = vec![0.0; settings.robots()];
-        let mut world = WorldEnv { sim, turns, signal: 0.0, ended: false, fresh: true };
+        let mut world = WorldEnv {
+            sim,
+            turns,
+            signal: 0.0,
+            ended: false,
+            fresh: true,
+        };
         world.signal = world.measure_signal(settings, None);
         Ok(world)
     }
@@ -91,7 +97,11 @@ impl WorldEnv {
         self.fresh = false;
         let eval = self.sim.eval();
         self.signal = self.measure_signal(settings, Some(eval));
-        WorldStep { reset: true, eval, ..WorldStep::default() }
+        WorldStep {
+            reset: true,
+            eval,
+            ..WorldStep::default()
+        }
     }
 
     /// One step with the robots' actions.
@@ -100,7 +110,10 @@ impl WorldEnv {
             WorldActions::Discrete(a) => {
                 for (turn, &action) in self.turns.iter_mut().zip(a) {
                     // In range: the batch checked every action first.
-                    *turn = settings.actions.angular(ActionId(action as u8)).unwrap_or(0.0);
+                    *turn = settings
+                        .actions
+                        .angular(ActionId(action as u8))
+                        .unwrap_or(0.0);
                 }
             }
             WorldActions::Continuous(a) => {
@@ -118,7 +131,8 @@ impl WorldEnv {
         self.signal = signal;
         let terminated = report.end == Some(EpisodeEnd::Formed);
         let truncated = !terminated
-            && (report.end == Some(EpisodeEnd::Stuck) || settings.max_steps.is_some_and(|m| report.episode_step >= m));
+            && (report.end == Some(EpisodeEnd::Stuck)
+                || settings.max_steps.is_some_and(|m| report.episode_step >= m));
         self.ended = terminated || truncated;
         WorldStep {
             reward,
@@ -132,7 +146,9 @@ impl WorldEnv {
     }
 
     fn measure_signal(&self, settings: &EnvSettings, eval: Option<f64>) -> f64 {
-        settings.reward.signal(self.sim.world(), self.sim.field(), self.sim.config(), eval)
+        settings
+            .reward
+            .signal(self.sim.world(), self.sim.field(), self.sim.config(), eval)
     }
 
     /// Whether the last step ended the episode and no reset followed.

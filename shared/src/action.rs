@@ -4,7 +4,9 @@ use core::fmt;
 use serde::{Deserialize, Serialize};
 
 /// Index of an action in an [`ActionTable`], `0 .. table.len()`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize,
+)]
 pub struct ActionId(pub u8);
 
 impl ActionId {
@@ -38,7 +40,9 @@ impl fmt::Display for ActionTableError {
                 ActionTable::MIN_ACTIONS,
                 ActionTable::MAX_ACTIONS
             ),
-            ActionTableError::NonFiniteSpeed => f.write_str("an action speed is not a finite number"),
+            ActionTableError::NonFiniteSpeed => {
+                f.write_str("an action speed is not a finite number")
+            }
         }
     }
 }
@@ -77,7 +81,11 @@ impl ActionTable {
         }
         let mut table = [0.0; Self::MAX_ACTIONS];
         table[..angular.len()].copy_from_slice(angular);
-        Ok(ActionTable { angular: table, len: angular.len() as u8, forward_speed })
+        Ok(ActionTable {
+            angular: table,
+            len: angular.len() as u8,
+            forward_speed,
+        })
     }
 
     /// Number of actions.
@@ -114,7 +122,11 @@ impl ActionTable {
 impl Default for ActionTable {
     /// The thesis' four actions at forward speed 2.0.
     fn default() -> ActionTable {
-        ActionTable { angular: Self::DEFAULT_ANGULAR, len: 4, forward_speed: Self::DEFAULT_FORWARD_SPEED }
+        ActionTable {
+            angular: Self::DEFAULT_ANGULAR,
+            len: 4,
+            forward_speed: Self::DEFAULT_FORWARD_SPEED,
+        }
     }
 }
 
@@ -134,10 +146,22 @@ mod tests {
 
     #[test]
     fn two_to_four_finite_actions() {
-        assert_eq!(ActionTable::new(&[0.3], 2.0), Err(ActionTableError::CountOutOfRange(1)));
-        assert_eq!(ActionTable::new(&[0.1; 5], 2.0), Err(ActionTableError::CountOutOfRange(5)));
-        assert_eq!(ActionTable::new(&[0.1, f32::NAN], 2.0), Err(ActionTableError::NonFiniteSpeed));
-        assert_eq!(ActionTable::new(&[0.1, 0.2], f32::INFINITY), Err(ActionTableError::NonFiniteSpeed));
+        assert_eq!(
+            ActionTable::new(&[0.3], 2.0),
+            Err(ActionTableError::CountOutOfRange(1))
+        );
+        assert_eq!(
+            ActionTable::new(&[0.1; 5], 2.0),
+            Err(ActionTableError::CountOutOfRange(5))
+        );
+        assert_eq!(
+            ActionTable::new(&[0.1, f32::NAN], 2.0),
+            Err(ActionTableError::NonFiniteSpeed)
+        );
+        assert_eq!(
+            ActionTable::new(&[0.1, 0.2], f32::INFINITY),
+            Err(ActionTableError::NonFiniteSpeed)
+        );
         let t = ActionTable::new(&[0.3, -0.3], 1.5).unwrap();
         assert_eq!(t.len(), 2);
         assert_eq!(t.angular_speeds(), &[0.3, -0.3]);

@@ -63,7 +63,12 @@ pub enum NameKind {
 
 impl Provenance {
     /// Provenance with names checked against [`MAX_NAME_LEN`].
-    pub fn new(field: &str, name: &str, trainer_steps: u64, seed: u64) -> Result<Provenance, BlobError> {
+    pub fn new(
+        field: &str,
+        name: &str,
+        trainer_steps: u64,
+        seed: u64,
+    ) -> Result<Provenance, BlobError> {
         Ok(Provenance {
             field: to_name(NameKind::Field, field)?,
             name: to_name(NameKind::Name, name)?,
@@ -144,21 +149,47 @@ impl fmt::Display for BlobError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
             BlobError::Truncated { needed, found } => {
-                write!(f, "truncated policy blob: needs {needed} bytes, has {found}")
+                write!(
+                    f,
+                    "truncated policy blob: needs {needed} bytes, has {found}"
+                )
             }
-            BlobError::WrongMagic(m) => write!(f, "not a policy blob: magic bytes are {m:02x?}, expected \"QPOL\""),
+            BlobError::WrongMagic(m) => write!(
+                f,
+                "not a policy blob: magic bytes are {m:02x?}, expected \"QPOL\""
+            ),
             BlobError::UnsupportedVersion(v) => {
-                write!(f, "unsupported policy blob format version {v} (this build reads version {})", PolicyBlob::VERSION)
+                write!(
+                    f,
+                    "unsupported policy blob format version {v} (this build reads version {})",
+                    PolicyBlob::VERSION
+                )
             }
             BlobError::TrailingBytes { expected, found } => {
-                write!(f, "policy blob has {} bytes after its end ({expected} expected, {found} found)", found - expected)
+                write!(
+                    f,
+                    "policy blob has {} bytes after its end ({expected} expected, {found} found)",
+                    found - expected
+                )
             }
             BlobError::CrcMismatch { stored, computed } => {
-                write!(f, "policy blob is corrupt: CRC-32 is {computed:#010x}, blob says {stored:#010x}")
+                write!(
+                    f,
+                    "policy blob is corrupt: CRC-32 is {computed:#010x}, blob says {stored:#010x}"
+                )
             }
-            BlobError::UnknownHasher(id) => write!(f, "unknown state hasher id {id} (expected 7, 8, 9 or 10)"),
-            BlobError::TableLength { hasher, expected, found } => {
-                write!(f, "policy table is {found} bytes but hasher {hasher} needs {expected}")
+            BlobError::UnknownHasher(id) => {
+                write!(f, "unknown state hasher id {id} (expected 7, 8, 9 or 10)")
+            }
+            BlobError::TableLength {
+                hasher,
+                expected,
+                found,
+            } => {
+                write!(
+                    f,
+                    "policy table is {found} bytes but hasher {hasher} needs {expected}"
+                )
             }
             BlobError::ActionCount(n) => write!(
                 f,
@@ -167,15 +198,25 @@ impl fmt::Display for BlobError {
                 ActionTable::MAX_ACTIONS
             ),
             BlobError::NonFiniteSpeed => f.write_str("an action speed is not a finite number"),
-            BlobError::ActionOutOfRange { state, action, count } => {
-                write!(f, "state {state} maps to action {action} but the table has {count} actions")
+            BlobError::ActionOutOfRange {
+                state,
+                action,
+                count,
+            } => {
+                write!(
+                    f,
+                    "state {state} maps to action {action} but the table has {count} actions"
+                )
             }
             BlobError::NameTooLong { kind, len } => {
                 let which = match kind {
                     NameKind::Field => "field name",
                     NameKind::Name => "name",
                 };
-                write!(f, "{which} is {len} bytes long, at most {MAX_NAME_LEN} allowed")
+                write!(
+                    f,
+                    "{which} is {len} bytes long, at most {MAX_NAME_LEN} allowed"
+                )
             }
             BlobError::Malformed(why) => write!(f, "malformed policy blob body: {why}"),
         }
@@ -229,11 +270,23 @@ impl PolicyBlob {
     pub const MAX_ENCODED_LEN: usize = HEADER_LEN + MAX_BODY_LEN + CRC_LEN;
 
     /// A blob, checked: every table entry must name one of the actions.
-    pub fn new(actions: ActionTable, table: PolicyTable, provenance: Provenance) -> Result<PolicyBlob, BlobError> {
+    pub fn new(
+        actions: ActionTable,
+        table: PolicyTable,
+        provenance: Provenance,
+    ) -> Result<PolicyBlob, BlobError> {
         if let Some((state, action)) = table.entries().find(|(_, a)| a.index() >= actions.len()) {
-            return Err(BlobError::ActionOutOfRange { state, action, count: actions.len() as u8 });
+            return Err(BlobError::ActionOutOfRange {
+                state,
+                action,
+                count: actions.len() as u8,
+            });
         }
-        Ok(PolicyBlob { actions, table, provenance })
+        Ok(PolicyBlob {
+            actions,
+            table,
+            provenance,
+        })
     }
 
     /// The state hasher the table is indexed by.
@@ -290,7 +343,10 @@ impl PolicyBlob {
     /// Decodes and checks a blob.
     pub fn decode(bytes: &[u8]) -> Result<PolicyBlob, BlobError> {
         if bytes.len() < HEADER_LEN {
-            return Err(BlobError::Truncated { needed: HEADER_LEN, found: bytes.len() });
+            return Err(BlobError::Truncated {
+                needed: HEADER_LEN,
+                found: bytes.len(),
+            });
         }
         let magic = [bytes[0], bytes[1], bytes[2], bytes[3]];
         if magic != Self::MAGIC {
@@ -303,33 +359,49 @@ impl PolicyBlob {
         let end = HEADER_LEN + body_len;
         let total = end + CRC_LEN;
         if bytes.len() < total {
-            return Err(BlobError::Truncated { needed: total, found: bytes.len() });
+            return Err(BlobError::Truncated {
+                needed: total,
+                found: bytes.len(),
+            });
         }
         if bytes.len() > total {
-            return Err(BlobError::TrailingBytes { expected: total, found: bytes.len() });
+            return Err(BlobError::TrailingBytes {
+                expected: total,
+                found: bytes.len(),
+            });
         }
-        let stored = u32::from_le_bytes([bytes[end], bytes[end + 1], bytes[end + 2], bytes[end + 3]]);
+        let stored =
+            u32::from_le_bytes([bytes[end], bytes[end + 1], bytes[end + 2], bytes[end + 3]]);
         let computed = CRC32.checksum(&bytes[..end]);
         if stored != computed {
             return Err(BlobError::CrcMismatch { stored, computed });
         }
         let body_bytes = &bytes[HEADER_LEN..end];
-        let (body, rest): (Body<'_>, &[u8]) = postcard::take_from_bytes(body_bytes).map_err(|e| match e {
-            postcard::Error::DeserializeUnexpectedEnd => {
-                BlobError::Truncated { needed: body_len + 1, found: body_len }
-            }
-            postcard::Error::DeserializeBadUtf8 => BlobError::Malformed("a name is not valid UTF-8"),
-            postcard::Error::DeserializeBadVarint => BlobError::Malformed("an integer is not a valid varint"),
-            _ => BlobError::Malformed("the body does not decode"),
-        })?;
+        let (body, rest): (Body<'_>, &[u8]) =
+            postcard::take_from_bytes(body_bytes).map_err(|e| match e {
+                postcard::Error::DeserializeUnexpectedEnd => BlobError::Truncated {
+                    needed: body_len + 1,
+                    found: body_len,
+                },
+                postcard::Error::DeserializeBadUtf8 => {
+                    BlobError::Malformed("a name is not valid UTF-8")
+                }
+                postcard::Error::DeserializeBadVarint => {
+                    BlobError::Malformed("an integer is not a valid varint")
+                }
+                _ => BlobError::Malformed("the body does not decode"),
+            })?;
         if !rest.is_empty() {
-            return Err(BlobError::Malformed("the body is shorter than its declared length"));
+            return Err(BlobError::Malformed(
+                "the body is shorter than its declared length",
+            ));
         }
         Self::from_body(&body)
     }
 
     fn from_body(body: &Body<'_>) -> Result<PolicyBlob, BlobError> {
-        let hasher = StateHasher::from_id(body.hasher).ok_or(BlobError::UnknownHasher(body.hasher))?;
+        let hasher =
+            StateHasher::from_id(body.hasher).ok_or(BlobError::UnknownHasher(body.hasher))?;
         let count = usize::from(body.action_count);
         if !(ActionTable::MIN_ACTIONS..=ActionTable::MAX_ACTIONS).contains(&count) {
             return Err(BlobError::ActionCount(body.action_count));

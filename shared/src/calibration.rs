@@ -96,12 +96,21 @@ impl SensorScale {
     /// Precomputes the scale of a range. A range with `dark <= bright`
     /// (which [`SensorRange::new`] never builds) is treated as a span of 1.
     pub const fn new(range: SensorRange) -> SensorScale {
-        let span = if range.dark > range.bright { range.dark - range.bright } else { 1 };
+        let span = if range.dark > range.bright {
+            range.dark - range.bright
+        } else {
+            1
+        };
         let shift = 15 - span.leading_zeros();
         let numerator = 1u32 << (15 + shift);
         let span32 = span as u32;
         let recip = numerator.div_ceil(span32);
-        SensorScale { dark: range.bright.saturating_add(span), span, recip: recip as u16, shift: shift as u8 }
+        SensorScale {
+            dark: range.bright.saturating_add(span),
+            span,
+            recip: recip as u16,
+            shift: shift as u8,
+        }
     }
 
     /// 1.0 at or below `bright`, 0.0 at or above `dark`, linear in between.
@@ -143,8 +152,9 @@ pub const CURVE_KNOTS: usize = 64;
 /// The light at field values `k / 32`, `(k / 32) ^ LIGHT_GAMMA` of full
 /// white, in units of 2^-14 (rounded): the light curve the calibration inverts.
 pub const LIGHT_AT: [u16; 33] = [
-    0, 8, 37, 90, 169, 276, 412, 579, 776, 1006, 1268, 1564, 1894, 2258, 2658, 3094, 3566, 4075, 4621, 5204, 5826, 6486,
-    7185, 7923, 8701, 9518, 10376, 11274, 12213, 13194, 14215, 15279, 16384,
+    0, 8, 37, 90, 169, 276, 412, 579, 776, 1006, 1268, 1564, 1894, 2258, 2658, 3094, 3566, 4075,
+    4621, 5204, 5826, 6486, 7185, 7923, 8701, 9518, 10376, 11274, 12213, 13194, 14215, 15279,
+    16384,
 ];
 
 /// How far a calibrated value may lie from the field value shown, for the
@@ -185,7 +195,11 @@ const EIGHTHS: [[u8; 8]; 8] = {
 
 impl SensorCurve {
     /// A curve that reads every time as 0.0, to be calibrated.
-    pub const UNSET: SensorCurve = SensorCurve { bright: 0, dark: 0, knots: [0; CURVE_KNOTS] };
+    pub const UNSET: SensorCurve = SensorCurve {
+        bright: 0,
+        dark: 0,
+        knots: [0; CURVE_KNOTS],
+    };
 
     /// The curve of a calibration range (a `bright` of 0 counts as 1 tick,
     /// a `dark` at or below `bright` as one tick above it; times beyond the
@@ -310,7 +324,11 @@ impl FieldScales {
 
     /// Calibrated values of the three sensors' times.
     pub fn values(&self, times: &[u16; 3]) -> [FieldValue; 3] {
-        [self.0[LEFT].value(times[LEFT]), self.0[MID].value(times[MID]), self.0[RIGHT].value(times[RIGHT])]
+        [
+            self.0[LEFT].value(times[LEFT]),
+            self.0[MID].value(times[MID]),
+            self.0[RIGHT].value(times[RIGHT]),
+        ]
     }
 }
 
@@ -347,13 +365,24 @@ mod tests {
 
     #[test]
     fn every_time_of_some_spans_is_within_two_steps_above_exact() {
-        for (bright, dark) in [(0, 1), (5, 7), (10, 13), (100, 612), (0, 500), (3, 32771), (0, u16::MAX)] {
+        for (bright, dark) in [
+            (0, 1),
+            (5, 7),
+            (10, 13),
+            (100, 612),
+            (0, 500),
+            (3, 32771),
+            (0, u16::MAX),
+        ] {
             let r = SensorRange::new(bright, dark, 1).unwrap();
             let s = SensorScale::new(r);
             for t in bright..=dark {
                 let got = u32::from(s.value(t).raw());
                 let exact = exact_floor(r, t);
-                assert!(got >= exact.min(32768) && got <= exact + 2, "{bright}..{dark} t={t}: {got} vs {exact}");
+                assert!(
+                    got >= exact.min(32768) && got <= exact + 2,
+                    "{bright}..{dark} t={t}: {got} vs {exact}"
+                );
             }
         }
     }
@@ -392,26 +421,46 @@ mod tests {
                 l if l < LIGHT_AT[2] => 0.0035,
                 _ => 0.0025,
             };
-            assert!((got - exact).abs() < tolerance, "light {l}: {got} vs {exact}");
+            assert!(
+                (got - exact).abs() < tolerance,
+                "light {l}: {got} vs {exact}"
+            );
         }
     }
 
     #[test]
     fn white_reads_one_black_reads_zero_and_outside_times_clamp() {
-        let curve = SensorCurve::new(SensorRange { bright: 38, dark: 425 });
+        let curve = SensorCurve::new(SensorRange {
+            bright: 38,
+            dark: 425,
+        });
         assert_eq!(curve.value(38), FieldValue::ONE);
         assert_eq!(curve.value(0), FieldValue::ONE);
         assert_eq!(curve.value(425), FieldValue::ZERO);
         assert_eq!(curve.value(u16::MAX), FieldValue::ZERO);
         // The uncalibrated range and a range without contrast never panic.
-        let _ = SensorCurve::new(SensorRange { bright: 0, dark: RC_TIMEOUT_TICKS }).value(100);
-        assert_eq!(SensorCurve::new(SensorRange { bright: 90, dark: 90 }).value(95), FieldValue::ZERO);
+        let _ = SensorCurve::new(SensorRange {
+            bright: 0,
+            dark: RC_TIMEOUT_TICKS,
+        })
+        .value(100);
+        assert_eq!(
+            SensorCurve::new(SensorRange {
+                bright: 90,
+                dark: 90
+            })
+            .value(95),
+            FieldValue::ZERO
+        );
     }
 
     #[test]
     fn the_calibrated_value_is_the_field_value_within_the_tolerance_across_0_to_1() {
         for response in RESPONSES {
-            let range = SensorRange { bright: ticks(response.0), dark: ticks(response.1) };
+            let range = SensorRange {
+                bright: ticks(response.0),
+                dark: ticks(response.1),
+            };
             let curve = SensorCurve::new(range);
             let mut worst = 0.0f64;
             for i in 0..=1000 {
@@ -419,19 +468,42 @@ mod tests {
                 let got = f64::from(curve.value(ticks(discharge_us(v, response))).to_f32());
                 worst = worst.max((got - v).abs());
             }
-            assert!(worst <= f64::from(CURVE_TOLERANCE), "{response:?}: off by up to {worst:.4}");
+            assert!(
+                worst <= f64::from(CURVE_TOLERANCE),
+                "{response:?}: off by up to {worst:.4}"
+            );
         }
         // The old linear map of times was off by 0.2 at 0.6 (a calibrated
         // 0.6 was a field value of about 0.38): now 0.6 reads 0.6.
-        let range = SensorRange { bright: ticks(160.0), dark: ticks(1760.0) };
-        let at_06 = f64::from(SensorCurve::new(range).value(ticks(discharge_us(0.6, (160.0, 1760.0)))).to_f32());
+        let range = SensorRange {
+            bright: ticks(160.0),
+            dark: ticks(1760.0),
+        };
+        let at_06 = f64::from(
+            SensorCurve::new(range)
+                .value(ticks(discharge_us(0.6, (160.0, 1760.0))))
+                .to_f32(),
+        );
         assert!((at_06 - 0.6).abs() < 0.01, "{at_06}");
     }
 
     #[test]
     fn the_three_sensors_use_their_own_curves() {
         let cal = FieldCalibration {
-            ranges: [SensorRange { bright: 50, dark: 450 }, SensorRange { bright: 60, dark: 460 }, SensorRange { bright: 40, dark: 440 }],
+            ranges: [
+                SensorRange {
+                    bright: 50,
+                    dark: 450,
+                },
+                SensorRange {
+                    bright: 60,
+                    dark: 460,
+                },
+                SensorRange {
+                    bright: 40,
+                    dark: 440,
+                },
+            ],
         };
         let v = cal.scales().values(&[50, 460, 240]);
         assert_eq!((v[0], v[1]), (FieldValue::ONE, FieldValue::ZERO));

@@ -78,7 +78,10 @@ impl ImageRegion {
         if y < self.y_min || y > self.y_max {
             return (false, false);
         }
-        (mirrored_x >= self.x_min && mirrored_x <= self.x_max, x >= self.x_min && x <= self.x_max)
+        (
+            mirrored_x >= self.x_min && mirrored_x <= self.x_max,
+            x >= self.x_min && x <= self.x_max,
+        )
     }
 
     /// The region's mirror image about the image's centre column.
@@ -135,8 +138,18 @@ impl CameraConfig {
     pub const DEFAULT: CameraConfig = CameraConfig {
         puck_signature: 1,
         robot_signature: 2,
-        puck_right: ImageRegion { x_min: 80, x_max: IMAGE_WIDTH - 1, y_min: 0, y_max: IMAGE_HEIGHT - 1 },
-        obstacle_right: ImageRegion { x_min: 100, x_max: IMAGE_WIDTH - 1, y_min: 150, y_max: IMAGE_HEIGHT - 1 },
+        puck_right: ImageRegion {
+            x_min: 80,
+            x_max: IMAGE_WIDTH - 1,
+            y_min: 0,
+            y_max: IMAGE_HEIGHT - 1,
+        },
+        obstacle_right: ImageRegion {
+            x_min: 100,
+            x_max: IMAGE_WIDTH - 1,
+            y_min: 150,
+            y_max: IMAGE_HEIGHT - 1,
+        },
     };
 
     /// The sensor bits of a set of blocks (any number, any order).
@@ -173,7 +186,14 @@ mod tests {
     use super::*;
 
     fn block(signature: u16, x: u16, y: u16) -> PixyBlock {
-        PixyBlock { signature, x, y, width: 10, height: 10, angle: 0 }
+        PixyBlock {
+            signature,
+            x,
+            y,
+            width: 10,
+            height: 10,
+            angle: 0,
+        }
     }
 
     #[test]
@@ -185,35 +205,81 @@ mod tests {
     fn sides_signatures_and_the_regions() {
         let c = CameraConfig::DEFAULT;
         let s = c.classify(&[block(1, 79, 20), block(2, 250, 199)]);
-        assert_eq!(s, BlobSummary { puck_left: true, puck_right: false, obstacle_left: false, obstacle_right: true });
+        assert_eq!(
+            s,
+            BlobSummary {
+                puck_left: true,
+                puck_right: false,
+                obstacle_left: false,
+                obstacle_right: true
+            }
+        );
         // A puck ahead is on both sides; a far robot and unknown signatures are ignored.
         let s = c.classify(&[block(1, 160, 5)]);
         assert!(s.puck_left && s.puck_right);
-        assert_eq!(c.classify(&[block(3, 10, 150), block(2, 300, 149)]), BlobSummary::default());
+        assert_eq!(
+            c.classify(&[block(3, 10, 150), block(2, 300, 149)]),
+            BlobSummary::default()
+        );
         // Region edges are inclusive.
-        assert!(c.classify(&[block(1, 0, 199)]).puck_left && !c.classify(&[block(1, 0, 199)]).puck_right);
+        assert!(
+            c.classify(&[block(1, 0, 199)]).puck_left
+                && !c.classify(&[block(1, 0, 199)]).puck_right
+        );
         assert!(c.classify(&[block(1, 80, 0)]).puck_right);
         assert!(c.classify(&[block(2, 219, 150)]).obstacle_left);
     }
 
     #[test]
     fn regions_with_a_gap_in_the_middle_and_their_mirror_images() {
-        let sides = ImageRegion { x_min: 220, x_max: 319, y_min: 0, y_max: 199 };
-        assert_eq!(sides.mirrored(), ImageRegion { x_min: 0, x_max: 99, y_min: 0, y_max: 199 });
-        let c = CameraConfig { puck_right: sides, ..CameraConfig::DEFAULT };
-        assert_eq!(c.classify(&[block(1, 160, 50)]), BlobSummary::default(), "straight ahead is in neither");
+        let sides = ImageRegion {
+            x_min: 220,
+            x_max: 319,
+            y_min: 0,
+            y_max: 199,
+        };
+        assert_eq!(
+            sides.mirrored(),
+            ImageRegion {
+                x_min: 0,
+                x_max: 99,
+                y_min: 0,
+                y_max: 199
+            }
+        );
+        let c = CameraConfig {
+            puck_right: sides,
+            ..CameraConfig::DEFAULT
+        };
+        assert_eq!(
+            c.classify(&[block(1, 160, 50)]),
+            BlobSummary::default(),
+            "straight ahead is in neither"
+        );
         let s = c.classify(&[block(1, 99, 10), block(1, 220, 190)]);
         assert!(s.puck_left && s.puck_right && !s.obstacle_left);
         // Overlapping regions set both bits.
-        let wide = CameraConfig { puck_right: ImageRegion { x_min: 100, ..sides }, ..CameraConfig::DEFAULT };
+        let wide = CameraConfig {
+            puck_right: ImageRegion {
+                x_min: 100,
+                ..sides
+            },
+            ..CameraConfig::DEFAULT
+        };
         let s = wide.classify(&[block(1, 160, 50)]);
         assert!(s.puck_left && s.puck_right);
     }
 
     #[test]
     fn a_colour_code_can_be_the_robot_signature() {
-        let c = CameraConfig { robot_signature: 0o12, ..CameraConfig::DEFAULT };
-        let s = c.classify(&[PixyBlock { angle: -45, ..block(0o12, 20, 180) }]);
+        let c = CameraConfig {
+            robot_signature: 0o12,
+            ..CameraConfig::DEFAULT
+        };
+        let s = c.classify(&[PixyBlock {
+            angle: -45,
+            ..block(0o12, 20, 180)
+        }]);
         assert!(s.obstacle_left && !s.obstacle_right && !s.puck_left);
     }
 }

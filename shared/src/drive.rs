@@ -51,8 +51,14 @@ pub struct DriveOutputs {
 impl DriveOutputs {
     /// Both motors stopped.
     pub const STOP: DriveOutputs = DriveOutputs {
-        left: MotorOutput { duty: 0, dir_high: false },
-        right: MotorOutput { duty: 0, dir_high: false },
+        left: MotorOutput {
+            duty: 0,
+            dir_high: false,
+        },
+        right: MotorOutput {
+            duty: 0,
+            dir_high: false,
+        },
     };
 }
 
@@ -103,14 +109,22 @@ impl RobotProfile {
     /// sharpest turn (0.3 rad/step) 341 / -41: inside the motor range, so
     /// the turn ratio the policy was trained with is kept. Both values are
     /// estimates to be measured on a real robot.
-    pub const ZUMO: RobotProfile =
-        RobotProfile { wheel_track: 17.0, speed_scale: 1.5, control_period_ms: 20, flip_left: false, flip_right: false };
+    pub const ZUMO: RobotProfile = RobotProfile {
+        wheel_track: 17.0,
+        speed_scale: 1.5,
+        control_period_ms: 20,
+        flip_left: false,
+        flip_right: false,
+    };
 
     /// Track speeds (world units per second) for a unicycle speed pair.
     pub fn track_speeds(&self, forward: f32, angular: f32) -> (f32, f32) {
         let steps_per_second = 1000.0 / f32::from(self.control_period_ms.max(1));
         let half_diff = angular * self.wheel_track / 2.0;
-        ((forward + half_diff) * steps_per_second, (forward - half_diff) * steps_per_second)
+        (
+            (forward + half_diff) * steps_per_second,
+            (forward - half_diff) * steps_per_second,
+        )
     }
 
     /// Motor commands for a forward speed (units per step) and an angular
@@ -123,13 +137,20 @@ impl RobotProfile {
         if !left.is_finite() || !right.is_finite() {
             return MotorCommand::default();
         }
-        let largest = if left.abs() > right.abs() { left.abs() } else { right.abs() };
+        let largest = if left.abs() > right.abs() {
+            left.abs()
+        } else {
+            right.abs()
+        };
         let max = f32::from(MAX_MOTOR);
         if largest > max {
             left = left * max / largest;
             right = right * max / largest;
         }
-        MotorCommand { left: round(left), right: round(right) }
+        MotorCommand {
+            left: round(left),
+            right: round(right),
+        }
     }
 
     /// The unicycle speeds (forward units per step, radians per step,
@@ -161,7 +182,10 @@ impl RobotProfile {
     /// direction pin high for reverse, inverted for a flipped motor (as the
     /// Pololu Zumo library does).
     pub fn outputs(&self, command: MotorCommand) -> DriveOutputs {
-        DriveOutputs { left: output(command.left, self.flip_left), right: output(command.right, self.flip_right) }
+        DriveOutputs {
+            left: output(command.left, self.flip_left),
+            right: output(command.right, self.flip_right),
+        }
     }
 }
 
@@ -173,7 +197,10 @@ impl Default for RobotProfile {
 }
 
 fn output(command: i16, flip: bool) -> MotorOutput {
-    MotorOutput { duty: command.unsigned_abs().min(MAX_MOTOR as u16), dir_high: (command < 0) != flip }
+    MotorOutput {
+        duty: command.unsigned_abs().min(MAX_MOTOR as u16),
+        dir_high: (command < 0) != flip,
+    }
 }
 
 /// Rounds half away from zero (`f32::round` needs std).
@@ -189,16 +216,34 @@ mod tests {
     #[test]
     fn straight_ahead_is_equal_tracks() {
         let c = RobotProfile::ZUMO.mix(2.0, 0.0);
-        assert_eq!(c, MotorCommand { left: 150, right: 150 });
+        assert_eq!(
+            c,
+            MotorCommand {
+                left: 150,
+                right: 150
+            }
+        );
     }
 
     #[test]
     fn turning_right_speeds_up_the_left_track() {
         let c = RobotProfile::ZUMO.mix(2.0, 0.3);
         // 2 +- 0.3 x 8.5 = 4.55 / -0.55 units per step, x 50 x 1.5
-        assert_eq!(c, MotorCommand { left: 341, right: -41 });
+        assert_eq!(
+            c,
+            MotorCommand {
+                left: 341,
+                right: -41
+            }
+        );
         let c = RobotProfile::ZUMO.mix(2.0, -0.15);
-        assert_eq!(c, MotorCommand { left: 54, right: 246 });
+        assert_eq!(
+            c,
+            MotorCommand {
+                left: 54,
+                right: 246
+            }
+        );
     }
 
     #[test]
@@ -206,12 +251,21 @@ mod tests {
         let p = RobotProfile::ZUMO;
         let (v, w) = p.unicycle(p.mix(2.0, 0.3));
         assert!((v - 2.0).abs() < 0.01 && (w - 0.3).abs() < 0.001, "{v} {w}");
-        assert_eq!(p.unicycle(MotorCommand { left: 150, right: 150 }), (2.0, 0.0));
+        assert_eq!(
+            p.unicycle(MotorCommand {
+                left: 150,
+                right: 150
+            }),
+            (2.0, 0.0)
+        );
     }
 
     #[test]
     fn saturation_keeps_the_ratio() {
-        let p = RobotProfile { speed_scale: 10.0, ..RobotProfile::ZUMO };
+        let p = RobotProfile {
+            speed_scale: 10.0,
+            ..RobotProfile::ZUMO
+        };
         let c = p.mix(2.0, 0.3);
         assert_eq!(c.left, 400);
         // -0.55 / 4.55 x 400 = -48.35
@@ -223,9 +277,27 @@ mod tests {
     fn every_action_gets_its_mix_and_outputs_and_missing_actions_stop() {
         let actions = ActionTable::new(&[0.3, -0.15], 2.0).unwrap();
         let m = RobotProfile::ZUMO.action_motors(&actions);
-        assert_eq!(m.command(ActionId(0)), MotorCommand { left: 341, right: -41 });
-        assert_eq!(m.command(ActionId(1)), MotorCommand { left: 54, right: 246 });
-        assert_eq!(m.outputs(ActionId(0)).right, MotorOutput { duty: 41, dir_high: true });
+        assert_eq!(
+            m.command(ActionId(0)),
+            MotorCommand {
+                left: 341,
+                right: -41
+            }
+        );
+        assert_eq!(
+            m.command(ActionId(1)),
+            MotorCommand {
+                left: 54,
+                right: 246
+            }
+        );
+        assert_eq!(
+            m.outputs(ActionId(0)).right,
+            MotorOutput {
+                duty: 41,
+                dir_high: true
+            }
+        );
         assert_eq!(m.command(ActionId(2)), MotorCommand::default());
         assert_eq!(m.outputs(ActionId(3)), DriveOutputs::STOP);
         // An id beyond the table's four slots wraps into them, never panics.
@@ -235,12 +307,46 @@ mod tests {
     #[test]
     fn outputs_follow_the_pololu_direction_rule() {
         let p = RobotProfile::ZUMO;
-        let o = p.outputs(MotorCommand { left: -120, right: 300 });
-        assert_eq!(o.left, MotorOutput { duty: 120, dir_high: true });
-        assert_eq!(o.right, MotorOutput { duty: 300, dir_high: false });
-        let flipped = RobotProfile { flip_right: true, ..p };
-        assert!(flipped.outputs(MotorCommand { left: 0, right: 300 }).right.dir_high);
-        assert_eq!(p.outputs(MotorCommand { left: i16::MIN, right: 0 }).left.duty, 400);
+        let o = p.outputs(MotorCommand {
+            left: -120,
+            right: 300,
+        });
+        assert_eq!(
+            o.left,
+            MotorOutput {
+                duty: 120,
+                dir_high: true
+            }
+        );
+        assert_eq!(
+            o.right,
+            MotorOutput {
+                duty: 300,
+                dir_high: false
+            }
+        );
+        let flipped = RobotProfile {
+            flip_right: true,
+            ..p
+        };
+        assert!(
+            flipped
+                .outputs(MotorCommand {
+                    left: 0,
+                    right: 300
+                })
+                .right
+                .dir_high
+        );
+        assert_eq!(
+            p.outputs(MotorCommand {
+                left: i16::MIN,
+                right: 0
+            })
+            .left
+            .duty,
+            400
+        );
         assert_eq!(p.outputs(MotorCommand::default()), DriveOutputs::STOP);
     }
 }

@@ -14,7 +14,9 @@ use serde::{Deserialize, Serialize};
 /// round to the nearest step, ties upwards. Hashing is defined on the fixed-
 /// point value, so the simulator converts once and then hashes exactly what
 /// the firmware would hash.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize,
+)]
 pub struct FieldValue(u16);
 
 impl FieldValue {

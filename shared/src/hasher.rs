@@ -31,7 +31,9 @@ use core::fmt;
 use serde::{Deserialize, Serialize};
 
 /// A hashed state, `0 .. hasher.num_states()`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[derive(
+    Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize,
+)]
 pub struct State(pub u16);
 
 impl State {
@@ -236,7 +238,11 @@ impl StateHasher {
     pub fn pack(self, inputs: &StateInputs) -> State {
         let k = self.mid_bits();
         let top_bin = (1u16 << k) - 1;
-        let bin = if inputs.mid_bin > top_bin { top_bin } else { inputs.mid_bin };
+        let bin = if inputs.mid_bin > top_bin {
+            top_bin
+        } else {
+            inputs.mid_bin
+        };
         let mut s = u16::from(inputs.puck_left)
             | u16::from(inputs.puck_right) << 1
             | u16::from(inputs.left_below_mid) << 2
@@ -329,7 +335,10 @@ mod tests {
         r.obstacle_right = true;
         // mid 0.8 -> bin 12 (k=4); right < mid; obstacles 256 + 512
         assert_eq!(StateHasher::Original.hash(&r), State(2 + 8 + 12 * 16));
-        assert_eq!(StateHasher::OriginalObstacle.hash(&r), State(2 + 8 + 192 + 768));
+        assert_eq!(
+            StateHasher::OriginalObstacle.hash(&r),
+            State(2 + 8 + 192 + 768)
+        );
 
         let all_on = SensorReading {
             left: FieldValue::ZERO,
@@ -341,7 +350,11 @@ mod tests {
             obstacle_right: true,
         };
         for h in StateHasher::ALL {
-            assert_eq!(h.hash_as(&all_on, Role::Innie).index(), h.num_states() - 1, "{h}");
+            assert_eq!(
+                h.hash_as(&all_on, Role::Innie).index(),
+                h.num_states() - 1,
+                "{h}"
+            );
         }
         for h in StateHasher::ALL {
             assert_eq!(h.hash(&SensorReading::default()), State(0), "{h}");
@@ -355,8 +368,14 @@ mod tests {
             for bin in 1..(1u16 << k) {
                 let edge = FieldValue::from_raw(bin << (15 - k));
                 let below = FieldValue::from_raw(edge.raw() - 1);
-                let at = SensorReading { mid: edge, ..SensorReading::default() };
-                let under = SensorReading { mid: below, ..SensorReading::default() };
+                let at = SensorReading {
+                    mid: edge,
+                    ..SensorReading::default()
+                };
+                let under = SensorReading {
+                    mid: below,
+                    ..SensorReading::default()
+                };
                 assert_eq!(h.quantise(&at).mid_bin, bin, "{h} edge {bin}");
                 assert_eq!(h.quantise(&under).mid_bin, bin - 1, "{h} below {bin}");
             }
@@ -366,9 +385,15 @@ mod tests {
     #[test]
     fn one_clamps_to_the_top_bin() {
         for h in StateHasher::ALL {
-            let r = SensorReading { mid: FieldValue::ONE, ..SensorReading::default() };
+            let r = SensorReading {
+                mid: FieldValue::ONE,
+                ..SensorReading::default()
+            };
             assert_eq!(h.quantise(&r).mid_bin, (1 << h.mid_bits()) - 1);
-            let r = SensorReading { mid: FieldValue::from_f32(0.999_99), ..SensorReading::default() };
+            let r = SensorReading {
+                mid: FieldValue::from_f32(0.999_99),
+                ..SensorReading::default()
+            };
             assert_eq!(h.quantise(&r).mid_bin, (1 << h.mid_bits()) - 1);
         }
     }
@@ -390,8 +415,16 @@ mod tests {
 
     #[test]
     fn obstacle_bits_only_in_the_10_bit_hash() {
-        let r = SensorReading { obstacle_left: true, obstacle_right: true, ..SensorReading::default() };
-        for h in [StateHasher::Bits7, StateHasher::Original, StateHasher::Bits9] {
+        let r = SensorReading {
+            obstacle_left: true,
+            obstacle_right: true,
+            ..SensorReading::default()
+        };
+        for h in [
+            StateHasher::Bits7,
+            StateHasher::Original,
+            StateHasher::Bits9,
+        ] {
             assert_eq!(h.hash(&r), State(0));
         }
         assert_eq!(StateHasher::OriginalObstacle.hash(&r), State(768));
@@ -401,17 +434,46 @@ mod tests {
     fn the_role_hash_is_the_original_one_plus_bit_8_for_an_innie() {
         let r = reading(0.35, 0.4, 0.45, true, false);
         assert_eq!(StateHasher::OriginalRole.hash(&r), State(101));
-        assert_eq!(StateHasher::OriginalRole.hash_as(&r, Role::Outie), State(101));
-        assert_eq!(StateHasher::OriginalRole.hash_as(&r, Role::Innie), State(101 + 256));
-        let mut seen = SensorReading { obstacle_left: true, obstacle_right: true, ..r };
+        assert_eq!(
+            StateHasher::OriginalRole.hash_as(&r, Role::Outie),
+            State(101)
+        );
+        assert_eq!(
+            StateHasher::OriginalRole.hash_as(&r, Role::Innie),
+            State(101 + 256)
+        );
+        let mut seen = SensorReading {
+            obstacle_left: true,
+            obstacle_right: true,
+            ..r
+        };
         seen.mid = FieldValue::ONE;
         // obstacles are not in the role layout; mid 1.0 is the top bin
-        assert_eq!(StateHasher::OriginalRole.hash_as(&seen, Role::Innie), State(1 + 4 + 8 + 15 * 16 + 256));
-        for h in [StateHasher::Bits7, StateHasher::Original, StateHasher::Bits9, StateHasher::OriginalObstacle] {
-            assert_eq!(h.hash_as(&r, Role::Innie), h.hash(&r), "{h} ignores the role");
+        assert_eq!(
+            StateHasher::OriginalRole.hash_as(&seen, Role::Innie),
+            State(1 + 4 + 8 + 15 * 16 + 256)
+        );
+        for h in [
+            StateHasher::Bits7,
+            StateHasher::Original,
+            StateHasher::Bits9,
+            StateHasher::OriginalObstacle,
+        ] {
+            assert_eq!(
+                h.hash_as(&r, Role::Innie),
+                h.hash(&r),
+                "{h} ignores the role"
+            );
         }
-        assert_eq!((Role::of_robot_id(0), Role::of_robot_id(1), Role::of_robot_id(2), Role::of_robot_id(255)),
-            (Role::Outie, Role::Innie, Role::Outie, Role::Innie));
+        assert_eq!(
+            (
+                Role::of_robot_id(0),
+                Role::of_robot_id(1),
+                Role::of_robot_id(2),
+                Role::of_robot_id(255)
+            ),
+            (Role::Outie, Role::Innie, Role::Outie, Role::Innie)
+        );
     }
 
     #[test]
@@ -419,11 +481,26 @@ mod tests {
         for h in StateHasher::ALL {
             assert_eq!(StateHasher::from_id(h.id()), Some(h));
             assert_eq!(StateHasher::from_name(h.name()), Some(h));
-            assert!(StateHasher::NAMES.contains(h.name()), "{h} missing from NAMES");
+            assert!(
+                StateHasher::NAMES.contains(h.name()),
+                "{h} missing from NAMES"
+            );
         }
-        for h in [StateHasher::Bits7, StateHasher::Original, StateHasher::Bits9, StateHasher::OriginalObstacle] {
-            assert_eq!(h.id(), h.bits(), "the thesis' hashers keep their bit counts as ids");
-            assert!(StateHasher::NAMES.contains(alloc_free_digits(h.bits()).as_str()), "{h}'s bits missing from NAMES");
+        for h in [
+            StateHasher::Bits7,
+            StateHasher::Original,
+            StateHasher::Bits9,
+            StateHasher::OriginalObstacle,
+        ] {
+            assert_eq!(
+                h.id(),
+                h.bits(),
+                "the thesis' hashers keep their bit counts as ids"
+            );
+            assert!(
+                StateHasher::NAMES.contains(alloc_free_digits(h.bits()).as_str()),
+                "{h}'s bits missing from NAMES"
+            );
         }
         assert_eq!(StateHasher::from_id(11), None);
         assert_eq!(StateHasher::from_name("nine"), None);

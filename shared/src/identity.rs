@@ -33,7 +33,20 @@ impl FirmwareIdentity {
     pub const fn to_bytes(&self) -> [u8; FirmwareIdentity::LEN] {
         let c = self.policy_crc.to_le_bytes();
         let m = Self::MAGIC;
-        [m[0], m[1], m[2], m[3], m[4], m[5], Self::LAYOUT, self.robot_id, c[0], c[1], c[2], c[3]]
+        [
+            m[0],
+            m[1],
+            m[2],
+            m[3],
+            m[4],
+            m[5],
+            Self::LAYOUT,
+            self.robot_id,
+            c[0],
+            c[1],
+            c[2],
+            c[3],
+        ]
     }
 
     /// The CRC-32 a policy blob stores (its last 4 bytes, LE), or `None`
@@ -45,10 +58,13 @@ impl FirmwareIdentity {
 
     /// Every identity record in an image.
     pub fn find_all(image: &[u8]) -> impl Iterator<Item = FirmwareIdentity> + '_ {
-        image.windows(Self::LEN).filter(|w| w[..6] == Self::MAGIC && w[6] == Self::LAYOUT).map(|w| FirmwareIdentity {
-            robot_id: w[Self::ROBOT_ID_OFFSET],
-            policy_crc: u32::from_le_bytes([w[8], w[9], w[10], w[11]]),
-        })
+        image
+            .windows(Self::LEN)
+            .filter(|w| w[..6] == Self::MAGIC && w[6] == Self::LAYOUT)
+            .map(|w| FirmwareIdentity {
+                robot_id: w[Self::ROBOT_ID_OFFSET],
+                policy_crc: u32::from_le_bytes([w[8], w[9], w[10], w[11]]),
+            })
     }
 }
 
@@ -58,13 +74,19 @@ mod tests {
 
     #[test]
     fn the_record_is_found_in_an_image_and_names_robot_and_policy() {
-        let id = FirmwareIdentity { robot_id: 5, policy_crc: 0xDEAD_BEEF };
+        let id = FirmwareIdentity {
+            robot_id: 5,
+            policy_crc: 0xDEAD_BEEF,
+        };
         let mut image = [0xFFu8; 64];
         image[20..32].copy_from_slice(&id.to_bytes());
         let mut found = FirmwareIdentity::find_all(&image);
         assert_eq!(found.next(), Some(id));
         assert_eq!(found.next(), None);
-        assert_eq!(FirmwareIdentity::policy_crc_of(&[1, 2, 0xEF, 0xBE, 0xAD, 0xDE]), Some(0xDEAD_BEEF));
+        assert_eq!(
+            FirmwareIdentity::policy_crc_of(&[1, 2, 0xEF, 0xBE, 0xAD, 0xDE]),
+            Some(0xDEAD_BEEF)
+        );
         assert_eq!(FirmwareIdentity::policy_crc_of(&[1, 2]), None);
     }
 }

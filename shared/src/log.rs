@@ -38,7 +38,8 @@ const CRC16: Crc<u16, NoTable> = Crc::<u16, NoTable>::new(&CRC_16_IBM_3740);
 /// its longest): tick, mode, faults, raw times, values, blobs, blocks,
 /// state, action, motors, the calibration (tag + six times), the robot id
 /// and the two encoder counts.
-const MAX_BODY_LEN: usize = 5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3;
+const MAX_BODY_LEN: usize =
+    5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3;
 /// Version byte + body + CRC.
 const MAX_RAW_LEN: usize = 1 + MAX_BODY_LEN + 2;
 
@@ -183,11 +184,18 @@ pub enum LogError {
 impl fmt::Display for LogError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            LogError::TooLong(n) => write!(f, "log frame of {n} bytes is longer than any frame ({})", LogFrame::MAX_ENCODED_LEN),
+            LogError::TooLong(n) => write!(
+                f,
+                "log frame of {n} bytes is longer than any frame ({})",
+                LogFrame::MAX_ENCODED_LEN
+            ),
             LogError::BadCobs => f.write_str("log frame is not valid COBS"),
             LogError::TooShort(n) => write!(f, "log frame of {n} bytes is too short"),
             LogError::CrcMismatch { stored, computed } => {
-                write!(f, "log frame is corrupt: CRC-16 is {computed:#06x}, frame says {stored:#06x}")
+                write!(
+                    f,
+                    "log frame is corrupt: CRC-16 is {computed:#06x}, frame says {stored:#06x}"
+                )
             }
             LogError::UnsupportedVersion(v) => write!(
                 f,
@@ -232,12 +240,14 @@ impl LogFrame {
         let mut raw = [0u8; MAX_RAW_LEN];
         raw[0] = Self::VERSION;
         // Cannot fail: MAX_BODY_LEN bounds every field's longest encoding.
-        let body_len = postcard::to_slice(self, &mut raw[1..1 + MAX_BODY_LEN]).map_or(0, |b| b.len());
+        let body_len =
+            postcard::to_slice(self, &mut raw[1..1 + MAX_BODY_LEN]).map_or(0, |b| b.len());
         let end = 1 + body_len;
         let crc = CRC16.checksum(&raw[..end]);
         raw[end..end + 2].copy_from_slice(&crc.to_le_bytes());
         // Cannot fail: `out` holds the longest COBS encoding plus the delimiter.
-        let n = cobs::try_encode(&raw[..end + 2], &mut out[..Self::MAX_ENCODED_LEN - 1]).unwrap_or(0);
+        let n =
+            cobs::try_encode(&raw[..end + 2], &mut out[..Self::MAX_ENCODED_LEN - 1]).unwrap_or(0);
         out[n] = Self::DELIMITER;
         n + 1
     }
@@ -284,12 +294,22 @@ mod tests {
             mode: RunMode::Driving,
             faults: Faults::CAMERA_SILENT,
             raw_times: [100, 250, 500],
-            values: [FieldValue::ONE, FieldValue::from_raw(13107), FieldValue::ZERO],
-            blobs: BlobSummary { puck_left: true, ..BlobSummary::default() },
+            values: [
+                FieldValue::ONE,
+                FieldValue::from_raw(13107),
+                FieldValue::ZERO,
+            ],
+            blobs: BlobSummary {
+                puck_left: true,
+                ..BlobSummary::default()
+            },
             blocks: 2,
             state: State(101),
             action: ActionId(3),
-            motors: MotorCommand { left: 341, right: -41 },
+            motors: MotorCommand {
+                left: 341,
+                right: -41,
+            },
             calibration: None,
             robot_id: 7,
             encoder_counts: [81, -12],
@@ -320,17 +340,34 @@ mod tests {
             blocks: u8::MAX,
             state: State(u16::MAX),
             action: ActionId(u8::MAX),
-            motors: MotorCommand { left: i16::MIN, right: i16::MIN },
+            motors: MotorCommand {
+                left: i16::MIN,
+                right: i16::MIN,
+            },
             faults: Faults(u8::MAX),
             mode: RunMode::Calibrating,
-            blobs: BlobSummary { puck_left: true, puck_right: true, obstacle_left: true, obstacle_right: true },
-            calibration: Some(FieldCalibration { ranges: [SensorRange { bright: u16::MAX, dark: u16::MAX }; 3] }),
+            blobs: BlobSummary {
+                puck_left: true,
+                puck_right: true,
+                obstacle_left: true,
+                obstacle_right: true,
+            },
+            calibration: Some(FieldCalibration {
+                ranges: [SensorRange {
+                    bright: u16::MAX,
+                    dark: u16::MAX,
+                }; 3],
+            }),
             robot_id: u8::MAX,
             encoder_counts: [i16::MIN; 2],
         };
         let (buf, n) = encoded(&big);
         assert!(n <= LogFrame::MAX_ENCODED_LEN);
-        assert_eq!(LogFrame::MAX_ENCODED_LEN, 71, "docs/firmware.md states this bound");
+        assert_eq!(
+            LogFrame::MAX_ENCODED_LEN,
+            71,
+            "docs/firmware.md states this bound"
+        );
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(big));
     }
 
@@ -342,15 +379,24 @@ mod tests {
         raw[6..].copy_from_slice(&crc.to_le_bytes());
         let mut enc = [0u8; 16];
         let n = cobs::try_encode(&raw, &mut enc).unwrap();
-        assert_eq!(LogFrame::decode(&enc[..n]), Err(LogError::UnsupportedVersion(1)));
+        assert_eq!(
+            LogFrame::decode(&enc[..n]),
+            Err(LogError::UnsupportedVersion(1))
+        );
         extern crate std;
         let message = std::format!("{}", LogError::UnsupportedVersion(2));
-        assert!(message.contains("version 2 is not supported") && message.contains("older firmware"), "{message}");
+        assert!(
+            message.contains("version 2 is not supported") && message.contains("older firmware"),
+            "{message}"
+        );
     }
 
     #[test]
     fn every_single_bit_flip_is_rejected() {
-        let with_calibration = LogFrame { calibration: Some(calibration()), ..sample() };
+        let with_calibration = LogFrame {
+            calibration: Some(calibration()),
+            ..sample()
+        };
         for frame in [sample(), with_calibration] {
             every_bit_flip_of(&frame);
         }
@@ -359,7 +405,20 @@ mod tests {
 
     fn calibration() -> FieldCalibration {
         FieldCalibration {
-            ranges: [SensorRange { bright: 40, dark: 420 }, SensorRange { bright: 35, dark: 500 }, SensorRange { bright: 50, dark: 380 }],
+            ranges: [
+                SensorRange {
+                    bright: 40,
+                    dark: 420,
+                },
+                SensorRange {
+                    bright: 35,
+                    dark: 500,
+                },
+                SensorRange {
+                    bright: 50,
+                    dark: 380,
+                },
+            ],
         }
     }
 
@@ -376,17 +435,34 @@ mod tests {
 
     #[test]
     fn the_calibration_round_trips_and_motor_stopping_faults_are_the_runtime_ones() {
-        let f = LogFrame { calibration: Some(calibration()), ..sample() };
+        let f = LogFrame {
+            calibration: Some(calibration()),
+            ..sample()
+        };
         let (buf, n) = encoded(&f);
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(f));
         assert!(Faults::STOPS_MOTORS.contains(Faults::CAMERA_SILENT));
         assert!(Faults::STOPS_MOTORS.contains(Faults::SENSORS_TIMEOUT));
         assert!(!Faults::STOPS_MOTORS.contains(Faults::NO_CALIBRATION));
-        let driving = LogFrame { mode: RunMode::Driving, faults: Faults::CALIBRATION_FAILED, ..sample() };
+        let driving = LogFrame {
+            mode: RunMode::Driving,
+            faults: Faults::CALIBRATION_FAILED,
+            ..sample()
+        };
         assert!(driving.policy_drove());
-        assert!(!LogFrame { faults: Faults::SENSORS_TIMEOUT, ..driving }.policy_drove());
-        assert!(!LogFrame { mode: RunMode::Idle, ..driving }.policy_drove());
-        let all = Faults::NAMED.iter().fold(Faults::NONE, |acc, (f, _)| acc.with(*f));
+        assert!(!LogFrame {
+            faults: Faults::SENSORS_TIMEOUT,
+            ..driving
+        }
+        .policy_drove());
+        assert!(!LogFrame {
+            mode: RunMode::Idle,
+            ..driving
+        }
+        .policy_drove());
+        let all = Faults::NAMED
+            .iter()
+            .fold(Faults::NONE, |acc, (f, _)| acc.with(*f));
         assert_eq!(all, Faults(15));
     }
 

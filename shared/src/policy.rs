@@ -22,7 +22,10 @@ impl PolicyTable {
 
     /// A table of `hasher`'s size with every state mapped to action 0.
     pub const fn new(hasher: StateHasher) -> PolicyTable {
-        PolicyTable { hasher, packed: [0; Self::MAX_BYTES] }
+        PolicyTable {
+            hasher,
+            packed: [0; Self::MAX_BYTES],
+        }
     }
 
     /// A table from its packed bytes, or `None` if their count is not
@@ -90,7 +93,10 @@ impl PolicyTable {
 
 impl core::fmt::Debug for PolicyTable {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("PolicyTable").field("hasher", &self.hasher).field("packed", &self.packed()).finish()
+        f.debug_struct("PolicyTable")
+            .field("hasher", &self.hasher)
+            .field("packed", &self.packed())
+            .finish()
     }
 }
 
@@ -106,7 +112,10 @@ mod tests {
                 t.set(State(s), ActionId((s % 4) as u8 ^ (s / 7 % 4) as u8));
             }
             for s in 0..h.num_states() as u16 {
-                assert_eq!(t.action(State(s)), ActionId((s % 4) as u8 ^ (s / 7 % 4) as u8));
+                assert_eq!(
+                    t.action(State(s)),
+                    ActionId((s % 4) as u8 ^ (s / 7 % 4) as u8)
+                );
             }
             assert_eq!(t.packed().len(), h.num_states() / 4);
         }

@@ -3,7 +3,9 @@
 use proptest::prelude::*;
 use serde::Serialize;
 use shared::blob::NameKind;
-use shared::{ActionId, ActionTable, BlobError, PolicyBlob, PolicyTable, Provenance, State, StateHasher};
+use shared::{
+    ActionId, ActionTable, BlobError, PolicyBlob, PolicyTable, Provenance, State, StateHasher,
+};
 
 const LONG_NAME: &str = "abcdefghijklmnopqrstuvwxyz012345"; // 32 bytes
 
@@ -74,7 +76,11 @@ fn round_trip_for_every_hasher_and_action_count() {
             let actions = ActionTable::new(&ActionTable::DEFAULT_ANGULAR[..n], 1.5).unwrap();
             let blob = sample(hasher, actions);
             let bytes = blob.encode();
-            assert_eq!(PolicyBlob::decode(&bytes), Ok(blob.clone()), "{hasher} with {n} actions");
+            assert_eq!(
+                PolicyBlob::decode(&bytes),
+                Ok(blob.clone()),
+                "{hasher} with {n} actions"
+            );
         }
     }
 }
@@ -106,7 +112,10 @@ fn every_single_bit_flip_is_rejected() {
     for i in 0..bytes.len() * 8 {
         let mut corrupt = bytes.to_vec();
         corrupt[i / 8] ^= 1 << (i % 8);
-        assert!(PolicyBlob::decode(&corrupt).is_err(), "flip of bit {i} accepted");
+        assert!(
+            PolicyBlob::decode(&corrupt).is_err(),
+            "flip of bit {i} accepted"
+        );
     }
 }
 
@@ -115,7 +124,10 @@ fn every_truncation_is_rejected() {
     let bytes = default_blob().encode();
     for len in 0..bytes.len() {
         let err = PolicyBlob::decode(&bytes[..len]).unwrap_err();
-        assert!(matches!(err, BlobError::Truncated { .. }), "length {len}: {err:?}");
+        assert!(
+            matches!(err, BlobError::Truncated { .. }),
+            "length {len}: {err:?}"
+        );
     }
 }
 
@@ -123,15 +135,24 @@ fn every_truncation_is_rejected() {
 fn wrong_magic() {
     let mut bytes = framed(&WireBody::valid(&[0; 64]));
     bytes[0] = b'X';
-    assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::WrongMagic(*b"XPOL")));
+    assert_eq!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::WrongMagic(*b"XPOL"))
+    );
     let png = b"\x89PNG\r\n\x1a\n....";
-    assert!(matches!(PolicyBlob::decode(png), Err(BlobError::WrongMagic(_))));
+    assert!(matches!(
+        PolicyBlob::decode(png),
+        Err(BlobError::WrongMagic(_))
+    ));
 }
 
 #[test]
 fn unsupported_version() {
     let body = postcard::to_allocvec(&WireBody::valid(&[0; 64])).unwrap();
-    assert_eq!(PolicyBlob::decode(&frame(2, &body)), Err(BlobError::UnsupportedVersion(2)));
+    assert_eq!(
+        PolicyBlob::decode(&frame(2, &body)),
+        Err(BlobError::UnsupportedVersion(2))
+    );
 }
 
 #[test]
@@ -139,16 +160,28 @@ fn crc_mismatch() {
     let mut bytes = framed(&WireBody::valid(&[0; 64]));
     let n = bytes.len();
     bytes[n - 1] ^= 0x80;
-    assert!(matches!(PolicyBlob::decode(&bytes), Err(BlobError::CrcMismatch { .. })));
+    assert!(matches!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::CrcMismatch { .. })
+    ));
     let mut bytes = framed(&WireBody::valid(&[0; 64]));
     bytes[20] ^= 1;
-    assert!(matches!(PolicyBlob::decode(&bytes), Err(BlobError::CrcMismatch { .. })));
+    assert!(matches!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::CrcMismatch { .. })
+    ));
 }
 
 #[test]
 fn unknown_hasher() {
-    let bytes = framed(&WireBody { hasher: 11, ..WireBody::valid(&[0; 64]) });
-    assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::UnknownHasher(11)));
+    let bytes = framed(&WireBody {
+        hasher: 11,
+        ..WireBody::valid(&[0; 64])
+    });
+    assert_eq!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::UnknownHasher(11))
+    );
 }
 
 #[test]
@@ -156,17 +189,37 @@ fn table_length_that_does_not_match_the_hasher() {
     let bytes = framed(&WireBody::valid(&[0; 63]));
     assert_eq!(
         PolicyBlob::decode(&bytes),
-        Err(BlobError::TableLength { hasher: StateHasher::Original, expected: 64, found: 63 })
+        Err(BlobError::TableLength {
+            hasher: StateHasher::Original,
+            expected: 64,
+            found: 63
+        })
     );
-    let bytes = framed(&WireBody { hasher: 10, ..WireBody::valid(&[0; 64]) });
-    assert!(matches!(PolicyBlob::decode(&bytes), Err(BlobError::TableLength { expected: 256, found: 64, .. })));
+    let bytes = framed(&WireBody {
+        hasher: 10,
+        ..WireBody::valid(&[0; 64])
+    });
+    assert!(matches!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::TableLength {
+            expected: 256,
+            found: 64,
+            ..
+        })
+    ));
 }
 
 #[test]
 fn action_count_out_of_range() {
     for count in [0u8, 1, 5, 255] {
-        let bytes = framed(&WireBody { action_count: count, ..WireBody::valid(&[0; 64]) });
-        assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::ActionCount(count)));
+        let bytes = framed(&WireBody {
+            action_count: count,
+            ..WireBody::valid(&[0; 64])
+        });
+        assert_eq!(
+            PolicyBlob::decode(&bytes),
+            Err(BlobError::ActionCount(count))
+        );
     }
 }
 
@@ -174,10 +227,17 @@ fn action_count_out_of_range() {
 fn table_entry_beyond_the_action_count() {
     let mut table = [0u8; 64];
     table[3] = 0b10 << 4; // state 14 -> action 2
-    let bytes = framed(&WireBody { action_count: 2, ..WireBody::valid(&table) });
+    let bytes = framed(&WireBody {
+        action_count: 2,
+        ..WireBody::valid(&table)
+    });
     assert_eq!(
         PolicyBlob::decode(&bytes),
-        Err(BlobError::ActionOutOfRange { state: State(14), action: ActionId(2), count: 2 })
+        Err(BlobError::ActionOutOfRange {
+            state: State(14),
+            action: ActionId(2),
+            count: 2
+        })
     );
 }
 
@@ -185,35 +245,73 @@ fn table_entry_beyond_the_action_count() {
 fn truncated_body_with_a_correct_crc() {
     let body = postcard::to_allocvec(&WireBody::valid(&[0; 64])).unwrap();
     let bytes = frame(1, &body[..body.len() - 10]);
-    assert!(matches!(PolicyBlob::decode(&bytes), Err(BlobError::Truncated { .. })));
+    assert!(matches!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::Truncated { .. })
+    ));
 }
 
 #[test]
 fn trailing_bytes_and_unused_body_bytes() {
     let mut bytes = framed(&WireBody::valid(&[0; 64]));
     bytes.push(0);
-    assert!(matches!(PolicyBlob::decode(&bytes), Err(BlobError::TrailingBytes { .. })));
+    assert!(matches!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::TrailingBytes { .. })
+    ));
     let mut body = postcard::to_allocvec(&WireBody::valid(&[0; 64])).unwrap();
     body.push(0);
-    assert!(matches!(PolicyBlob::decode(&frame(1, &body)), Err(BlobError::Malformed(_))));
+    assert!(matches!(
+        PolicyBlob::decode(&frame(1, &body)),
+        Err(BlobError::Malformed(_))
+    ));
 }
 
 #[test]
 fn non_finite_speed_and_long_names() {
-    let bytes = framed(&WireBody { forward_speed: f32::NAN, ..WireBody::valid(&[0; 64]) });
+    let bytes = framed(&WireBody {
+        forward_speed: f32::NAN,
+        ..WireBody::valid(&[0; 64])
+    });
     assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::NonFiniteSpeed));
     let long = "x".repeat(33);
-    let bytes = framed(&WireBody { name: &long, ..WireBody::valid(&[0; 64]) });
-    assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::NameTooLong { kind: NameKind::Name, len: 33 }));
-    let bytes = framed(&WireBody { field: &long, ..WireBody::valid(&[0; 64]) });
-    assert_eq!(PolicyBlob::decode(&bytes), Err(BlobError::NameTooLong { kind: NameKind::Field, len: 33 }));
+    let bytes = framed(&WireBody {
+        name: &long,
+        ..WireBody::valid(&[0; 64])
+    });
+    assert_eq!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::NameTooLong {
+            kind: NameKind::Name,
+            len: 33
+        })
+    );
+    let bytes = framed(&WireBody {
+        field: &long,
+        ..WireBody::valid(&[0; 64])
+    });
+    assert_eq!(
+        PolicyBlob::decode(&bytes),
+        Err(BlobError::NameTooLong {
+            kind: NameKind::Field,
+            len: 33
+        })
+    );
     assert!(Provenance::new(&long, "", 0, 0).is_err());
 }
 
 #[test]
 fn errors_say_what_is_wrong() {
-    let text = BlobError::TableLength { hasher: StateHasher::Original, expected: 64, found: 63 }.to_string();
-    assert!(text.contains("63") && text.contains("64") && text.contains("original"), "{text}");
+    let text = BlobError::TableLength {
+        hasher: StateHasher::Original,
+        expected: 64,
+        found: 63,
+    }
+    .to_string();
+    assert!(
+        text.contains("63") && text.contains("64") && text.contains("original"),
+        "{text}"
+    );
     let text = BlobError::WrongMagic(*b"\x89PNG").to_string();
     assert!(text.contains("not a policy blob"), "{text}");
 }
@@ -226,7 +324,10 @@ fn golden_blob_still_decodes() {
     let blob = PolicyBlob::decode(bytes).expect("golden blob decodes");
     assert_eq!(blob, default_blob());
     assert_eq!(blob.provenance().field.as_str(), LONG_NAME);
-    assert_eq!(blob.table().action(State(101)), ActionId(((101 * 7 + 101 / 5) % 4) as u8));
+    assert_eq!(
+        blob.table().action(State(101)),
+        ActionId(((101 * 7 + 101 / 5) % 4) as u8)
+    );
 }
 
 proptest! {

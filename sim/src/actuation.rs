@@ -27,7 +27,10 @@ pub struct RobotMotion {
 
 impl RobotMotion {
     /// Moving exactly as commanded.
-    pub const EXACT: RobotMotion = RobotMotion { wheel_speed_factor: 1.0, turn_bias: 0.0 };
+    pub const EXACT: RobotMotion = RobotMotion {
+        wheel_speed_factor: 1.0,
+        turn_bias: 0.0,
+    };
 }
 
 /// The actuation noise models; every field is optional in a file.
@@ -58,8 +61,13 @@ impl Default for ActuationNoise {
 
 impl ActuationNoise {
     /// No noise: robots move exactly as commanded.
-    pub const NONE: ActuationNoise =
-        ActuationNoise { speed_spread: 0.0, turn_bias: 0.0, period_jitter: 0.0, drop_period: 0.0, robots: Vec::new() };
+    pub const NONE: ActuationNoise = ActuationNoise {
+        speed_spread: 0.0,
+        turn_bias: 0.0,
+        period_jitter: 0.0,
+        drop_period: 0.0,
+        robots: Vec::new(),
+    };
 
     /// The default noise (`--randomise`), each figure's source in
     /// `docs/robot-sensors.md`: wheel speeds +-10 % (Zumo units differ
@@ -67,7 +75,13 @@ impl ActuationNoise {
     /// difference between the two tracks), period jitter 1 %, and 1 % of
     /// periods dropped.
     pub fn randomised() -> ActuationNoise {
-        ActuationNoise { speed_spread: 0.1, turn_bias: 0.005, period_jitter: 0.01, drop_period: 0.01, robots: Vec::new() }
+        ActuationNoise {
+            speed_spread: 0.1,
+            turn_bias: 0.005,
+            period_jitter: 0.01,
+            drop_period: 0.01,
+            robots: Vec::new(),
+        }
     }
 
     /// This noise with every amount times `k` (measured robots kept).
@@ -89,16 +103,46 @@ impl ActuationNoise {
     /// Checks every amount; the error names the setting.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let s = self.speed_spread;
-        check("world.actuation.speed_spread", s, (0.0..1.0).contains(&s), "must be in [0, 1)")?;
-        check("world.actuation.turn_bias", self.turn_bias, self.turn_bias >= 0.0, "must not be negative")?;
+        check(
+            "world.actuation.speed_spread",
+            s,
+            (0.0..1.0).contains(&s),
+            "must be in [0, 1)",
+        )?;
+        check(
+            "world.actuation.turn_bias",
+            self.turn_bias,
+            self.turn_bias >= 0.0,
+            "must not be negative",
+        )?;
         let j = self.period_jitter;
-        check("world.actuation.period_jitter", j, (0.0..0.15).contains(&j), "must be in [0, 0.15)")?;
+        check(
+            "world.actuation.period_jitter",
+            j,
+            (0.0..0.15).contains(&j),
+            "must be in [0, 0.15)",
+        )?;
         let d = self.drop_period;
-        check("world.actuation.drop_period", d, (0.0..=1.0).contains(&d), "must be in [0, 1]")?;
+        check(
+            "world.actuation.drop_period",
+            d,
+            (0.0..=1.0).contains(&d),
+            "must be in [0, 1]",
+        )?;
         for (i, r) in self.robots.iter().enumerate() {
             let f = r.wheel_speed_factor;
-            check(&format!("world.actuation.robots[{i}].wheel_speed_factor"), f, f > 0.0, "must be positive")?;
-            check(&format!("world.actuation.robots[{i}].turn_bias"), r.turn_bias, true, "must be a finite number")?;
+            check(
+                &format!("world.actuation.robots[{i}].wheel_speed_factor"),
+                f,
+                f > 0.0,
+                "must be positive",
+            )?;
+            check(
+                &format!("world.actuation.robots[{i}].turn_bias"),
+                r.turn_bias,
+                true,
+                "must be a finite number",
+            )?;
         }
         Ok(())
     }
@@ -140,7 +184,13 @@ mod tests {
         assert_eq!(none.motion(1, 0, 3), RobotMotion::EXACT);
         assert_eq!(none.period(1, 10, 3), (1.0, false));
         let measured = ActuationNoise {
-            robots: vec![RobotMotion { wheel_speed_factor: 0.9, turn_bias: 0.01 }, RobotMotion::EXACT],
+            robots: vec![
+                RobotMotion {
+                    wheel_speed_factor: 0.9,
+                    turn_bias: 0.01,
+                },
+                RobotMotion::EXACT,
+            ],
             ..ActuationNoise::randomised()
         };
         assert_eq!(measured.motion(1, 4, 2).wheel_speed_factor, 0.9);
@@ -154,11 +204,16 @@ mod tests {
         assert_eq!(m, n.motion(5, 2, 1));
         assert_ne!(m, n.motion(5, 3, 1));
         assert_ne!(m, n.motion(6, 2, 1));
-        let factors: Vec<f64> = (0..2000).map(|e| n.motion(5, e, 0).wheel_speed_factor).collect();
+        let factors: Vec<f64> = (0..2000)
+            .map(|e| n.motion(5, e, 0).wheel_speed_factor)
+            .collect();
         assert!(factors.iter().all(|f| (0.9..=1.1).contains(f)));
         assert!(factors.iter().any(|f| *f < 0.92) && factors.iter().any(|f| *f > 1.08));
         let drops = (0..20_000).filter(|s| n.period(5, *s, 0).1).count();
-        assert!((150..250).contains(&drops), "{drops} of 20,000 periods dropped at 1 %");
+        assert!(
+            (150..250).contains(&drops),
+            "{drops} of 20,000 periods dropped at 1 %"
+        );
         let lengths: Vec<f64> = (0..20_000).map(|s| n.period(5, s, 0).0).collect();
         let sd = (lengths.iter().map(|l| (l - 1.0) * (l - 1.0)).sum::<f64>() / 20_000.0).sqrt();
         assert!((sd - 0.01).abs() < 0.001, "{sd}");
@@ -168,10 +223,27 @@ mod tests {
 
     #[test]
     fn bad_amounts_are_named() {
-        let bad = ActuationNoise { speed_spread: 1.5, ..ActuationNoise::NONE };
-        assert!(bad.validate().unwrap_err().to_string().contains("world.actuation.speed_spread"));
-        let bad = ActuationNoise { robots: vec![RobotMotion { wheel_speed_factor: 0.0, turn_bias: 0.0 }], ..ActuationNoise::NONE };
-        assert!(bad.validate().unwrap_err().to_string().contains("robots[0].wheel_speed_factor"));
+        let bad = ActuationNoise {
+            speed_spread: 1.5,
+            ..ActuationNoise::NONE
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("world.actuation.speed_spread"));
+        let bad = ActuationNoise {
+            robots: vec![RobotMotion {
+                wheel_speed_factor: 0.0,
+                turn_bias: 0.0,
+            }],
+            ..ActuationNoise::NONE
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("robots[0].wheel_speed_factor"));
         assert!(ActuationNoise::randomised().validate().is_ok());
     }
 }

@@ -130,21 +130,43 @@ impl ArenaSpec {
         positive("arena.screen_mm[0]", self.screen_mm[0])?;
         positive("arena.screen_mm[1]", self.screen_mm[1])?;
         for (i, px) in self.screen_px.iter().enumerate() {
-            check(&format!("arena.screen_px[{i}]"), f64::from(*px), (1..=16384).contains(px), "must be 1 to 16384")?;
+            check(
+                &format!("arena.screen_px[{i}]"),
+                f64::from(*px),
+                (1..=16384).contains(px),
+                "must be 1 to 16384",
+            )?;
         }
         positive("arena.display_gamma", self.display_gamma)?;
         positive("arena.robot_radius_mm", self.robot_radius_mm)?;
         positive("arena.puck_radius_mm", self.puck_radius_mm)?;
         positive("arena.puck_mass_ratio", self.puck_mass_ratio)?;
-        check("arena.robots", self.robots as f64, self.robots > 0, "at least one robot is needed")?;
-        check("arena.forward_speed", self.forward_speed, self.forward_speed >= 0.0, "must not be negative")?;
-        check("arena.stuck_limit", self.stuck_limit as f64, self.stuck_limit > 0, "must be positive")
+        check(
+            "arena.robots",
+            self.robots as f64,
+            self.robots > 0,
+            "at least one robot is needed",
+        )?;
+        check(
+            "arena.forward_speed",
+            self.forward_speed,
+            self.forward_speed >= 0.0,
+            "must not be negative",
+        )?;
+        check(
+            "arena.stuck_limit",
+            self.stuck_limit as f64,
+            self.stuck_limit > 0,
+            "must be positive",
+        )
     }
 
     /// Cells of the annulus generated for this screen: 64 across, as many
     /// down as keep the cells square.
     pub fn annulus_cells(&self) -> (usize, usize) {
-        let rows = (ANNULUS_COLUMNS as f64 * self.screen_mm[1] / self.screen_mm[0]).round().max(1.0) as usize;
+        let rows = (ANNULUS_COLUMNS as f64 * self.screen_mm[1] / self.screen_mm[0])
+            .round()
+            .max(1.0) as usize;
         (ANNULUS_COLUMNS, rows)
     }
 
@@ -157,7 +179,12 @@ impl ArenaSpec {
             FieldFit::Contain => {
                 let scale = (size.x / cells.0 as f64).min(size.y / cells.1 as f64);
                 let (width, height) = (cells.0 as f64 * scale, cells.1 as f64 * scale);
-                FieldFrame { x: (size.x - width) / 2.0, y: (size.y - height) / 2.0, width, height }
+                FieldFrame {
+                    x: (size.x - width) / 2.0,
+                    y: (size.y - height) / 2.0,
+                    width,
+                    height,
+                }
             }
         }
     }
@@ -165,7 +192,10 @@ impl ArenaSpec {
     /// Where `field` lies on this screen and how the robots read it: its
     /// [`ArenaSpec::field_frame`], bilinear (as the screen scales it).
     pub fn field_layout(&self, field: &ScalarField) -> FieldLayout {
-        FieldLayout { frame: self.field_frame((field.width(), field.height())), sampling: FieldSampling::Bilinear }
+        FieldLayout {
+            frame: self.field_frame((field.width(), field.height())),
+            sampling: FieldSampling::Bilinear,
+        }
     }
 
     /// The position of panel pixel (`i`, `j`)'s centre, in units from the
@@ -192,7 +222,8 @@ impl ArenaSpec {
         world.unit_mm = unit;
         world.robot_radius = ROBOT_RADIUS_UNITS;
         world.puck_radius = self.puck_radius_mm / unit;
-        world.puck_mass = Some(self.puck_mass_ratio * crate::body::Body::MASS_PER_RADIUS * ROBOT_RADIUS_UNITS);
+        world.puck_mass =
+            Some(self.puck_mass_ratio * crate::body::Body::MASS_PER_RADIUS * ROBOT_RADIUS_UNITS);
         world.robots = self.robots;
         world.pucks = self.pucks;
         world.forward_speed = self.forward_speed;
@@ -216,7 +247,10 @@ mod tests {
     fn the_tv_is_about_25_by_14_robot_radii_and_its_annulus_has_square_cells() {
         let tv = ArenaSpec::tv75();
         let size = tv.size();
-        assert!((size.x / 10.0 - 25.4).abs() < 0.05 && (size.y / 10.0 - 14.3).abs() < 0.05, "{size:?}");
+        assert!(
+            (size.x / 10.0 - 25.4).abs() < 0.05 && (size.y / 10.0 - 14.3).abs() < 0.05,
+            "{size:?}"
+        );
         assert_eq!(tv.annulus_cells(), (64, 36));
         assert_eq!(tv.unit_mm(), 6.5);
         assert!(tv.validate().is_ok());
@@ -229,8 +263,14 @@ mod tests {
         let f = tv.field_frame((600, 600));
         assert!((f.height - size.y).abs() < 1e-9 && (f.width - size.y).abs() < 1e-9);
         assert!((f.x - (size.x - size.y) / 2.0).abs() < 1e-9 && f.y == 0.0);
-        let stretched = ArenaSpec { fit: FieldFit::Stretch, ..tv };
-        assert_eq!(stretched.field_frame((600, 600)), FieldFrame::whole(size.x, size.y));
+        let stretched = ArenaSpec {
+            fit: FieldFit::Stretch,
+            ..tv
+        };
+        assert_eq!(
+            stretched.field_frame((600, 600)),
+            FieldFrame::whole(size.x, size.y)
+        );
     }
 
     #[test]
@@ -239,9 +279,15 @@ mod tests {
         let size = tv.size();
         let pixel = size.x / 3840.0;
         let first = tv.panel_pixel_centre(0, 0);
-        assert!((first.x - pixel / 2.0).abs() < 1e-12 && (first.y - size.y / 2160.0 / 2.0).abs() < 1e-12);
+        assert!(
+            (first.x - pixel / 2.0).abs() < 1e-12
+                && (first.y - size.y / 2160.0 / 2.0).abs() < 1e-12
+        );
         let last = tv.panel_pixel_centre(3839, 2159);
-        assert!((size.x - last.x - pixel / 2.0).abs() < 1e-9 && (size.y - last.y - size.y / 4320.0).abs() < 1e-9);
+        assert!(
+            (size.x - last.x - pixel / 2.0).abs() < 1e-9
+                && (size.y - last.y - size.y / 4320.0).abs() < 1e-9
+        );
     }
 
     #[test]
@@ -251,11 +297,24 @@ mod tests {
         tv.apply(&mut config, &ScalarField::annulus_of(64, 36));
         assert_eq!((config.world.robots, config.world.pucks), (5, 12));
         assert_eq!(config.world.field_sampling, FieldSampling::Bilinear);
-        assert_eq!((config.world.puck_radius, config.world.puck_mass), (10.0, Some(100.0)));
+        assert_eq!(
+            (config.world.puck_radius, config.world.puck_mass),
+            (10.0, Some(100.0))
+        );
         assert_eq!(config.episode.stuck_limit, 15_000);
         assert_eq!(config.validate(), Ok(()));
-        let bad = ArenaSpec { robot_radius_mm: -1.0, ..ArenaSpec::tv75() };
-        assert_eq!(config.world.field_layout(), tv.field_layout(&ScalarField::annulus_of(64, 36)));
-        assert!(bad.validate().unwrap_err().to_string().contains("arena.robot_radius_mm"));
+        let bad = ArenaSpec {
+            robot_radius_mm: -1.0,
+            ..ArenaSpec::tv75()
+        };
+        assert_eq!(
+            config.world.field_layout(),
+            tv.field_layout(&ScalarField::annulus_of(64, 36))
+        );
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("arena.robot_radius_mm"));
     }
 }

@@ -10,7 +10,9 @@ pub struct BitSet {
 impl BitSet {
     /// An empty set for indices below `len`.
     pub fn new(len: usize) -> BitSet {
-        BitSet { words: vec![0; len.div_ceil(64)] }
+        BitSet {
+            words: vec![0; len.div_ceil(64)],
+        }
     }
 
     /// Adds `i`.

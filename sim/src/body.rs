@@ -1,8 +1,8 @@
 //! Circle bodies and the robots that drive some of them.
 
 use crate::vec2::Vec2;
-use std::f64::consts::{PI, TAU};
 use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
 
 /// A circle in the arena: a robot or a puck.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -27,7 +27,13 @@ impl Body {
 
     /// A body at rest.
     pub fn new(pos: Vec2, radius: f64) -> Body {
-        Body { pos, vel: Vec2::ZERO, radius, mass: Self::MASS_PER_RADIUS * radius, in_contact: false }
+        Body {
+            pos,
+            vel: Vec2::ZERO,
+            radius,
+            mass: Self::MASS_PER_RADIUS * radius,
+            in_contact: false,
+        }
     }
 }
 
@@ -67,7 +73,11 @@ pub struct Robot {
 impl Robot {
     /// A robot facing `heading`.
     pub fn new(heading: f64, kind: RobotKind) -> Robot {
-        Robot { heading, direction: Vec2::from_angle(heading), kind }
+        Robot {
+            heading,
+            direction: Vec2::from_angle(heading),
+            kind,
+        }
     }
 
     /// Turns by `angle` radians (positive = right). The heading is kept
@@ -76,7 +86,11 @@ impl Robot {
     pub fn turn(&mut self, angle: f64) {
         if angle != 0.0 {
             let heading = self.heading + angle;
-            self.heading = if heading.abs() > PI { heading - TAU * (heading / TAU).round() } else { heading };
+            self.heading = if heading.abs() > PI {
+                heading - TAU * (heading / TAU).round()
+            } else {
+                heading
+            };
             self.direction = Vec2::from_angle(self.heading);
         }
     }

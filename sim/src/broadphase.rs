@@ -41,7 +41,10 @@ pub struct Candidates {
 impl Candidates {
     /// A buffer for a world of `bodies` bodies.
     pub fn new(bodies: usize) -> Candidates {
-        Candidates { slots: vec![0; bodies], len: 0 }
+        Candidates {
+            slots: vec![0; bodies],
+            len: 0,
+        }
     }
 
     /// The candidates, ascending.
@@ -59,7 +62,9 @@ impl NeighbourIndex {
             BroadPhase::Grid => cell,
             BroadPhase::Naive => size.x.max(size.y),
         };
-        NeighbourIndex { grid: SpatialGrid::new(size, cell, bodies.iter().map(|b| (b.pos, b.radius))) }
+        NeighbourIndex {
+            grid: SpatialGrid::new(size, cell, bodies.iter().map(|b| (b.pos, b.radius))),
+        }
     }
 
     /// Records a body's new position.
@@ -95,7 +100,8 @@ impl NeighbourIndex {
         // both (when anything can overlap at all).
         let touch = radius + max_radius - threshold;
         let (len, close) = if half <= self.grid.cell_width() * (1.0 - 1e-9) {
-            self.grid.gather_around(body, pos, half * half, touch * touch, &mut out.slots)
+            self.grid
+                .gather_around(body, pos, half * half, touch * touch, &mut out.slots)
         } else {
             self.gather_in_box(pos, half, touch, &mut out.slots)
         };
@@ -132,15 +138,19 @@ impl NeighbourIndex {
     fn gather_in_box(&self, pos: Vec2, half: f64, touch: f64, out: &mut [u32]) -> (usize, usize) {
         let (reach2, close2) = (half * half, touch * touch);
         let (mut len, mut close) = (0, 0);
-        self.grid.any_in_box(pos - Vec2::new(half, half), pos + Vec2::new(half, half), |row| {
-            for n in row {
-                let d2 = (n.pos - pos).length_squared();
-                out[len] = n.body;
-                len += usize::from(d2 < reach2);
-                close += usize::from(d2 < close2);
-            }
-            false
-        });
+        self.grid.any_in_box(
+            pos - Vec2::new(half, half),
+            pos + Vec2::new(half, half),
+            |row| {
+                for n in row {
+                    let d2 = (n.pos - pos).length_squared();
+                    out[len] = n.body;
+                    len += usize::from(d2 < reach2);
+                    close += usize::from(d2 < close2);
+                }
+                false
+            },
+        );
         (len, close)
     }
 
@@ -151,12 +161,22 @@ impl NeighbourIndex {
     /// rounding of cell indices cannot matter), the body's cell and the
     /// eight around it are searched, with no box to convert to cells.
     #[inline]
-    pub fn any_around(&self, bodies: &[Body], body: usize, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+    pub fn any_around(
+        &self,
+        bodies: &[Body],
+        body: usize,
+        reach: f64,
+        pred: impl FnMut(&[Neighbour]) -> bool,
+    ) -> bool {
         if reach <= self.grid.cell_width() * (1.0 - 1e-9) {
             self.grid.any_around(body, pred)
         } else {
             let pos = bodies[body].pos;
-            self.grid.any_in_box(pos - Vec2::new(reach, reach), pos + Vec2::new(reach, reach), pred)
+            self.grid.any_in_box(
+                pos - Vec2::new(reach, reach),
+                pos + Vec2::new(reach, reach),
+                pred,
+            )
         }
     }
 
@@ -191,7 +211,10 @@ mod tests {
             // Dense enough that many bodies touch; some outside the arena.
             let bodies: Vec<Body> = (0..150)
                 .map(|k| {
-                    let p = Vec2::new(rng.random_range(-5.0..size.x + 5.0), rng.random_range(-5.0..size.y + 5.0));
+                    let p = Vec2::new(
+                        rng.random_range(-5.0..size.x + 5.0),
+                        rng.random_range(-5.0..size.y + 5.0),
+                    );
                     Body::new(p, radii[k % 3])
                 })
                 .collect();
@@ -212,29 +235,60 @@ mod tests {
                         let touch = b.radius + o.radius - threshold;
                         (o.pos - b.pos).length_squared() < touch * touch
                     });
-                    index.contact_candidates(&bodies, i, None, max_radius, margin, threshold, &mut out);
+                    index.contact_candidates(
+                        &bodies, i, None, max_radius, margin, threshold, &mut out,
+                    );
                     let found = out.as_slice().to_vec();
-                    assert!(!(overlapping && found.is_empty()), "scene {scene}, {kind:?}, body {i}");
+                    assert!(
+                        !(overlapping && found.is_empty()),
+                        "scene {scene}, {kind:?}, body {i}"
+                    );
                     empty += usize::from(found.is_empty());
                     check_candidates(&found, &near, i, 0);
                     turns += 1;
                     let after = i.saturating_sub(3);
-                    index.contact_candidates(&bodies, i, Some(after), max_radius, margin, threshold, &mut out);
-                    let later: Vec<u32> = near.iter().copied().filter(|&j| j as usize > after).collect();
+                    index.contact_candidates(
+                        &bodies,
+                        i,
+                        Some(after),
+                        max_radius,
+                        margin,
+                        threshold,
+                        &mut out,
+                    );
+                    let later: Vec<u32> = near
+                        .iter()
+                        .copied()
+                        .filter(|&j| j as usize > after)
+                        .collect();
                     check_candidates(out.as_slice(), &later, i, after + 1);
                 }
             }
         }
-        assert!(empty > 1_000 && turns - empty > 1_000, "both outcomes tested: {empty} empty of {turns}");
+        assert!(
+            empty > 1_000 && turns - empty > 1_000,
+            "both outcomes tested: {empty} empty of {turns}"
+        );
     }
 
     /// `found` holds every body of `near`, ascending, without `body` or any
     /// below `first`.
     fn check_candidates(found: &[u32], near: &[u32], body: usize, first: usize) {
-        assert!(found.windows(2).all(|w| w[0] < w[1]), "ascending: {found:?}");
-        assert!(found.iter().all(|&j| j as usize != body && j as usize >= first), "{found:?}");
+        assert!(
+            found.windows(2).all(|w| w[0] < w[1]),
+            "ascending: {found:?}"
+        );
+        assert!(
+            found
+                .iter()
+                .all(|&j| j as usize != body && j as usize >= first),
+            "{found:?}"
+        );
         if !found.is_empty() {
-            assert!(near.iter().all(|j| found.contains(j)), "{near:?} in {found:?}");
+            assert!(
+                near.iter().all(|j| found.contains(j)),
+                "{near:?} in {found:?}"
+            );
         }
     }
 }

@@ -46,7 +46,14 @@ mod tests {
 
     #[test]
     fn a_frame_serves_two_periods_when_no_new_one_comes() {
-        let block = PixyBlock { signature: 1, x: 1, y: 2, width: 3, height: 4, angle: 0 };
+        let block = PixyBlock {
+            signature: 1,
+            x: 1,
+            y: 2,
+            width: 3,
+            height: 4,
+            angle: 0,
+        };
         let mut m = CameraMemory::default();
         assert!(m.period(&[]).is_empty());
         assert_eq!(m.period(&[block]), [block]);
@@ -54,6 +61,10 @@ mod tests {
         assert!(m.period(&[]).is_empty(), "then cleared");
         let other = PixyBlock { x: 9, ..block };
         assert_eq!(m.period(&[block]), [block]);
-        assert_eq!(m.period(&[other]), [other], "a new frame replaces the held one");
+        assert_eq!(
+            m.period(&[other]),
+            [other],
+            "a new frame replaces the held one"
+        );
     }
 }

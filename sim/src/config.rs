@@ -9,8 +9,8 @@ use crate::actuation::ActuationNoise;
 use crate::broadphase::BroadPhase;
 use crate::disc_sensor_config::DiscSensorConfig;
 use crate::field::{FieldFrame, FieldLayout, FieldSampling};
-use crate::vec2::Vec2;
 use crate::validate::{check, positive, unit, ConfigError};
+use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 
 /// The arena and what is in it. Lengths are in units: a tenth of the
@@ -93,8 +93,13 @@ impl WorldConfig {
 
     /// Where the field lies and how it is read.
     pub fn field_layout(&self) -> FieldLayout {
-        let frame = self.field_frame.unwrap_or(FieldFrame::whole(self.arena_width, self.arena_height));
-        FieldLayout { frame, sampling: self.field_sampling }
+        let frame = self
+            .field_frame
+            .unwrap_or(FieldFrame::whole(self.arena_width, self.arena_height));
+        FieldLayout {
+            frame,
+            sampling: self.field_sampling,
+        }
     }
 }
 
@@ -115,7 +120,12 @@ pub struct PhysicsConfig {
 impl Default for PhysicsConfig {
     /// The reference model: 0.4, 0.001, 0.1; walls of zero thickness.
     fn default() -> PhysicsConfig {
-        PhysicsConfig { deceleration: 0.4, stop_speed: 0.001, overlap_threshold: 0.1, wall_radius: 0.0 }
+        PhysicsConfig {
+            deceleration: 0.4,
+            stop_speed: 0.001,
+            overlap_threshold: 0.1,
+            wall_radius: 0.0,
+        }
     }
 }
 
@@ -133,13 +143,19 @@ pub struct Thresholds {
 impl Default for Thresholds {
     /// The annulus: 0.6 and 0.8.
     fn default() -> Thresholds {
-        Thresholds { outie: 0.6, innie: 0.8 }
+        Thresholds {
+            outie: 0.6,
+            innie: 0.8,
+        }
     }
 }
 
 impl Thresholds {
     /// The letter experiments' thresholds: both 1.0.
-    pub const LETTERS: Thresholds = Thresholds { outie: 1.0, innie: 1.0 };
+    pub const LETTERS: Thresholds = Thresholds {
+        outie: 1.0,
+        innie: 1.0,
+    };
 }
 
 /// What a formation check compares with the success threshold.
@@ -220,14 +236,29 @@ impl SimConfig {
         positive("world.arena_width", w.arena_width)?;
         positive("world.arena_height", w.arena_height)?;
         positive("world.unit_mm", w.unit_mm)?;
-        check("world.robots", w.robots as f64, w.robots > 0, "at least one robot is needed")?;
-        check("world.innies", w.innies as f64, w.innies <= w.robots, "cannot exceed world.robots")?;
+        check(
+            "world.robots",
+            w.robots as f64,
+            w.robots > 0,
+            "at least one robot is needed",
+        )?;
+        check(
+            "world.innies",
+            w.innies as f64,
+            w.innies <= w.robots,
+            "cannot exceed world.robots",
+        )?;
         positive("world.robot_radius", w.robot_radius)?;
         positive("world.puck_radius", w.puck_radius)?;
         if let Some(mass) = w.puck_mass {
             positive("world.puck_mass", mass)?;
         }
-        check("world.forward_speed", w.forward_speed, w.forward_speed >= 0.0, "must not be negative")?;
+        check(
+            "world.forward_speed",
+            w.forward_speed,
+            w.forward_speed >= 0.0,
+            "must not be negative",
+        )?;
         let short_side = w.arena_width.min(w.arena_height);
         check(
             "world.puck_radius",
@@ -249,32 +280,72 @@ impl SimConfig {
         }
         w.actuation.validate()?;
         let area = std::f64::consts::PI
-            * (w.robots as f64 * w.robot_radius * w.robot_radius + w.pucks as f64 * w.puck_radius * w.puck_radius);
+            * (w.robots as f64 * w.robot_radius * w.robot_radius
+                + w.pucks as f64 * w.puck_radius * w.puck_radius);
         let capacity = PACKING_DENSITY * w.arena_width * w.arena_height;
         if area > capacity {
-            return Err(ConfigError::TooManyBodies { bodies: w.bodies(), area, capacity });
+            return Err(ConfigError::TooManyBodies {
+                bodies: w.bodies(),
+                area,
+                capacity,
+            });
         }
 
         let p = &self.physics;
         unit("physics.deceleration", p.deceleration)?;
-        check("physics.stop_speed", p.stop_speed, p.stop_speed >= 0.0, "must not be negative")?;
-        check("physics.overlap_threshold", p.overlap_threshold, p.overlap_threshold >= 0.0, "must not be negative")?;
-        check("physics.wall_radius", p.wall_radius, p.wall_radius >= 0.0, "must not be negative")?;
+        check(
+            "physics.stop_speed",
+            p.stop_speed,
+            p.stop_speed >= 0.0,
+            "must not be negative",
+        )?;
+        check(
+            "physics.overlap_threshold",
+            p.overlap_threshold,
+            p.overlap_threshold >= 0.0,
+            "must not be negative",
+        )?;
+        check(
+            "physics.wall_radius",
+            p.wall_radius,
+            p.wall_radius >= 0.0,
+            "must not be negative",
+        )?;
 
         self.sensors.validate()?;
 
         let t = &self.thresholds;
         unit("thresholds.outie", t.outie)?;
         unit("thresholds.innie", t.innie)?;
-        check("thresholds.innie", t.innie, t.innie >= t.outie, "must not be below thresholds.outie")?;
+        check(
+            "thresholds.innie",
+            t.innie,
+            t.innie >= t.outie,
+            "must not be below thresholds.outie",
+        )?;
 
         let e = &self.episode;
         unit("episode.success_eval", e.success_eval)?;
-        check("episode.check_interval", e.check_interval as f64, e.check_interval > 0, "must be positive")?;
-        check("episode.stuck_limit", e.stuck_limit as f64, e.stuck_limit > 0, "must be positive")?;
+        check(
+            "episode.check_interval",
+            e.check_interval as f64,
+            e.check_interval > 0,
+            "must be positive",
+        )?;
+        check(
+            "episode.stuck_limit",
+            e.stuck_limit as f64,
+            e.stuck_limit > 0,
+            "must be positive",
+        )?;
         unit("episode.phi", e.phi)?;
         unit("episode.nu", e.nu)?;
-        check("episode.nu", e.nu, (e.phi + e.nu - 1.0).abs() < 1e-9, "episode.phi + episode.nu must be 1")?;
+        check(
+            "episode.nu",
+            e.nu,
+            (e.phi + e.nu - 1.0).abs() < 1e-9,
+            "episode.phi + episode.nu must be 1",
+        )?;
         Ok(())
     }
 }
@@ -292,27 +363,47 @@ mod tests {
     fn errors_name_the_offending_value() {
         let mut c = SimConfig::default();
         c.world.robot_radius = -2.0;
-        assert_eq!(c.validate().unwrap_err().to_string(), "world.robot_radius = -2: must be positive");
+        assert_eq!(
+            c.validate().unwrap_err().to_string(),
+            "world.robot_radius = -2: must be positive"
+        );
 
         let mut c = SimConfig::default();
         c.world.robots = 0;
-        assert!(c.validate().unwrap_err().to_string().starts_with("world.robots = 0"));
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("world.robots = 0"));
 
         let mut c = SimConfig::default();
         c.thresholds.outie = 1.5;
-        assert_eq!(c.validate().unwrap_err().to_string(), "thresholds.outie = 1.5: must be in [0, 1]");
+        assert_eq!(
+            c.validate().unwrap_err().to_string(),
+            "thresholds.outie = 1.5: must be in [0, 1]"
+        );
 
         let mut c = SimConfig::default();
         c.world.pucks = 10_000;
-        assert!(matches!(c.validate(), Err(ConfigError::TooManyBodies { bodies: 10_008, .. })));
+        assert!(matches!(
+            c.validate(),
+            Err(ConfigError::TooManyBodies { bodies: 10_008, .. })
+        ));
 
         let mut c = SimConfig::default();
         c.world.arena_width = f64::NAN;
-        assert!(c.validate().unwrap_err().to_string().starts_with("world.arena_width = NaN"));
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("world.arena_width = NaN"));
 
         let mut c = SimConfig::default();
         c.world.arena_height = 70.0;
         let e = c.validate().unwrap_err().to_string();
-        assert!(e.starts_with("world.puck_radius = 10") && e.contains("shorter side"), "{e}");
+        assert!(
+            e.starts_with("world.puck_radius = 10") && e.contains("shorter side"),
+            "{e}"
+        );
     }
 }

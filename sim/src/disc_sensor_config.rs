@@ -21,12 +21,26 @@ pub struct SensorDisc {
 
 impl SensorDisc {
     const fn new(angle_deg: f64, distance: f64, radius: f64) -> SensorDisc {
-        SensorDisc { angle_deg, distance, radius }
+        SensorDisc {
+            angle_deg,
+            distance,
+            radius,
+        }
     }
 
     fn validate(&self, name: &str) -> Result<(), ConfigError> {
-        check(&format!("{name}.angle_deg"), self.angle_deg, true, "must be a finite number")?;
-        check(&format!("{name}.distance"), self.distance, self.distance >= 0.0, "must not be negative")?;
+        check(
+            &format!("{name}.angle_deg"),
+            self.angle_deg,
+            true,
+            "must be a finite number",
+        )?;
+        check(
+            &format!("{name}.distance"),
+            self.distance,
+            self.distance >= 0.0,
+            "must not be negative",
+        )?;
         positive(&format!("{name}.radius"), self.radius)
     }
 }
@@ -67,8 +81,14 @@ impl Default for DiscSensorConfig {
         DiscSensorConfig {
             field_angle_deg: 45.0,
             field_distance: 2.0,
-            outie_pucks: vec![SensorDisc::new(30.0, 4.0, 2.0), SensorDisc::new(60.0, 7.0, 2.0)],
-            innie_pucks: vec![SensorDisc::new(45.0, 3.0, 2.0), SensorDisc::new(70.0, 6.5, 2.0)],
+            outie_pucks: vec![
+                SensorDisc::new(30.0, 4.0, 2.0),
+                SensorDisc::new(60.0, 7.0, 2.0),
+            ],
+            innie_pucks: vec![
+                SensorDisc::new(45.0, 3.0, 2.0),
+                SensorDisc::new(70.0, 6.5, 2.0),
+            ],
             obstacle: SensorDisc::new(45.0, 1.0, 0.25),
             obstacle_targets: ObstacleTargets::AnyBody,
         }
@@ -88,8 +108,18 @@ impl DiscSensorConfig {
 
     /// Checks every angle, distance and radius.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check("sensors.field_angle_deg", self.field_angle_deg, true, "must be a finite number")?;
-        check("sensors.field_distance", self.field_distance, self.field_distance >= 0.0, "must not be negative")?;
+        check(
+            "sensors.field_angle_deg",
+            self.field_angle_deg,
+            true,
+            "must be a finite number",
+        )?;
+        check(
+            "sensors.field_distance",
+            self.field_distance,
+            self.field_distance >= 0.0,
+            "must not be negative",
+        )?;
         for (i, d) in self.outie_pucks.iter().enumerate() {
             d.validate(&format!("sensors.outie_pucks[{i}]"))?;
         }

@@ -23,7 +23,16 @@ impl LocalDisc {
     fn pair(d: &SensorDisc, robot_radius: f64) -> [LocalDisc; 2] {
         let right = Vec2::from_angle(d.angle_deg.to_radians()) * (d.distance * robot_radius);
         let radius = d.radius * robot_radius;
-        [LocalDisc { offset: Vec2::new(right.x, -right.y), radius }, LocalDisc { offset: right, radius }]
+        [
+            LocalDisc {
+                offset: Vec2::new(right.x, -right.y),
+                radius,
+            },
+            LocalDisc {
+                offset: right,
+                radius,
+            },
+        ]
     }
 }
 
@@ -49,13 +58,24 @@ pub struct DiscSensors {
 impl DiscSensors {
     /// Sensors of the given geometry for robots of `robot_radius`.
     pub fn new(config: &DiscSensorConfig, robot_radius: f64) -> DiscSensors {
-        let side = Vec2::from_angle(config.field_angle_deg.to_radians()) * (config.field_distance * robot_radius);
+        let side = Vec2::from_angle(config.field_angle_deg.to_radians())
+            * (config.field_distance * robot_radius);
         let pucks = |discs: &[SensorDisc]| {
-            let pairs: Vec<[LocalDisc; 2]> = discs.iter().map(|d| LocalDisc::pair(d, robot_radius)).collect();
-            [pairs.iter().map(|p| p[0]).collect(), pairs.iter().map(|p| p[1]).collect()]
+            let pairs: Vec<[LocalDisc; 2]> = discs
+                .iter()
+                .map(|d| LocalDisc::pair(d, robot_radius))
+                .collect();
+            [
+                pairs.iter().map(|p| p[0]).collect(),
+                pairs.iter().map(|p| p[1]).collect(),
+            ]
         };
         DiscSensors {
-            field: [Vec2::new(side.x, -side.y), Vec2::new(config.field_distance * robot_radius, 0.0), side],
+            field: [
+                Vec2::new(side.x, -side.y),
+                Vec2::new(config.field_distance * robot_radius, 0.0),
+                side,
+            ],
             pucks: [pucks(&config.outie_pucks), pucks(&config.innie_pucks)],
             obstacle: LocalDisc::pair(&config.obstacle, robot_radius),
             obstacle_reach: (config.obstacle.distance + config.obstacle.radius) * robot_radius,
@@ -78,13 +98,25 @@ impl SensorModel for DiscSensors {
         } as u32;
         let mut witnesses = std::mem::take(&mut self.witnesses);
         witnesses.resize(world.robots().len(), [usize::MAX; 2]);
-        for (i, ((robot, reading), witness)) in world.robots().iter().zip(out.iter_mut()).zip(&mut witnesses).enumerate() {
+        for (i, ((robot, reading), witness)) in world
+            .robots()
+            .iter()
+            .zip(out.iter_mut())
+            .zip(&mut witnesses)
+            .enumerate()
+        {
             let pos = world.bodies()[i].pos;
             let at = |local: Vec2| pos + local.rotated(robot.direction);
             let [left, right] = self.puck_discs(robot.kind);
             let any_puck = |discs: &[LocalDisc], witness: &mut usize| {
-                discs.iter().any(|d| world.puck_overlaps_disc(*witness, at(d.offset), d.radius))
-                    || discs.iter().find_map(|d| world.puck_in_disc(at(d.offset), d.radius)).map(|puck| *witness = puck).is_some()
+                discs
+                    .iter()
+                    .any(|d| world.puck_overlaps_disc(*witness, at(d.offset), d.radius))
+                    || discs
+                        .iter()
+                        .find_map(|d| world.puck_in_disc(at(d.offset), d.radius))
+                        .map(|puck| *witness = puck)
+                        .is_some()
             };
             // Both obstacle discs hug the robot: one neighbour query around
             // the robot serves both.
@@ -123,12 +155,24 @@ impl SensorModel for DiscSensors {
     fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
         let (pos, r) = (world.bodies()[robot].pos, world.robots()[robot]);
         let at = |local: Vec2| pos + local.rotated(r.direction);
-        out.extend(self.field.iter().map(|&p| Footprint { centre: at(p), radius: 0.0, kind: FootprintKind::Field }));
+        out.extend(self.field.iter().map(|&p| Footprint {
+            centre: at(p),
+            radius: 0.0,
+            kind: FootprintKind::Field,
+        }));
         for d in self.puck_discs(r.kind).iter().flatten() {
-            out.push(Footprint { centre: at(d.offset), radius: d.radius, kind: FootprintKind::Puck });
+            out.push(Footprint {
+                centre: at(d.offset),
+                radius: d.radius,
+                kind: FootprintKind::Puck,
+            });
         }
         for d in &self.obstacle {
-            out.push(Footprint { centre: at(d.offset), radius: d.radius, kind: FootprintKind::Obstacle });
+            out.push(Footprint {
+                centre: at(d.offset),
+                radius: d.radius,
+                kind: FootprintKind::Obstacle,
+            });
         }
     }
 }

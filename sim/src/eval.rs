@@ -59,7 +59,11 @@ impl Distances {
     fn new(field: &ScalarField, layout: &FieldLayout, t: &Thresholds) -> Distances {
         match layout.sampling {
             FieldSampling::Nearest => Distances::ByCell {
-                cells: field.values().iter().map(|&v| fixed_of_value(v, t)).collect(),
+                cells: field
+                    .values()
+                    .iter()
+                    .map(|&v| fixed_of_value(v, t))
+                    .collect(),
                 outside: fixed_of_value(0.0, t),
             },
             FieldSampling::Bilinear => Distances::Interpolated,
@@ -69,7 +73,9 @@ impl Distances {
     #[inline]
     fn at(&self, p: Vec2, layout: &FieldLayout, field: &ScalarField, t: &Thresholds) -> u64 {
         match self {
-            Distances::ByCell { cells, outside } => field.truncated_cell(p, &layout.frame).map_or(*outside, |k| cells[k]),
+            Distances::ByCell { cells, outside } => field
+                .truncated_cell(p, &layout.frame)
+                .map_or(*outside, |k| cells[k]),
             Distances::Interpolated => fixed_distance(p, layout, field, t),
         }
     }
@@ -87,7 +93,11 @@ fn eval_of(total: u64, pucks: usize, t: &Thresholds) -> f64 {
 /// Eval of the pucks' positions, 1 when every puck is in the band.
 pub fn eval(world: &World, field: &ScalarField, t: &Thresholds) -> f64 {
     let layout = world.config().field_layout();
-    let total = world.pucks().iter().map(|p| fixed_distance(p.pos, &layout, field, t)).sum();
+    let total = world
+        .pucks()
+        .iter()
+        .map(|p| fixed_distance(p.pos, &layout, field, t))
+        .sum();
     eval_of(total, world.pucks().len(), t)
 }
 
@@ -109,7 +119,11 @@ impl EvalTracker {
     /// A tracker of `world`'s current pucks.
     pub fn new(world: &World, field: &ScalarField, t: &Thresholds) -> EvalTracker {
         let lookup = Distances::new(field, &world.config().field_layout(), t);
-        let mut tracker = EvalTracker { distances: vec![0; world.bodies().len()], total: 0, lookup };
+        let mut tracker = EvalTracker {
+            distances: vec![0; world.bodies().len()],
+            total: 0,
+            lookup,
+        };
         tracker.rebuild(world, field, t);
         tracker
     }
@@ -160,7 +174,14 @@ pub enum EvalPrime {
 }
 
 /// Eval' of the given variant with weights `phi` and `nu`.
-pub fn eval_prime(world: &World, field: &ScalarField, t: &Thresholds, variant: EvalPrime, phi: f64, nu: f64) -> f64 {
+pub fn eval_prime(
+    world: &World,
+    field: &ScalarField,
+    t: &Thresholds,
+    variant: EvalPrime,
+    phi: f64,
+    nu: f64,
+) -> f64 {
     let robots = &world.bodies()[..world.robots().len()];
     let n = robots.len();
     let layout = world.config().field_layout();
@@ -169,7 +190,13 @@ pub fn eval_prime(world: &World, field: &ScalarField, t: &Thresholds, variant: E
             let value = |b: &crate::body::Body| f64::from(field.evaluate(b.pos, &layout));
             let total_ad: f64 = robots
                 .iter()
-                .map(|j| robots.iter().map(|k| (value(j) - value(k)).abs()).sum::<f64>() / n as f64)
+                .map(|j| {
+                    robots
+                        .iter()
+                        .map(|k| (value(j) - value(k)).abs())
+                        .sum::<f64>()
+                        / n as f64
+                })
                 .sum();
             1.0 - total_ad / n as f64
         }
@@ -211,13 +238,31 @@ mod tests {
     #[test]
     fn the_cell_table_gives_the_formulas_distance_everywhere() {
         let field = ScalarField::annulus_of(16, 12);
-        let layout = FieldLayout { frame: FieldFrame { x: 30.0, y: -12.5, width: 160.0, height: 90.0 }, sampling: FieldSampling::Nearest };
-        for t in [Thresholds::default(), Thresholds::LETTERS, Thresholds { outie: 0.2, innie: 0.3 }] {
+        let layout = FieldLayout {
+            frame: FieldFrame {
+                x: 30.0,
+                y: -12.5,
+                width: 160.0,
+                height: 90.0,
+            },
+            sampling: FieldSampling::Nearest,
+        };
+        for t in [
+            Thresholds::default(),
+            Thresholds::LETTERS,
+            Thresholds {
+                outie: 0.2,
+                innie: 0.3,
+            },
+        ] {
             let table = Distances::new(&field, &layout, &t);
             let mut points: Vec<Vec2> = Vec::new();
             for i in -8..=200 {
                 for j in -8..=130 {
-                    points.push(Vec2::new(20.0 + f64::from(i) * 0.9, -25.0 + f64::from(j) * 0.9));
+                    points.push(Vec2::new(
+                        20.0 + f64::from(i) * 0.9,
+                        -25.0 + f64::from(j) * 0.9,
+                    ));
                 }
             }
             // exactly on cell edges (10 x 7.5 units each) and a hair off them
@@ -225,12 +270,24 @@ mod tests {
             for i in -1..=17 {
                 for j in -1..=13 {
                     let edge = Vec2::new(30.0 + f64::from(i) * 10.0, -12.5 + f64::from(j) * 7.5);
-                    points.extend([edge, Vec2::new(edge.x - hair(edge.x), edge.y), Vec2::new(edge.x, edge.y + hair(edge.y))]);
+                    points.extend([
+                        edge,
+                        Vec2::new(edge.x - hair(edge.x), edge.y),
+                        Vec2::new(edge.x, edge.y + hair(edge.y)),
+                    ]);
                 }
             }
-            points.extend([Vec2::new(f64::NAN, 40.0), Vec2::new(50.0, f64::INFINITY), Vec2::new(-1e300, 1e300)]);
+            points.extend([
+                Vec2::new(f64::NAN, 40.0),
+                Vec2::new(50.0, f64::INFINITY),
+                Vec2::new(-1e300, 1e300),
+            ]);
             for p in points {
-                assert_eq!(table.at(p, &layout, &field, &t), fixed_distance(p, &layout, &field, &t), "at {p:?}");
+                assert_eq!(
+                    table.at(p, &layout, &field, &t),
+                    fixed_distance(p, &layout, &field, &t),
+                    "at {p:?}"
+                );
             }
         }
     }

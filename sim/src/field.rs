@@ -36,7 +36,12 @@ pub struct FieldFrame {
 impl FieldFrame {
     /// The whole of a `width` x `height` arena.
     pub const fn whole(width: f64, height: f64) -> FieldFrame {
-        FieldFrame { x: 0.0, y: 0.0, width, height }
+        FieldFrame {
+            x: 0.0,
+            y: 0.0,
+            width,
+            height,
+        }
     }
 }
 
@@ -76,9 +81,17 @@ impl ScalarField {
         if width == 0 || height == 0 || values.len() != width * height {
             return None;
         }
-        let values: Vec<f32> = values.into_iter().map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 }).collect();
+        let values: Vec<f32> = values
+            .into_iter()
+            .map(|v| if v > 0.0 { v.min(1.0) } else { 0.0 })
+            .collect();
         let fixed = values.iter().map(|&v| FieldValue::from_f32(v)).collect();
-        Some(ScalarField { width, height, values, fixed })
+        Some(ScalarField {
+            width,
+            height,
+            values,
+            fixed,
+        })
     }
 
     /// The annulus field of the reference model: 64 x 64 cells, value
@@ -165,7 +178,9 @@ impl ScalarField {
     /// cell found by truncation (0 outside), with bilinear the interpolation.
     pub fn evaluate(&self, p: Vec2, layout: &FieldLayout) -> f32 {
         match layout.sampling {
-            FieldSampling::Nearest => self.truncated_cell(p, &layout.frame).map_or(0.0, |k| self.values[k]),
+            FieldSampling::Nearest => self
+                .truncated_cell(p, &layout.frame)
+                .map_or(0.0, |k| self.values[k]),
             FieldSampling::Bilinear => self.bilinear(p, &layout.frame) as f32,
         }
     }
@@ -244,7 +259,10 @@ mod tests {
     }
 
     /// The reference model's layout: the 800 x 800 arena, nearest cell.
-    const THESIS: FieldLayout = FieldLayout { frame: FieldFrame::whole(800.0, 800.0), sampling: FieldSampling::Nearest };
+    const THESIS: FieldLayout = FieldLayout {
+        frame: FieldFrame::whole(800.0, 800.0),
+        sampling: FieldSampling::Nearest,
+    };
 
     #[test]
     fn sensors_round_and_read_zero_past_the_last_half_cell() {
@@ -257,7 +275,10 @@ mod tests {
         assert_eq!(f.nearest_cell(Vec2::new(793.75, 400.0), &frame), (64, 32));
         assert_eq!(f.sense(Vec2::new(793.75, 400.0), &THESIS), FieldValue::ZERO);
         assert_eq!(f.sense(Vec2::new(400.0, 795.0), &THESIS), FieldValue::ZERO);
-        assert_eq!(f.sense(Vec2::new(793.0, 400.0), &THESIS), FieldValue::from_f32(f.cell(63, 32)));
+        assert_eq!(
+            f.sense(Vec2::new(793.0, 400.0), &THESIS),
+            FieldValue::from_f32(f.cell(63, 32))
+        );
         assert_eq!(f.sense(Vec2::new(-7.0, 400.0), &THESIS), FieldValue::ZERO);
         // evaluation truncates: 799 -> cell 63
         assert_eq!(f.evaluate(Vec2::new(799.0, 400.0), &THESIS), f.cell(63, 32));
@@ -270,7 +291,12 @@ mod tests {
         // and 115, y 52.5 and 57.5.
         let f = ScalarField::new(2, 2, vec![0.0, 1.0, 0.5, 0.25]).unwrap();
         let layout = FieldLayout {
-            frame: FieldFrame { x: 100.0, y: 50.0, width: 20.0, height: 10.0 },
+            frame: FieldFrame {
+                x: 100.0,
+                y: 50.0,
+                width: 20.0,
+                height: 10.0,
+            },
             sampling: FieldSampling::Bilinear,
         };
         let at = |x, y| f.shown(Vec2::new(x, y), &layout);
@@ -295,11 +321,15 @@ mod tests {
     }
 
     #[test]
-    fn two_sensors_37_mm_apart_on_a_gradient_read_different_values_bilinear_but_often_one_cell_nearest() {
+    fn two_sensors_37_mm_apart_on_a_gradient_read_different_values_bilinear_but_often_one_cell_nearest(
+    ) {
         // The annulus over the thesis' arena: cells of 12.5 units (62.5 mm
         // at 5 mm per unit); sensors 37 mm = 7.4 units apart across a radius.
         let f = ScalarField::annulus();
-        let bilinear = FieldLayout { sampling: FieldSampling::Bilinear, ..THESIS };
+        let bilinear = FieldLayout {
+            sampling: FieldSampling::Bilinear,
+            ..THESIS
+        };
         let (mut same_cell, mut differ) = (0, 0);
         for k in 0..100 {
             let x = 420.0 + 2.0 * f64::from(k);
@@ -308,15 +338,30 @@ mod tests {
             differ += usize::from(f.sense(a, &bilinear) > f.sense(b, &bilinear));
         }
         assert_eq!(differ, 100, "bilinear: the inner sensor always reads more");
-        assert!(same_cell >= 30, "nearest: {same_cell} of 100 pairs read one cell");
+        assert!(
+            same_cell >= 30,
+            "nearest: {same_cell} of 100 pairs read one cell"
+        );
     }
 
     #[test]
     fn nearest_sensing_reads_the_cell_that_rounding_picks_also_at_half_cells_and_outside() {
         let f = ScalarField::annulus_of(64, 36);
-        let layout = FieldLayout { frame: FieldFrame { x: -3.5, y: 10.0, width: 800.0, height: 450.0 }, sampling: FieldSampling::Nearest };
+        let layout = FieldLayout {
+            frame: FieldFrame {
+                x: -3.5,
+                y: 10.0,
+                width: 800.0,
+                height: 450.0,
+            },
+            sampling: FieldSampling::Nearest,
+        };
         let cell = 800.0 / 64.0;
-        let mut points = vec![Vec2::new(f64::NAN, 100.0), Vec2::new(1e300, 100.0), Vec2::new(-1e300, -1e300)];
+        let mut points = vec![
+            Vec2::new(f64::NAN, 100.0),
+            Vec2::new(1e300, 100.0),
+            Vec2::new(-1e300, -1e300),
+        ];
         for k in -40..1700 {
             let t = f64::from(k) * 0.5 * cell - 3.5;
             for d in [0.0, 1e-9, -1e-9, 0.3, 4.0, 6.25, -6.25] {

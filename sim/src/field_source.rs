@@ -49,12 +49,24 @@ impl fmt::Display for FieldError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             FieldError::UnknownLetter(l) => {
-                write!(f, "unknown letter {l:?} in the field name: expected one of {}", Letter::NAMES)
+                write!(
+                    f,
+                    "unknown letter {l:?} in the field name: expected one of {}",
+                    Letter::NAMES
+                )
             }
-            FieldError::Image { path, reason } => write!(f, "cannot load field image {}: {reason}", path.display()),
-            FieldError::EmptyImage(path) => write!(f, "field image {} has no pixels", path.display()),
+            FieldError::Image { path, reason } => {
+                write!(f, "cannot load field image {}: {reason}", path.display())
+            }
+            FieldError::EmptyImage(path) => {
+                write!(f, "field image {} has no pixels", path.display())
+            }
             FieldError::NoThesisImage(l) => {
-                write!(f, "the thesis has no letter image {l:?}: expected one of {}", THESIS_LETTERS.join(", "))
+                write!(
+                    f,
+                    "the thesis has no letter image {l:?}: expected one of {}",
+                    THESIS_LETTERS.join(", ")
+                )
             }
         }
     }
@@ -70,7 +82,10 @@ impl FromStr for FieldSource {
         if s == "annulus" {
             Ok(FieldSource::Annulus)
         } else if let Some(letter) = s.strip_prefix("letter:") {
-            letter.parse().map(FieldSource::Letter).map_err(|_| FieldError::UnknownLetter(letter.to_string()))
+            letter
+                .parse()
+                .map(FieldSource::Letter)
+                .map_err(|_| FieldError::UnknownLetter(letter.to_string()))
         } else if let Some(letter) = s.strip_prefix("thesis:") {
             match letter.parse::<Letter>() {
                 Ok(l) if thesis_image(l).is_some() => Ok(FieldSource::Thesis(l)),
@@ -113,9 +128,13 @@ impl FieldSource {
             FieldSource::Annulus => Ok(ScalarField::annulus()),
             FieldSource::Letter(l) => Ok(l.field()),
             FieldSource::Thesis(l) => {
-                let bytes = thesis_image(*l).ok_or_else(|| FieldError::NoThesisImage(l.to_string()))?;
+                let bytes =
+                    thesis_image(*l).ok_or_else(|| FieldError::NoThesisImage(l.to_string()))?;
                 let name = PathBuf::from(self.to_string());
-                let err = |reason| FieldError::Image { path: name.clone(), reason };
+                let err = |reason| FieldError::Image {
+                    path: name.clone(),
+                    reason,
+                };
                 field_of(image::load_from_memory(bytes).map_err(err)?, &name)
             }
             FieldSource::Image(path) => load_image(path),
@@ -158,7 +177,10 @@ fn thesis_image(letter: Letter) -> Option<&'static [u8]> {
 
 /// An image file's field.
 fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
-    let err = |reason| FieldError::Image { path: path.to_path_buf(), reason };
+    let err = |reason| FieldError::Image {
+        path: path.to_path_buf(),
+        reason,
+    };
     let img = image::ImageReader::open(path)
         .map_err(|e| err(image::ImageError::IoError(e)))?
         .with_guessed_format()
@@ -171,7 +193,10 @@ fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
 /// An image's field: mean of R, G, B over 255, one cell per pixel.
 fn field_of(img: image::DynamicImage, path: &Path) -> Result<ScalarField, FieldError> {
     let img = img.to_rgb8();
-    let values = img.pixels().map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / (3.0 * 255.0)).collect();
+    let values = img
+        .pixels()
+        .map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / (3.0 * 255.0))
+        .collect();
     ScalarField::new(img.width() as usize, img.height() as usize, values)
         .ok_or_else(|| FieldError::EmptyImage(path.to_path_buf()))
 }
@@ -182,11 +207,20 @@ mod tests {
 
     #[test]
     fn sources_parse_and_errors_name_the_input() {
-        assert_eq!("annulus".parse::<FieldSource>().unwrap(), FieldSource::Annulus);
-        assert_eq!("letter:T".parse::<FieldSource>().unwrap(), FieldSource::Letter(Letter::T));
+        assert_eq!(
+            "annulus".parse::<FieldSource>().unwrap(),
+            FieldSource::Annulus
+        );
+        assert_eq!(
+            "letter:T".parse::<FieldSource>().unwrap(),
+            FieldSource::Letter(Letter::T)
+        );
         let e = "letter:Q".parse::<FieldSource>().unwrap_err().to_string();
         assert!(e.contains("\"Q\""), "{e}");
-        assert_eq!("thesis:X".parse::<FieldSource>().unwrap(), FieldSource::Thesis(Letter::X));
+        assert_eq!(
+            "thesis:X".parse::<FieldSource>().unwrap(),
+            FieldSource::Thesis(Letter::X)
+        );
         let e = "thesis:I".parse::<FieldSource>().unwrap_err().to_string();
         assert!(e.contains("\"I\"") && e.contains("T, L, V, X, Z"), "{e}");
         let missing = FieldSource::Image(PathBuf::from("/no/such/field.png"));
@@ -198,8 +232,14 @@ mod tests {
     fn the_thesis_images_are_built_in_and_read_like_their_files() {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../experiments/fields");
         for l in THESIS_LETTERS {
-            let built_in = format!("thesis:{l}").parse::<FieldSource>().unwrap().load().unwrap();
-            let file = FieldSource::Image(dir.join(format!("{l}.png"))).load().unwrap();
+            let built_in = format!("thesis:{l}")
+                .parse::<FieldSource>()
+                .unwrap()
+                .load()
+                .unwrap();
+            let file = FieldSource::Image(dir.join(format!("{l}.png")))
+                .load()
+                .unwrap();
             assert_eq!((built_in.width(), built_in.height()), (600, 600));
             assert!(built_in == file, "{l}");
         }

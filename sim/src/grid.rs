@@ -55,7 +55,11 @@ impl SpatialGrid {
     /// A grid over an arena of `size` (width, height) with cells of at
     /// least `min_cell` units each way, holding bodies of the given centres
     /// and radii.
-    pub fn new(size: Vec2, min_cell: f64, bodies: impl ExactSizeIterator<Item = (Vec2, f64)>) -> SpatialGrid {
+    pub fn new(
+        size: Vec2,
+        min_cell: f64,
+        bodies: impl ExactSizeIterator<Item = (Vec2, f64)>,
+    ) -> SpatialGrid {
         let count = |side: f64| ((side / min_cell).floor() as usize).clamp(1, u16::MAX as usize);
         let (cols, rows) = (count(size.x), count(size.y));
         let mut grid = SpatialGrid {
@@ -65,7 +69,14 @@ impl SpatialGrid {
             rows,
             stride: cols + 2,
             start: vec![0; (cols + 2) * (rows + 2) + 1],
-            slots: bodies.enumerate().map(|(body, (pos, radius))| Neighbour { pos, radius, body: body as u32 }).collect(),
+            slots: bodies
+                .enumerate()
+                .map(|(body, (pos, radius))| Neighbour {
+                    pos,
+                    radius,
+                    body: body as u32,
+                })
+                .collect(),
             slot_of: Vec::new(),
             cell_of: Vec::new(),
         };
@@ -147,11 +158,19 @@ impl SpatialGrid {
     /// the box `min ..= max` (a superset of the bodies inside the box),
     /// until it returns true; returns whether it did.
     #[inline]
-    pub fn any_in_box(&self, min: Vec2, max: Vec2, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+    pub fn any_in_box(
+        &self,
+        min: Vec2,
+        max: Vec2,
+        mut pred: impl FnMut(&[Neighbour]) -> bool,
+    ) -> bool {
         let (first_col, last_col) = (self.column(min.x), self.column(max.x));
         for row in self.row(min.y)..self.row(max.y) + 1 {
             let base = row * self.stride;
-            let (from, to) = (self.start[base + first_col], self.start[base + last_col + 1]);
+            let (from, to) = (
+                self.start[base + first_col],
+                self.start[base + last_col + 1],
+            );
             if pred(&self.slots[from as usize..to as usize]) {
                 return true;
             }
@@ -166,10 +185,12 @@ impl SpatialGrid {
     #[inline]
     pub fn any_around(&self, body: usize, mut pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
         let cell = self.cell_of[body] as usize;
-        [cell - self.stride, cell, cell + self.stride].into_iter().any(|mid| {
-            let (from, to) = (self.start[mid - 1], self.start[mid + 2]);
-            pred(&self.slots[from as usize..to as usize])
-        })
+        [cell - self.stride, cell, cell + self.stride]
+            .into_iter()
+            .any(|mid| {
+                let (from, to) = (self.start[mid - 1], self.start[mid + 2]);
+                pred(&self.slots[from as usize..to as usize])
+            })
     }
 
     /// Writes to the start of `out` the bodies of body `body`'s cell and
@@ -178,7 +199,14 @@ impl SpatialGrid {
     /// among them if it does; returns how many, and how many of those lie
     /// closer than `sqrt(close2)`. `out` needs a slot for every body.
     #[inline]
-    pub fn gather_around(&self, body: usize, centre: Vec2, reach2: f64, close2: f64, out: &mut [u32]) -> (usize, usize) {
+    pub fn gather_around(
+        &self,
+        body: usize,
+        centre: Vec2,
+        reach2: f64,
+        close2: f64,
+        out: &mut [u32],
+    ) -> (usize, usize) {
         let cell = self.cell_of[body] as usize;
         let (mut len, mut close) = (0, 0);
         for mid in [cell - self.stride, cell, cell + self.stride] {
@@ -221,14 +249,30 @@ mod tests {
 
     #[test]
     fn moved_bodies_are_found_in_their_new_cell_only() {
-        let pts = [Vec2::new(5.0, 5.0), Vec2::new(100.0, 100.0), Vec2::new(-3.0, 900.0)];
+        let pts = [
+            Vec2::new(5.0, 5.0),
+            Vec2::new(100.0, 100.0),
+            Vec2::new(-3.0, 900.0),
+        ];
         let mut g = grid(800.0, 20.0, &pts);
-        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), vec![0]);
+        assert_eq!(
+            found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)),
+            vec![0]
+        );
         // clamped into the bottom-left border cell
-        assert_eq!(found(&g, Vec2::new(0.0, 790.0), Vec2::new(1.0, 799.0)), vec![2]);
+        assert_eq!(
+            found(&g, Vec2::new(0.0, 790.0), Vec2::new(1.0, 799.0)),
+            vec![2]
+        );
         g.moved(0, Vec2::new(101.0, 99.0));
-        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)), Vec::<u32>::new());
-        assert_eq!(found(&g, Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0)), vec![0, 1]);
+        assert_eq!(
+            found(&g, Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0)),
+            Vec::<u32>::new()
+        );
+        assert_eq!(
+            found(&g, Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0)),
+            vec![0, 1]
+        );
         let mut seen = Vec::new();
         g.any_in_box(Vec2::new(95.0, 95.0), Vec2::new(105.0, 105.0), |row| {
             seen.extend(row.iter().map(|n| (n.body, n.pos)));
@@ -240,17 +284,27 @@ mod tests {
 
     #[test]
     fn queries_in_wide_grids() {
-        let pts: Vec<Vec2> = (0..100).map(|i| Vec2::new(i as f64 * 20.0 + 10.0, 30.0)).collect();
+        let pts: Vec<Vec2> = (0..100)
+            .map(|i| Vec2::new(i as f64 * 20.0 + 10.0, 30.0))
+            .collect();
         let g = grid(2000.0, 20.0, &pts);
-        assert_eq!(found(&g, Vec2::new(1250.0, 0.0), Vec2::new(1310.0, 40.0)), vec![62, 63, 64, 65]);
-        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(2000.0, 2000.0)).len(), 100);
+        assert_eq!(
+            found(&g, Vec2::new(1250.0, 0.0), Vec2::new(1310.0, 40.0)),
+            vec![62, 63, 64, 65]
+        );
+        assert_eq!(
+            found(&g, Vec2::new(0.0, 0.0), Vec2::new(2000.0, 2000.0)).len(),
+            100
+        );
     }
 
     /// A body's neighbourhood holds every body less than a cell's width
     /// away, also at the arena's edges and for bodies outside it.
     #[test]
     fn the_cells_around_a_body_hold_everything_within_a_cell_width() {
-        let pts: Vec<Vec2> = (0..400).map(|i| Vec2::new((i * 37 % 113) as f64 - 6.5, (i * 53 % 109) as f64 - 4.5)).collect();
+        let pts: Vec<Vec2> = (0..400)
+            .map(|i| Vec2::new((i * 37 % 113) as f64 - 6.5, (i * 53 % 109) as f64 - 4.5))
+            .collect();
         let g = grid(100.0, 10.0, &pts);
         assert_eq!(g.cell_width(), 10.0);
         for (b, p) in pts.iter().enumerate() {
@@ -273,13 +327,31 @@ mod tests {
 
     #[test]
     fn a_rectangular_arena_has_its_own_rows_and_columns_and_clamps_outside_points_into_them() {
-        let pts = [Vec2::new(5.0, 5.0), Vec2::new(395.0, 95.0), Vec2::new(500.0, -20.0), Vec2::new(200.0, 150.0)];
+        let pts = [
+            Vec2::new(5.0, 5.0),
+            Vec2::new(395.0, 95.0),
+            Vec2::new(500.0, -20.0),
+            Vec2::new(200.0, 150.0),
+        ];
         let g = SpatialGrid::new(Vec2::new(400.0, 100.0), 20.0, pts.iter().map(|&p| (p, 1.0)));
         assert_eq!((g.cols, g.rows), (20, 5));
-        assert_eq!(found(&g, Vec2::new(390.0, 90.0), Vec2::new(399.0, 99.0)), vec![1]);
-        assert_eq!(found(&g, Vec2::new(195.0, 95.0), Vec2::new(205.0, 99.0)), vec![3], "below the arena: last row");
-        assert_eq!(found(&g, Vec2::new(390.0, 0.0), Vec2::new(399.0, 10.0)), vec![2]);
-        assert_eq!(found(&g, Vec2::new(0.0, 0.0), Vec2::new(400.0, 100.0)), vec![0, 1, 2, 3]);
+        assert_eq!(
+            found(&g, Vec2::new(390.0, 90.0), Vec2::new(399.0, 99.0)),
+            vec![1]
+        );
+        assert_eq!(
+            found(&g, Vec2::new(195.0, 95.0), Vec2::new(205.0, 99.0)),
+            vec![3],
+            "below the arena: last row"
+        );
+        assert_eq!(
+            found(&g, Vec2::new(390.0, 0.0), Vec2::new(399.0, 10.0)),
+            vec![2]
+        );
+        assert_eq!(
+            found(&g, Vec2::new(0.0, 0.0), Vec2::new(400.0, 100.0)),
+            vec![0, 1, 2, 3]
+        );
     }
 
     /// Many bodies carried across many cells in both directions stay
@@ -287,11 +359,16 @@ mod tests {
     #[test]
     fn long_moves_keep_every_cell_exact() {
         let n = 60;
-        let mut pts: Vec<Vec2> = (0..n).map(|i| Vec2::new((i * 37 % 100) as f64, (i * 53 % 100) as f64)).collect();
+        let mut pts: Vec<Vec2> = (0..n)
+            .map(|i| Vec2::new((i * 37 % 100) as f64, (i * 53 % 100) as f64))
+            .collect();
         let mut g = grid(100.0, 10.0, &pts);
         for step in 0..500 {
             let i = step * 7 % n;
-            pts[i] = Vec2::new(((step * 31 + 11) % 100) as f64 + 0.5, ((step * 17 + 3) % 100) as f64 + 0.5);
+            pts[i] = Vec2::new(
+                ((step * 31 + 11) % 100) as f64 + 0.5,
+                ((step * 17 + 3) % 100) as f64 + 0.5,
+            );
             g.moved(i, pts[i]);
             for (c, w) in g.start.windows(2).enumerate() {
                 for s in w[0]..w[1] {

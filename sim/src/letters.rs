@@ -43,7 +43,14 @@ pub enum Letter {
 
 impl Letter {
     /// Every letter.
-    pub const ALL: [Letter; 6] = [Letter::T, Letter::I, Letter::L, Letter::V, Letter::X, Letter::Z];
+    pub const ALL: [Letter; 6] = [
+        Letter::T,
+        Letter::I,
+        Letter::L,
+        Letter::V,
+        Letter::X,
+        Letter::Z,
+    ];
     /// The accepted names, for messages.
     pub const NAMES: &'static str = "T, I, L, V, X, Z";
 
@@ -60,8 +67,8 @@ impl Letter {
         const A: f64 = MARGIN + STROKE_WIDTH / 2.0; // 198: near edge of the box
         const B: f64 = LETTER_SIZE as f64 - A; // 402: far edge
         const M: f64 = LETTER_SIZE as f64 / 2.0; // 300: middle
-        // The Z is narrower (30 % of the side) so its three strokes stay
-        // within the thesis' 2-6 % of the image.
+                                                 // The Z is narrower (30 % of the side) so its three strokes stay
+                                                 // within the thesis' 2-6 % of the image.
         const ZA: f64 = A + 30.0;
         // The I has serifs: a bare bar holds too few of the thesis' 200
         // pucks for any formation (see the test below), where the thesis'
@@ -70,7 +77,11 @@ impl Letter {
         const ZB: f64 = B - 30.0;
         match self {
             Letter::T => &[[(A, A), (B, A)], [(M, A), (M, B)]],
-            Letter::I => &[[(M, A), (M, B)], [(M - SERIF, A), (M + SERIF, A)], [(M - SERIF, B), (M + SERIF, B)]],
+            Letter::I => &[
+                [(M, A), (M, B)],
+                [(M - SERIF, A), (M + SERIF, A)],
+                [(M - SERIF, B), (M + SERIF, B)],
+            ],
             Letter::L => &[[(A, A), (A, B)], [(A, B), (B, B)]],
             Letter::V => &[[(A, A), (M, B)], [(B, A), (M, B)]],
             Letter::X => &[[(A, A), (B, B)], [(B, A), (A, B)]],
@@ -81,15 +92,24 @@ impl Letter {
     /// Whether pixel (`x`, `y`)'s centre lies on a stroke.
     fn on_stroke(self, x: usize, y: usize) -> bool {
         let p = (x as f64 + 0.5, y as f64 + 0.5);
-        self.strokes().iter().any(|&[a, b]| segment_distance(p, a, b) <= STROKE_WIDTH / 2.0)
+        self.strokes()
+            .iter()
+            .any(|&[a, b]| segment_distance(p, a, b) <= STROKE_WIDTH / 2.0)
     }
 
     /// Each pixel's Euclidean distance to the nearest stroke pixel (0 on the
     /// stroke), row-major.
     pub fn distance_map(self) -> Vec<f64> {
         let n = LETTER_SIZE;
-        let mut sq: Vec<f64> =
-            (0..n * n).map(|k| if self.on_stroke(k % n, k / n) { 0.0 } else { f64::INFINITY }).collect();
+        let mut sq: Vec<f64> = (0..n * n)
+            .map(|k| {
+                if self.on_stroke(k % n, k / n) {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
         squared_distance_transform(&mut sq, n, n);
         sq.into_iter().map(f64::sqrt).collect()
     }
@@ -97,7 +117,11 @@ impl Letter {
     /// The letter's field: 1 on the stroke, `1 - distance / falloff` off it.
     pub fn field(self) -> ScalarField {
         let falloff = self.falloff();
-        let values = self.distance_map().into_iter().map(|d| (1.0 - d / falloff).max(0.0) as f32).collect();
+        let values = self
+            .distance_map()
+            .into_iter()
+            .map(|d| (1.0 - d / falloff).max(0.0) as f32)
+            .collect();
         ScalarField::new(LETTER_SIZE, LETTER_SIZE, values).expect("600 x 600 values")
     }
 }
@@ -107,7 +131,10 @@ impl FromStr for Letter {
 
     /// One of `T I L V X Z`, either case.
     fn from_str(s: &str) -> Result<Letter, ()> {
-        Letter::ALL.into_iter().find(|l| l.to_string().eq_ignore_ascii_case(s)).ok_or(())
+        Letter::ALL
+            .into_iter()
+            .find(|l| l.to_string().eq_ignore_ascii_case(s))
+            .ok_or(())
     }
 }
 
@@ -165,7 +192,8 @@ fn lower_envelope(f: &[f64], out: &mut [f64]) {
         // z[0] is minus infinity, so k never drops below 0
         let s = loop {
             let p = v[k];
-            let s = ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
+            let s =
+                ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
             if s > z[k] {
                 break s;
             }
@@ -194,8 +222,15 @@ mod tests {
     fn distance_transform_is_exact_on_a_small_grid() {
         let (w, h) = (7, 5);
         let features = [(1usize, 1usize), (5, 3)];
-        let mut g: Vec<f64> =
-            (0..w * h).map(|k| if features.contains(&(k % w, k / w)) { 0.0 } else { f64::INFINITY }).collect();
+        let mut g: Vec<f64> = (0..w * h)
+            .map(|k| {
+                if features.contains(&(k % w, k / w)) {
+                    0.0
+                } else {
+                    f64::INFINITY
+                }
+            })
+            .collect();
         squared_distance_transform(&mut g, w, h);
         for (k, &got) in g.iter().enumerate() {
             let (x, y) = ((k % w) as f64, (k / w) as f64);
@@ -209,25 +244,46 @@ mod tests {
 
     /// Mean field value of the pixels at `d` (+- 0.5) px from the stroke.
     fn profile_at(distances: &[f64], field: &ScalarField, d: f64) -> f64 {
-        let (sum, n) = distances.iter().enumerate().filter(|(_, &x)| (x - d).abs() <= 0.5).fold(
-            (0.0, 0),
-            |(s, n), (k, _)| (s + f64::from(field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64)), n + 1),
-        );
+        let (sum, n) = distances
+            .iter()
+            .enumerate()
+            .filter(|(_, &x)| (x - d).abs() <= 0.5)
+            .fold((0.0, 0), |(s, n), (k, _)| {
+                (
+                    s + f64::from(field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64)),
+                    n + 1,
+                )
+            });
         assert!(n > 0, "no pixel at distance {d}");
         sum / n as f64
     }
 
     #[test]
     fn letters_have_full_strokes_and_the_thesis_falloff() {
-        let reference = [(10.0, 0.97), (25.0, 0.93), (50.0, 0.85), (100.0, 0.71), (150.0, 0.56), (200.0, 0.41)];
+        let reference = [
+            (10.0, 0.97),
+            (25.0, 0.93),
+            (50.0, 0.85),
+            (100.0, 0.71),
+            (150.0, 0.56),
+            (200.0, 0.41),
+        ];
         for letter in Letter::ALL {
             let field = letter.field();
             let distances = letter.distance_map();
-            let stroke: Vec<usize> = (0..distances.len()).filter(|&k| distances[k] == 0.0).collect();
+            let stroke: Vec<usize> = (0..distances.len())
+                .filter(|&k| distances[k] == 0.0)
+                .collect();
             let share = stroke.len() as f64 / distances.len() as f64;
-            assert!((0.02..=0.06).contains(&share), "{letter}: stroke covers {share}");
+            assert!(
+                (0.02..=0.06).contains(&share),
+                "{letter}: stroke covers {share}"
+            );
             for k in stroke {
-                assert_eq!(field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64), 1.0);
+                assert_eq!(
+                    field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64),
+                    1.0
+                );
             }
             if letter == Letter::L {
                 let v = profile_at(&distances, &field, 100.0);
@@ -235,7 +291,10 @@ mod tests {
             } else {
                 for (d, want) in reference {
                     let v = profile_at(&distances, &field, d);
-                    assert!((v - want).abs() <= 0.02, "{letter} at {d} px: {v}, reference {want}");
+                    assert!(
+                        (v - want).abs() <= 0.02,
+                        "{letter} at {d} px: {v}, reference {want}"
+                    );
                 }
             }
         }
@@ -247,10 +306,15 @@ mod tests {
         let puck_area = std::f64::consts::PI * 7.5 * 7.5 / 0.9069;
         let pixels = (200.0 * puck_area).round() as usize;
         let field = letter.field();
-        let mut values: Vec<f32> =
-            (0..LETTER_SIZE * LETTER_SIZE).map(|k| field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64)).collect();
+        let mut values: Vec<f32> = (0..LETTER_SIZE * LETTER_SIZE)
+            .map(|k| field.cell((k % LETTER_SIZE) as i64, (k / LETTER_SIZE) as i64))
+            .collect();
         values.sort_by(|a, b| b.total_cmp(a));
-        1.0 - values[..pixels].iter().map(|&v| 1.0 - f64::from(v)).sum::<f64>() / pixels as f64
+        1.0 - values[..pixels]
+            .iter()
+            .map(|&v| 1.0 - f64::from(v))
+            .sum::<f64>()
+            / pixels as f64
     }
 
     #[test]
@@ -259,7 +323,10 @@ mod tests {
             let best = best_eval_of_200_pucks(letter);
             println!("{letter}: best Eval {best:.4}");
             // Success needs Eval > 0.94; leave room for imperfect packing.
-            assert!(best > 0.95, "{letter}: even perfectly packed pucks reach only Eval {best:.4}");
+            assert!(
+                best > 0.95,
+                "{letter}: even perfectly packed pucks reach only Eval {best:.4}"
+            );
         }
     }
 

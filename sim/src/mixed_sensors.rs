@@ -21,7 +21,12 @@ pub struct MixedSensors<M> {
 impl<M: SensorModel> MixedSensors<M> {
     /// The three models' mix.
     pub fn new(field: M, pucks: M, obstacles: M) -> MixedSensors<M> {
-        MixedSensors { field, pucks, obstacles, scratch: Vec::new() }
+        MixedSensors {
+            field,
+            pucks,
+            obstacles,
+            scratch: Vec::new(),
+        }
     }
 }
 
@@ -59,7 +64,9 @@ impl<M: SensorModel> SensorModel for MixedSensors<M> {
         let mut rest = &memory.cameras[..];
         for part in [&mut self.field, &mut self.pucks, &mut self.obstacles] {
             let k = part.memory().cameras.len().min(rest.len());
-            part.restore(&SensorMemory { cameras: rest[..k].to_vec() });
+            part.restore(&SensorMemory {
+                cameras: rest[..k].to_vec(),
+            });
             rest = &rest[k..];
         }
     }

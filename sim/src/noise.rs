@@ -62,9 +62,17 @@ mod tests {
     #[test]
     fn the_same_place_draws_the_same_and_other_places_draw_otherwise() {
         let draw = |seed, purpose, a, b| normal(&mut stream(seed, purpose, a, b));
-        assert_eq!(draw(1, Purpose::Period, 5, 2), draw(1, Purpose::Period, 5, 2));
+        assert_eq!(
+            draw(1, Purpose::Period, 5, 2),
+            draw(1, Purpose::Period, 5, 2)
+        );
         let here = draw(1, Purpose::Period, 5, 2);
-        for other in [draw(2, Purpose::Period, 5, 2), draw(1, Purpose::Camera, 5, 2), draw(1, Purpose::Period, 6, 2), draw(1, Purpose::Period, 5, 3)] {
+        for other in [
+            draw(2, Purpose::Period, 5, 2),
+            draw(1, Purpose::Camera, 5, 2),
+            draw(1, Purpose::Period, 6, 2),
+            draw(1, Purpose::Period, 5, 3),
+        ] {
             assert_ne!(here, other);
         }
     }
@@ -76,12 +84,19 @@ mod tests {
         let xs: Vec<f64> = (0..n).map(|_| normal(&mut rng)).collect();
         let mean = xs.iter().sum::<f64>() / n as f64;
         let var = xs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n as f64;
-        assert!(mean.abs() < 0.01 && (var - 1.0).abs() < 0.02, "mean {mean}, variance {var}");
+        assert!(
+            mean.abs() < 0.01 && (var - 1.0).abs() < 0.02,
+            "mean {mean}, variance {var}"
+        );
         assert!(xs.iter().all(|x| x.abs() <= 6.0));
         let hits = (0..n).filter(|_| chance(&mut rng, 0.1)).count() as f64 / n as f64;
         assert!((hits - 0.1).abs() < 0.005, "{hits}");
         assert!(!chance(&mut rng, 0.0));
         let u: Vec<f64> = (0..1000).map(|_| symmetric(&mut rng, 0.5)).collect();
-        assert!(u.iter().all(|x| x.abs() <= 0.5) && u.iter().any(|x| *x < -0.4) && u.iter().any(|x| *x > 0.4));
+        assert!(
+            u.iter().all(|x| x.abs() <= 0.5)
+                && u.iter().any(|x| *x < -0.4)
+                && u.iter().any(|x| *x > 0.4)
+        );
     }
 }

@@ -50,7 +50,10 @@ pub fn panel_image(arena: &ArenaSpec, field: &ScalarField) -> GrayImage {
     let layout = arena.field_layout(field);
     let exponent = level_exponent(arena.display_gamma);
     GrayImage::from_fn(arena.screen_px[0], arena.screen_px[1], |i, j| {
-        Luma([level_of(field.shown(arena.panel_pixel_centre(i, j), &layout), exponent)])
+        Luma([level_of(
+            field.shown(arena.panel_pixel_centre(i, j), &layout),
+            exponent,
+        )])
     })
 }
 
@@ -72,7 +75,10 @@ mod tests {
             let v = f64::from(k) / 100.0;
             let level = f64::from(panel_level(v, 2.4));
             let light = |p: f64| (p / 255.0).powf(2.4);
-            assert!(light(level - 0.5) <= v.powf(2.2) && v.powf(2.2) <= light(level + 0.5), "{v}: level {level}");
+            assert!(
+                light(level - 0.5) <= v.powf(2.2) && v.powf(2.2) <= light(level + 0.5),
+                "{v}: level {level}"
+            );
         }
         assert_eq!(panel_level(0.5, 1.1), (255.0 * 0.25f64).round() as u8);
     }
@@ -83,7 +89,11 @@ mod tests {
         // covers the middle 4 x 4 pixels; each field pixel spans 2 x 2
         // panel pixels, so panel pixel centres lie a quarter of a field
         // pixel from its centre, interpolating towards the neighbour.
-        let arena = ArenaSpec { screen_mm: [80.0, 40.0], screen_px: [8, 4], ..ArenaSpec::tv75() };
+        let arena = ArenaSpec {
+            screen_mm: [80.0, 40.0],
+            screen_px: [8, 4],
+            ..ArenaSpec::tv75()
+        };
         let field = ScalarField::new(2, 2, vec![0.0, 1.0, 0.5, 1.0]).unwrap();
         let image = panel_image(&arena, &field);
         assert_eq!(image.dimensions(), (8, 4));
@@ -92,7 +102,10 @@ mod tests {
         assert_eq!(row(0), [0, 0, 0, 64, 191, 255, 0, 0]);
         // Row 1: a quarter of the way down to the bottom row (0.5, 1.0).
         assert_eq!(row(1), [0, 0, 32, 88, 199, 255, 0, 0]);
-        let stretched = ArenaSpec { fit: FieldFit::Stretch, ..arena };
+        let stretched = ArenaSpec {
+            fit: FieldFit::Stretch,
+            ..arena
+        };
         let image = panel_image(&stretched, &field);
         assert_eq!(image.get_pixel(0, 0)[0], 0);
         assert_eq!(image.get_pixel(7, 0)[0], 255);

@@ -27,11 +27,11 @@
 //! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
 //! identical inputs identically.
 
-use crate::validate::{check, ConfigError};
 use crate::field::{FieldLayout, ScalarField};
 use crate::rng::SimRng;
 use crate::robot_noise::RobotNoise;
 use crate::rounding;
+use crate::validate::{check, ConfigError};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
@@ -115,11 +115,18 @@ impl Default for PhotoSensorConfig {
     /// measured in simavr, 2.8 us (`docs/robot-sensors.md`).
     fn default() -> PhotoSensorConfig {
         let side = 65.0 * std::f64::consts::FRAC_1_SQRT_2;
-        let mount = |forward_mm, right_mm| MountPoint { forward_mm, right_mm };
+        let mount = |forward_mm, right_mm| MountPoint {
+            forward_mm,
+            right_mm,
+        };
         let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
         PhotoSensorConfig {
             mounts: [mount(side, -side), mount(65.0, 0.0), mount(side, side)],
-            response: [response(150.0, 1700.0), response(160.0, 1760.0), response(170.0, 1820.0)],
+            response: [
+                response(150.0, 1700.0),
+                response(160.0, 1760.0),
+                response(170.0, 1820.0),
+            ],
             gamma: f64::from(LIGHT_GAMMA),
             poll_latency_us: 2.8,
             ideal: false,
@@ -146,13 +153,33 @@ impl PhotoSensorConfig {
     /// Checks every position, time and the gamma; each sensor's bright and
     /// dark times must differ by at least one tick, or no calibration exists.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check("field.gamma", self.gamma, self.gamma > 0.0, "must be positive")?;
+        check(
+            "field.gamma",
+            self.gamma,
+            self.gamma > 0.0,
+            "must be positive",
+        )?;
         let latency = self.poll_latency_us;
-        check("field.poll_latency_us", latency, latency >= 0.0, "must not be negative")?;
+        check(
+            "field.poll_latency_us",
+            latency,
+            latency >= 0.0,
+            "must not be negative",
+        )?;
         for (i, name) in NAMES.iter().enumerate() {
             let m = self.mounts[i];
-            check(&format!("field.mounts[{i}].forward_mm ({name})"), m.forward_mm, true, "must be a finite number")?;
-            check(&format!("field.mounts[{i}].right_mm ({name})"), m.right_mm, true, "must be a finite number")?;
+            check(
+                &format!("field.mounts[{i}].forward_mm ({name})"),
+                m.forward_mm,
+                true,
+                "must be a finite number",
+            )?;
+            check(
+                &format!("field.mounts[{i}].right_mm ({name})"),
+                m.right_mm,
+                true,
+                "must be a finite number",
+            )?;
             let r = self.response[i];
             check(
                 &format!("field.response[{i}].bright_us ({name})"),
@@ -176,7 +203,10 @@ impl PhotoSensorConfig {
     pub fn calibration(&self) -> FieldCalibration {
         let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
         FieldCalibration {
-            ranges: self.response.map(|r| SensorRange { bright: ticks(r.bright_us), dark: ticks(r.dark_us) }),
+            ranges: self.response.map(|r| SensorRange {
+                bright: ticks(r.bright_us),
+                dark: ticks(r.dark_us),
+            }),
         }
     }
 }
@@ -212,7 +242,9 @@ impl PhotoSensors {
     pub fn new(config: &PhotoSensorConfig, unit_mm: f64) -> PhotoSensors {
         let calibration = config.calibration();
         PhotoSensors {
-            points: config.mounts.map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
+            points: config
+                .mounts
+                .map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
             response: config.response,
             gamma: config.gamma,
             latency_us: config.poll_latency_us,
@@ -257,13 +289,19 @@ impl PhotoSensors {
             r.discharge_us[i] = match noise.as_mut() {
                 None => self.response[i].discharge_us(shown[i], self.gamma),
                 Some(n) => {
-                    let light = shown[i].clamp(0.0, 1.0).powf(self.gamma) * RobotNoise::gain_at(n.grid, point, n.arena);
-                    n.noise.jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
+                    let light = shown[i].clamp(0.0, 1.0).powf(self.gamma)
+                        * RobotNoise::gain_at(n.grid, point, n.arena);
+                    n.noise
+                        .jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
                 }
             };
             r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
         }
-        r.values = if self.ideal { shown.map(|v| FieldValue::from_f32(v as f32)) } else { self.scales.values(&r.ticks) };
+        r.values = if self.ideal {
+            shown.map(|v| FieldValue::from_f32(v as f32))
+        } else {
+            self.scales.values(&r.ticks)
+        };
         r
     }
 }
@@ -274,7 +312,10 @@ mod tests {
     use crate::field::{FieldFrame, FieldSampling};
 
     /// A 100 x 100 arena, nearest cell.
-    const SQUARE_100: FieldLayout = FieldLayout { frame: FieldFrame::whole(100.0, 100.0), sampling: FieldSampling::Nearest };
+    const SQUARE_100: FieldLayout = FieldLayout {
+        frame: FieldFrame::whole(100.0, 100.0),
+        sampling: FieldSampling::Nearest,
+    };
 
     #[test]
     fn brighter_discharges_faster_between_the_calibrated_ends() {
@@ -311,7 +352,13 @@ mod tests {
         let config = PhotoSensorConfig::default();
         let cal = config.calibration();
         // (150 + 2.8) / 4 and (1700 + 2.8) / 4, floored.
-        assert_eq!(cal.ranges[0], SensorRange { bright: 38, dark: 425 });
+        assert_eq!(
+            cal.ranges[0],
+            SensorRange {
+                bright: 38,
+                dark: 425
+            }
+        );
         let sensors = PhotoSensors::new(&config, 5.0);
         let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
@@ -332,7 +379,13 @@ mod tests {
         let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 5.0);
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
-        let r = sensors.read(Vec2::new(24.0, 20.0), Vec2::new(0.0, 1.0), &field, &SQUARE_100, None);
+        let r = sensors.read(
+            Vec2::new(24.0, 20.0),
+            Vec2::new(0.0, 1.0),
+            &field,
+            &SQUARE_100,
+            None,
+        );
         let values = sensors.values(&r.ticks);
         assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
     }
@@ -343,8 +396,15 @@ mod tests {
         c.response[2].dark_us = c.response[2].bright_us + 1.0;
         let e = c.validate().unwrap_err().to_string();
         assert!(e.contains("field.response[2].dark_us (right)"), "{e}");
-        let c = PhotoSensorConfig { gamma: 0.0, ..PhotoSensorConfig::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("field.gamma"));
+        let c = PhotoSensorConfig {
+            gamma: 0.0,
+            ..PhotoSensorConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("field.gamma"));
         assert!(PhotoSensorConfig::default().validate().is_ok());
     }
 }

@@ -15,8 +15,8 @@ use crate::bitset::BitSet;
 use crate::body::{Body, Robot};
 use crate::broadphase::{Candidates, NeighbourIndex};
 use crate::config::PhysicsConfig;
-use crate::vec2::Vec2;
 use crate::rng::SimRng;
+use crate::vec2::Vec2;
 use rand::RngExt;
 
 /// What the other side of a contact is.
@@ -212,7 +212,11 @@ impl StepContext<'_> {
     fn record_wall(&mut self, body: u32, point: Vec2, velocity: Vec2) {
         self.bodies[body as usize].in_contact = true;
         self.scratch.live.insert(body as usize);
-        self.scratch.contacts.push(Contact::Wall { body, point, velocity });
+        self.scratch.contacts.push(Contact::Wall {
+            body,
+            point,
+            velocity,
+        });
     }
 
     /// The four border walls in a fixed order (top, right, bottom, left),
@@ -225,7 +229,12 @@ impl StepContext<'_> {
             return; // farther than `reach` from every wall: no contact possible
         }
         // (axis is x?, wall coordinate, inward normal)
-        let walls = [(false, 0.0, Vec2::new(0.0, 1.0)), (true, w, Vec2::new(-1.0, 0.0)), (false, h, Vec2::new(0.0, -1.0)), (true, 0.0, Vec2::new(1.0, 0.0))];
+        let walls = [
+            (false, 0.0, Vec2::new(0.0, 1.0)),
+            (true, w, Vec2::new(-1.0, 0.0)),
+            (false, h, Vec2::new(0.0, -1.0)),
+            (true, 0.0, Vec2::new(1.0, 0.0)),
+        ];
         for (vertical, at, inward) in walls {
             let b = self.bodies[i];
             let across = if vertical { b.pos.x - at } else { b.pos.y - at };
@@ -260,7 +269,15 @@ impl StepContext<'_> {
         let margin = CANDIDATE_MARGIN * self.max_radius;
         let threshold = self.config.overlap_threshold;
         let candidates = &mut self.scratch.candidates;
-        self.index.contact_candidates(self.bodies, i, None, self.max_radius, margin, threshold, candidates);
+        self.index.contact_candidates(
+            self.bodies,
+            i,
+            None,
+            self.max_radius,
+            margin,
+            threshold,
+            candidates,
+        );
         if candidates.as_slice().is_empty() {
             return;
         }
@@ -269,10 +286,20 @@ impl StepContext<'_> {
         while let Some(&j) = self.scratch.candidates.as_slice().get(k) {
             let j = j as usize;
             k += 1;
-            if self.separate(i, j) && (self.bodies[i].pos - anchor).length_squared() > margin * margin {
+            if self.separate(i, j)
+                && (self.bodies[i].pos - anchor).length_squared() > margin * margin
+            {
                 anchor = self.bodies[i].pos;
                 let candidates = &mut self.scratch.candidates;
-                self.index.contact_candidates(self.bodies, i, Some(j), self.max_radius, margin, threshold, candidates);
+                self.index.contact_candidates(
+                    self.bodies,
+                    i,
+                    Some(j),
+                    self.max_radius,
+                    margin,
+                    threshold,
+                    candidates,
+                );
                 k = 0;
             }
         }
@@ -290,7 +317,10 @@ impl StepContext<'_> {
             return false;
         }
         if d2 == 0.0 {
-            let nudge = Vec2::new(self.rng.random_range(-1.0..1.0), self.rng.random_range(-1.0..1.0));
+            let nudge = Vec2::new(
+                self.rng.random_range(-1.0..1.0),
+                self.rng.random_range(-1.0..1.0),
+            );
             self.bodies[j].pos += nudge;
             self.relocated(j);
             delta = self.bodies[j].pos - self.bodies[i].pos;
@@ -316,7 +346,10 @@ impl StepContext<'_> {
     fn clamp(&mut self, i: usize) {
         let b = &mut self.bodies[i];
         let r = b.radius;
-        let clamped = Vec2::new(b.pos.x.clamp(r, self.arena.x - r), b.pos.y.clamp(r, self.arena.y - r));
+        let clamped = Vec2::new(
+            b.pos.x.clamp(r, self.arena.x - r),
+            b.pos.y.clamp(r, self.arena.y - r),
+        );
         if clamped != b.pos {
             b.pos = clamped;
             self.relocated(i);
@@ -340,9 +373,17 @@ impl StepContext<'_> {
                     self.bodies[a].vel = x.vel;
                     self.bodies[b].vel = y.vel;
                 }
-                Contact::Wall { body, point, velocity } => {
+                Contact::Wall {
+                    body,
+                    point,
+                    velocity,
+                } => {
                     let b = &mut self.bodies[body as usize];
-                    let mut wall = Body { pos: point, vel: velocity, ..*b };
+                    let mut wall = Body {
+                        pos: point,
+                        vel: velocity,
+                        ..*b
+                    };
                     elastic_impulse(b, &mut wall);
                 }
             }

@@ -108,10 +108,23 @@ impl Default for PixyCameraConfig {
 impl PixyCameraConfig {
     /// Checks the pose, field of view, heights and range.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check("camera.forward_mm", self.forward_mm, true, "must be a finite number")?;
+        check(
+            "camera.forward_mm",
+            self.forward_mm,
+            true,
+            "must be a finite number",
+        )?;
         positive("camera.height_mm", self.height_mm)?;
-        for (name, fov) in [("camera.fov_h_deg", self.fov_h_deg), ("camera.fov_v_deg", self.fov_v_deg)] {
-            check(name, fov, fov > 0.0 && fov < 180.0, "must be between 0 and 180 degrees")?;
+        for (name, fov) in [
+            ("camera.fov_h_deg", self.fov_h_deg),
+            ("camera.fov_v_deg", self.fov_v_deg),
+        ] {
+            check(
+                name,
+                fov,
+                fov > 0.0 && fov < 180.0,
+                "must be between 0 and 180 degrees",
+            )?;
         }
         let half = self.fov_v_deg / 2.0;
         check(
@@ -124,7 +137,12 @@ impl PixyCameraConfig {
         positive("camera.robot_height_mm", self.robot_height_mm)?;
         positive("camera.max_range_mm", self.max_range_mm)?;
         let l = f64::from(self.latency_frames);
-        check("camera.latency_frames", l, self.latency_frames <= 1, "must be 0 or 1")
+        check(
+            "camera.latency_frames",
+            l,
+            self.latency_frames <= 1,
+            "must be 0 or 1",
+        )
     }
 }
 
@@ -208,17 +226,33 @@ impl Rect {
             return;
         }
         if self.top < cut.top {
-            out.push(Rect { bottom: cut.top - 1, ..*self });
+            out.push(Rect {
+                bottom: cut.top - 1,
+                ..*self
+            });
         }
         if self.bottom > cut.bottom {
-            out.push(Rect { top: cut.bottom + 1, ..*self });
+            out.push(Rect {
+                top: cut.bottom + 1,
+                ..*self
+            });
         }
         let (top, bottom) = (self.top.max(cut.top), self.bottom.min(cut.bottom));
         if self.left < cut.left {
-            out.push(Rect { top, bottom, right: cut.left - 1, ..*self });
+            out.push(Rect {
+                top,
+                bottom,
+                right: cut.left - 1,
+                ..*self
+            });
         }
         if self.right > cut.right {
-            out.push(Rect { top, bottom, left: cut.right + 1, ..*self });
+            out.push(Rect {
+                top,
+                bottom,
+                left: cut.right + 1,
+                ..*self
+            });
         }
     }
 }
@@ -254,7 +288,11 @@ impl Blob {
 
     /// The two as one blob: the union of their boxes, the sum of their pixels.
     fn merged(&self, o: &Blob) -> Blob {
-        Blob { signature: self.signature, rect: self.rect.union(&o.rect), area: self.area + o.area }
+        Blob {
+            signature: self.signature,
+            rect: self.rect.union(&o.rect),
+            area: self.area + o.area,
+        }
     }
 }
 
@@ -336,8 +374,9 @@ impl PixyCamera {
         let tilt = config.tilt_deg.to_radians();
         let half_h = (config.fov_h_deg / 2.0).to_radians();
         let half_v = (config.fov_v_deg / 2.0).to_radians();
-        let rim: [Vec2; RIM_POINTS] =
-            std::array::from_fn(|k| Vec2::from_angle(std::f64::consts::TAU * k as f64 / RIM_POINTS as f64));
+        let rim: [Vec2; RIM_POINTS] = std::array::from_fn(|k| {
+            Vec2::from_angle(std::f64::consts::TAU * k as f64 / RIM_POINTS as f64)
+        });
         PixyCamera {
             forward: config.forward_mm / unit_mm,
             height: config.height_mm / unit_mm,
@@ -358,7 +397,8 @@ impl PixyCamera {
             classify: config.classify,
             rim_ahead: rim.map(|p| p.x),
             rim_right: rim.map(|p| p.y),
-            rim_back: (0..RIM_POINTS).fold(0, |back, k| if rim[k].x < rim[back].x { k } else { back }),
+            rim_back: (0..RIM_POINTS)
+                .fold(0, |back, k| if rim[k].x < rim[back].x { k } else { back }),
             in_view: Vec::new(),
             cuts: Vec::new(),
             pieces: Vec::new(),
@@ -394,7 +434,9 @@ impl PixyCamera {
         in_view.clear();
         world.any_body_in_box(min, max, |row| {
             for b in row {
-                let Some(c) = self.candidate(world.robots().len(), robot, &lens, b) else { continue };
+                let Some(c) = self.candidate(world.robots().len(), robot, &lens, b) else {
+                    continue;
+                };
                 if let Some(rect) = self.silhouette(c.ahead, c.side, c.radius, c.height) {
                     in_view.push(c.in_view(rect));
                 }
@@ -428,13 +470,23 @@ impl PixyCamera {
         let reach = self.max_range + max_radius;
         let radius = reach + behind;
         let pad = radius * 1e-6;
-        let (min, max) = (|a: f64, b: f64| if a < b { a } else { b }, |a: f64, b: f64| if a > b { a } else { b });
+        let (min, max) = (
+            |a: f64, b: f64| if a < b { a } else { b },
+            |a: f64, b: f64| if a > b { a } else { b },
+        );
         // The cone's corners where the culls' `ahead >= -r` cuts it, and
         // where its edges meet the arc.
         let back = lens.pos - lens.ahead * max_radius;
         let half_width = (self.height + tallest) * self.tan_half_h + max_radius;
-        let edge = |sign: f64| apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius;
-        let corners = [back + lens.right * half_width, back - lens.right * half_width, edge(1.0), edge(-1.0)];
+        let edge = |sign: f64| {
+            apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius
+        };
+        let corners = [
+            back + lens.right * half_width,
+            back - lens.right * half_width,
+            edge(1.0),
+            edge(-1.0),
+        ];
         let mut low = corners[0];
         let mut high = corners[0];
         for p in &corners[1..] {
@@ -469,7 +521,13 @@ impl PixyCamera {
     /// whose bodies come first) and the cheap culls before projecting keep
     /// it: not behind the lens, not far outside the horizontal field of
     /// view, in range.
-    fn candidate(&self, robots: usize, robot: usize, lens: &Lens, b: &Neighbour) -> Option<Candidate> {
+    fn candidate(
+        &self,
+        robots: usize,
+        robot: usize,
+        lens: &Lens,
+        b: &Neighbour,
+    ) -> Option<Candidate> {
         let index = b.body as usize;
         if index == robot {
             return None;
@@ -526,7 +584,12 @@ impl PixyCamera {
         for k in 0..self.in_view.len() {
             let body = self.in_view[k];
             self.cuts.clear();
-            self.cuts.extend(self.in_view[..k].iter().filter(|n| n.rect.overlaps(&body.rect)).map(|n| n.rect));
+            self.cuts.extend(
+                self.in_view[..k]
+                    .iter()
+                    .filter(|n| n.rect.overlaps(&body.rect))
+                    .map(|n| n.rect),
+            );
             let visible = match self.cuts[..] {
                 [] => Some((body.rect, body.rect.area())),
                 [cut] => body.rect.without(&cut),
@@ -534,7 +597,11 @@ impl PixyCamera {
             };
             if let Some((rect, area)) = visible {
                 if area >= self.min_area {
-                    self.blobs.push(Blob { signature: body.signature, rect, area });
+                    self.blobs.push(Blob {
+                        signature: body.signature,
+                        rect,
+                        area,
+                    });
                 }
             }
         }
@@ -556,7 +623,10 @@ impl PixyCamera {
             }
         }
         let first = self.pieces[0];
-        Some((self.pieces.iter().fold(first, |r, p| r.union(p)), self.pieces.iter().map(Rect::area).sum()))
+        Some((
+            self.pieces.iter().fold(first, |r, p| r.union(p)),
+            self.pieces.iter().map(Rect::area).sum(),
+        ))
     }
 
     /// Stage 3, first half: merges close blobs of one signature until no two
@@ -580,7 +650,8 @@ impl PixyCamera {
                 // Not grown: no other group comes any closer.
                 continue;
             }
-            while let Some(other) = (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
+            while let Some(other) =
+                (0..groups.len()).find(|&g| g != grown && groups[g].merges_with(&groups[grown], d))
             {
                 let (kept, absorbed) = (grown.min(other), grown.max(other));
                 groups[kept] = groups[kept].merged(&groups[absorbed]);
@@ -598,10 +669,16 @@ impl PixyCamera {
     fn drop_enclosed_blobs(&mut self) {
         let blobs = &self.blobs;
         let encloses = |o: usize, k: usize| {
-            o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k)
+            o != k
+                && blobs[o].rect.contains(&blobs[k].rect)
+                && (blobs[o].rect != blobs[k].rect || o < k)
         };
         self.merged.clear();
-        self.merged.extend((0..blobs.len()).filter(|&k| !(0..blobs.len()).any(|o| encloses(o, k))).map(|k| blobs[k]));
+        self.merged.extend(
+            (0..blobs.len())
+                .filter(|&k| !(0..blobs.len()).any(|o| encloses(o, k)))
+                .map(|k| blobs[k]),
+        );
         std::mem::swap(&mut self.blobs, &mut self.merged);
     }
 
@@ -624,11 +701,18 @@ impl PixyCamera {
                 .enumerate()
                 .filter_map(|(i, b)| {
                     // Blobs are grouped by signature: count within the group.
-                    kept = if i > 0 && self.blobs[i - 1].signature == b.signature { kept + 1 } else { 1 };
+                    kept = if i > 0 && self.blobs[i - 1].signature == b.signature {
+                        kept + 1
+                    } else {
+                        1
+                    };
                     (kept <= per_signature).then_some(b)
                 })
                 .map(|b| {
-                    let (width, height) = ((b.rect.right - b.rect.left) as u16, (b.rect.bottom - b.rect.top) as u16);
+                    let (width, height) = (
+                        (b.rect.right - b.rect.left) as u16,
+                        (b.rect.bottom - b.rect.top) as u16,
+                    );
                     PixyBlock {
                         signature: b.signature,
                         x: b.rect.left as u16 + width / 2,
@@ -646,14 +730,23 @@ impl Lens {
     /// Robot `robot`'s lens, `forward` ahead of its centre.
     fn of(world: &World, robot: usize, forward: f64) -> Lens {
         let ahead = world.robots()[robot].direction;
-        Lens { pos: world.bodies()[robot].pos + ahead * forward, ahead, right: Vec2::new(-ahead.y, ahead.x) }
+        Lens {
+            pos: world.bodies()[robot].pos + ahead * forward,
+            ahead,
+            right: Vec2::new(-ahead.y, ahead.x),
+        }
     }
 }
 
 impl Candidate {
     /// The candidate in view with silhouette `rect`.
     fn in_view(&self, rect: Rect) -> InView {
-        InView { distance: self.distance_squared.sqrt(), index: self.index as u32, signature: self.signature, rect }
+        InView {
+            distance: self.distance_squared.sqrt(),
+            index: self.index as u32,
+            signature: self.signature,
+            rect,
+        }
     }
 }
 
@@ -666,7 +759,8 @@ fn sort_nearest_first(in_view: &mut [InView]) {
         // No distance is NaN.
         while k > 0 && {
             let nearer = &in_view[k - 1];
-            body.distance < nearer.distance || (body.distance == nearer.distance && body.index < nearer.index)
+            body.distance < nearer.distance
+                || (body.distance == nearer.distance && body.index < nearer.index)
         } {
             in_view[k] = in_view[k - 1];
             k -= 1;
@@ -780,7 +874,11 @@ fn last_pixel(v: f64, end: u16) -> i32 {
         return -1;
     }
     let whole = v as i32;
-    let ceil_less_one = if f64::from(whole) < v { whole } else { whole - 1 };
+    let ceil_less_one = if f64::from(whole) < v {
+        whole
+    } else {
+        whole - 1
+    };
     ceil_less_one.min(i32::from(end) - 1)
 }
 
@@ -805,7 +903,11 @@ mod tests {
         frame_with(&PixyCameraConfig::default(), robots, pucks)
     }
 
-    fn frame_with(camera: &PixyCameraConfig, robots: &[(f64, f64)], pucks: &[(f64, f64)]) -> Vec<PixyBlock> {
+    fn frame_with(
+        camera: &PixyCameraConfig,
+        robots: &[(f64, f64)],
+        pucks: &[(f64, f64)],
+    ) -> Vec<PixyBlock> {
         let mut config = SimConfig::default();
         config.world.robots = 1 + robots.len();
         config.world.pucks = pucks.len();
@@ -827,7 +929,10 @@ mod tests {
         let b = blocks[0];
         assert_eq!(b.signature, 1);
         assert!(b.x.abs_diff(160) <= 1, "{b:?}");
-        assert!(b.y >= 100, "a puck 3 radii ahead is in the lower half: {b:?}");
+        assert!(
+            b.y >= 100,
+            "a puck 3 radii ahead is in the lower half: {b:?}"
+        );
         let s = CameraConfig::DEFAULT.classify(&blocks);
         assert!(s.puck_left && s.puck_right, "ahead is on both sides");
     }
@@ -844,12 +949,18 @@ mod tests {
     #[test]
     fn the_field_of_view_is_75_degrees_so_the_thesis_side_discs_are_blind() {
         // The thesis' outer puck disc at 60 degrees, 7 radii: outside +-37.5.
-        let (f, s) = (7.0 * 60f64.to_radians().cos(), 7.0 * 60f64.to_radians().sin());
+        let (f, s) = (
+            7.0 * 60f64.to_radians().cos(),
+            7.0 * 60f64.to_radians().sin(),
+        );
         assert!(frame_of(&[], &[(f, s), (f, -s)]).is_empty());
         // Behind the robot: nothing.
         assert!(frame_of(&[], &[(-4.0, 0.0)]).is_empty());
         // At 30 degrees it is seen.
-        let (f, s) = (7.0 * 30f64.to_radians().cos(), 7.0 * 30f64.to_radians().sin());
+        let (f, s) = (
+            7.0 * 30f64.to_radians().cos(),
+            7.0 * 30f64.to_radians().sin(),
+        );
         assert_eq!(frame_of(&[], &[(f, s)]).len(), 1);
     }
 
@@ -859,21 +970,40 @@ mod tests {
         let sigs: Vec<u16> = blocks.iter().map(|b| b.signature).collect();
         assert_eq!(sigs, [1, 1, 2], "{blocks:?}");
         assert!(blocks[0].width * blocks[0].height > blocks[1].width * blocks[1].height);
-        let halves = ImageRegion { x_min: 160, x_max: 319, y_min: 100, y_max: 199 };
-        let s = CameraConfig { obstacle_right: halves, ..CameraConfig::DEFAULT }.classify(&blocks);
+        let halves = ImageRegion {
+            x_min: 160,
+            x_max: 319,
+            y_min: 100,
+            y_max: 199,
+        };
+        let s = CameraConfig {
+            obstacle_right: halves,
+            ..CameraConfig::DEFAULT
+        }
+        .classify(&blocks);
         assert!(s.obstacle_right && !s.obstacle_left);
     }
 
     #[test]
     fn a_puck_hidden_behind_a_robot_is_not_seen_and_small_far_ones_are_dropped() {
         let blocks = frame_of(&[(3.0, 0.0)], &[(6.0, 0.0)]);
-        assert_eq!(blocks.iter().map(|b| b.signature).collect::<Vec<_>>(), [2], "{blocks:?}");
+        assert_eq!(
+            blocks.iter().map(|b| b.signature).collect::<Vec<_>>(),
+            [2],
+            "{blocks:?}"
+        );
         // The range ends at 25 radii; far blocks are small and high in the image.
         let far = frame_of(&[], &[(24.0, 0.0)]);
-        assert!(far.len() == 1 && far[0].y < 100 && far[0].width * far[0].height < 200, "{far:?}");
+        assert!(
+            far.len() == 1 && far[0].y < 100 && far[0].width * far[0].height < 200,
+            "{far:?}"
+        );
         assert!(frame_of(&[], &[(27.0, 0.0)]).is_empty());
         // Blobs under the minimum area are dropped.
-        let strict = PixyCameraConfig { min_area: 200, ..PixyCameraConfig::default() };
+        let strict = PixyCameraConfig {
+            min_area: 200,
+            ..PixyCameraConfig::default()
+        };
         assert!(frame_with(&strict, &[], &[(24.0, 0.0)]).is_empty());
     }
 
@@ -883,9 +1013,15 @@ mod tests {
         let blocks = frame_of(&[(10.0, 5.0)], &pucks);
         let sigs: Vec<u16> = blocks.iter().map(|b| b.signature).collect();
         assert_eq!(sigs, [1, 1, 2], "{blocks:?}");
-        let all = PixyCameraConfig { max_blocks_per_signature: 10, ..PixyCameraConfig::default() };
+        let all = PixyCameraConfig {
+            max_blocks_per_signature: 10,
+            ..PixyCameraConfig::default()
+        };
         let blocks = frame_with(&all, &[(10.0, 5.0)], &pucks);
-        assert!(blocks.iter().filter(|b| b.signature == 1).count() > 2, "{blocks:?}");
+        assert!(
+            blocks.iter().filter(|b| b.signature == 1).count() > 2,
+            "{blocks:?}"
+        );
         assert_eq!(blocks.last().map(|b| b.signature), Some(2));
     }
 
@@ -898,8 +1034,18 @@ mod tests {
 
     #[test]
     fn rectangle_subtraction_keeps_exactly_the_uncovered_pixels() {
-        let a = Rect { left: 0, top: 0, right: 9, bottom: 9 };
-        let cut = Rect { left: 3, top: 4, right: 5, bottom: 20 };
+        let a = Rect {
+            left: 0,
+            top: 0,
+            right: 9,
+            bottom: 9,
+        };
+        let cut = Rect {
+            left: 3,
+            top: 4,
+            right: 5,
+            bottom: 20,
+        };
         let mut out = Vec::new();
         a.subtract_into(&cut, &mut out);
         assert_eq!(out.iter().map(Rect::area).sum::<u32>(), 100 - 3 * 6);
@@ -910,18 +1056,31 @@ mod tests {
 
     #[test]
     fn one_cut_leaves_the_box_and_pixels_of_the_pieces_it_leaves() {
-        let a = Rect { left: 2, top: 3, right: 6, bottom: 7 };
+        let a = Rect {
+            left: 2,
+            top: 3,
+            right: 6,
+            bottom: 7,
+        };
         let spans = |lo: i32, hi: i32| (lo..=hi).flat_map(move |l| (l..=hi).map(move |r| (l, r)));
         for (left, right) in spans(0, 8) {
             for (top, bottom) in spans(1, 9) {
-                let cut = Rect { left, top, right, bottom };
+                let cut = Rect {
+                    left,
+                    top,
+                    right,
+                    bottom,
+                };
                 if !a.overlaps(&cut) {
                     continue;
                 }
                 let mut pieces = Vec::new();
                 a.subtract_into(&cut, &mut pieces);
                 let expected = pieces.first().map(|&first| {
-                    (pieces.iter().fold(first, |r, p| r.union(p)), pieces.iter().map(Rect::area).sum())
+                    (
+                        pieces.iter().fold(first, |r, p| r.union(p)),
+                        pieces.iter().map(Rect::area).sum(),
+                    )
                 });
                 assert_eq!(a.without(&cut), expected, "{cut:?}");
             }
@@ -930,10 +1089,24 @@ mod tests {
 
     #[test]
     fn bad_poses_are_named() {
-        let c = PixyCameraConfig { tilt_deg: 70.0, ..PixyCameraConfig::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("camera.tilt_deg"));
-        let c = PixyCameraConfig { height_mm: -1.0, ..PixyCameraConfig::default() };
-        assert!(c.validate().unwrap_err().to_string().contains("camera.height_mm"));
+        let c = PixyCameraConfig {
+            tilt_deg: 70.0,
+            ..PixyCameraConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("camera.tilt_deg"));
+        let c = PixyCameraConfig {
+            height_mm: -1.0,
+            ..PixyCameraConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("camera.height_mm"));
         assert!(PixyCameraConfig::default().validate().is_ok());
     }
 
@@ -944,8 +1117,16 @@ mod tests {
         let d = PixyCameraConfig::default;
         vec![
             d(),
-            PixyCameraConfig { max_blocks_per_signature: 100, ..d() },
-            PixyCameraConfig { max_blocks_per_signature: 100, min_area: 1, merge_distance: 0, ..d() },
+            PixyCameraConfig {
+                max_blocks_per_signature: 100,
+                ..d()
+            },
+            PixyCameraConfig {
+                max_blocks_per_signature: 100,
+                min_area: 1,
+                merge_distance: 0,
+                ..d()
+            },
             PixyCameraConfig {
                 max_blocks_per_signature: 100,
                 fov_h_deg: 120.0,
@@ -953,9 +1134,24 @@ mod tests {
                 merge_distance: 12,
                 ..d()
             },
-            PixyCameraConfig { tilt_deg: -10.0, fov_v_deg: 40.0, forward_mm: 40.0, height_mm: 30.0, ..d() },
-            PixyCameraConfig { tilt_deg: 45.0, fov_v_deg: 60.0, fov_h_deg: 50.0, ..d() },
-            PixyCameraConfig { max_range_mm: 400.0, max_blocks_per_signature: 100, ..d() },
+            PixyCameraConfig {
+                tilt_deg: -10.0,
+                fov_v_deg: 40.0,
+                forward_mm: 40.0,
+                height_mm: 30.0,
+                ..d()
+            },
+            PixyCameraConfig {
+                tilt_deg: 45.0,
+                fov_v_deg: 60.0,
+                fov_h_deg: 50.0,
+                ..d()
+            },
+            PixyCameraConfig {
+                max_range_mm: 400.0,
+                max_blocks_per_signature: 100,
+                ..d()
+            },
         ]
     }
 
@@ -978,9 +1174,15 @@ mod tests {
         let range = camera.max_range_mm / w.unit_mm;
         let half_h = (camera.fov_h_deg / 2.0).to_radians();
         let inside = |p: Vec2| {
-            Vec2::new(p.x.clamp(robot_r, w.arena_width - robot_r), p.y.clamp(robot_r, w.arena_height - robot_r))
+            Vec2::new(
+                p.x.clamp(robot_r, w.arena_width - robot_r),
+                p.y.clamp(robot_r, w.arena_height - robot_r),
+            )
         };
-        let me = inside(Vec2::new(rng.random_range(0.0..w.arena_width), rng.random_range(0.0..w.arena_height)));
+        let me = inside(Vec2::new(
+            rng.random_range(0.0..w.arena_width),
+            rng.random_range(0.0..w.arena_height),
+        ));
         // Headings along the axes too, where the search box is tightest.
         let quarter = std::f64::consts::FRAC_PI_2;
         let heading = if seed % 3 == 0 {
@@ -988,7 +1190,8 @@ mod tests {
         } else {
             rng.random_range(-2.0 * quarter..2.0 * quarter)
         };
-        let around = |distance: f64, angle: f64| inside(me + Vec2::from_angle(heading + angle) * distance);
+        let around =
+            |distance: f64, angle: f64| inside(me + Vec2::from_angle(heading + angle) * distance);
         let mut robots = vec![(me, heading, RobotKind::Outie)];
         let mut pucks = Vec::new();
         for _ in 0..rng.random_range(1..5) {
@@ -1000,19 +1203,33 @@ mod tests {
             }
         }
         for _ in 0..rng.random_range(1..6) {
-            let p = around(rng.random_range(2.0 * robot_r..0.6 * range), rng.random_range(-1.5..1.5));
-            let next = inside(p + Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * 2.05 * robot_r);
+            let p = around(
+                rng.random_range(2.0 * robot_r..0.6 * range),
+                rng.random_range(-1.5..1.5),
+            );
+            let next = inside(
+                p + Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU)) * 2.05 * robot_r,
+            );
             for q in [p, next] {
-                robots.push((q, rng.random_range(-std::f64::consts::PI..std::f64::consts::PI), RobotKind::Outie));
+                robots.push((
+                    q,
+                    rng.random_range(-std::f64::consts::PI..std::f64::consts::PI),
+                    RobotKind::Outie,
+                ));
             }
         }
         for _ in 0..rng.random_range(2..8) {
-            let edge_of_range =
-                around(range + rng.random_range(-2.0 * puck_r..2.0 * puck_r), rng.random_range(-half_h..half_h));
+            let edge_of_range = around(
+                range + rng.random_range(-2.0 * puck_r..2.0 * puck_r),
+                rng.random_range(-half_h..half_h),
+            );
             let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
             let angle = side * (half_h + rng.random_range(-0.15..0.25));
             let edge_of_view = around(rng.random_range(0.0..range), angle);
-            let at_lens = around(rng.random_range(robot_r..robot_r + 3.0 * puck_r), rng.random_range(-1.6..1.6));
+            let at_lens = around(
+                rng.random_range(robot_r..robot_r + 3.0 * puck_r),
+                rng.random_range(-1.6..1.6),
+            );
             pucks.extend([edge_of_range, edge_of_view, at_lens]);
         }
         World::scene(config, &robots, &pucks, seed)
@@ -1045,7 +1262,10 @@ mod tests {
                 let mut camera = PixyCamera::new(settings, config.world.unit_mm);
                 for seed in 0..150 {
                     let world = random_scene(&config, settings, seed);
-                    let what = format!("unit {} mm, camera {variant}, seed {seed}", config.world.unit_mm);
+                    let what = format!(
+                        "unit {} mm, camera {variant}, seed {seed}",
+                        config.world.unit_mm
+                    );
                     blocks += assert_reference_frames(&mut camera, &world, &what);
                 }
             }
@@ -1060,12 +1280,20 @@ mod tests {
             let sensors = crate::RobotSensors::new(&crate::RobotSensorConfig::default(), unit);
             let field = Arc::new(crate::ScalarField::annulus_of(64, 36));
             let mut sim = crate::Simulation::with_sensors(config, field, sensors, 3).unwrap();
-            let mut controller = crate::controllers::RandomTurns::new(shared::ActionTable::default());
-            let every_block = PixyCameraConfig { max_blocks_per_signature: 100, ..PixyCameraConfig::default() };
+            let mut controller =
+                crate::controllers::RandomTurns::new(shared::ActionTable::default());
+            let every_block = PixyCameraConfig {
+                max_blocks_per_signature: 100,
+                ..PixyCameraConfig::default()
+            };
             let mut camera = PixyCamera::new(&every_block, unit);
             for step in 0..600 {
                 sim.run(&mut controller, 1);
-                assert_reference_frames(&mut camera, sim.world(), &format!("unit {unit} mm, step {step}"));
+                assert_reference_frames(
+                    &mut camera,
+                    sim.world(),
+                    &format!("unit {unit} mm, step {step}"),
+                );
             }
         }
     }
@@ -1078,8 +1306,11 @@ mod tests {
             let (robot_r, puck_r) = (10.0, 8.0);
             for pose in 0..400 {
                 let quarter = std::f64::consts::FRAC_PI_2;
-                let heading =
-                    if pose % 2 == 0 { quarter * f64::from(pose / 2 % 4) } else { rng.random_range(-4.0..4.0) };
+                let heading = if pose % 2 == 0 {
+                    quarter * f64::from(pose / 2 % 4)
+                } else {
+                    rng.random_range(-4.0..4.0)
+                };
                 let ahead = Vec2::from_angle(heading);
                 let lens = Lens {
                     pos: Vec2::new(rng.random_range(0.0..800.0), rng.random_range(0.0..800.0)),
@@ -1088,8 +1319,16 @@ mod tests {
                 };
                 let (min, max) = camera.search_box(&lens, robot_r);
                 for k in 0..2000 {
-                    let (radius, body) = if k % 2 == 0 { (robot_r, 1) } else { (puck_r, 2) };
-                    let height = if body == 1 { camera.robot_height } else { camera.puck_height };
+                    let (radius, body) = if k % 2 == 0 {
+                        (robot_r, 1)
+                    } else {
+                        (puck_r, 2)
+                    };
+                    let height = if body == 1 {
+                        camera.robot_height
+                    } else {
+                        camera.puck_height
+                    };
                     let reach = camera.max_range + radius;
                     // On the range's circle, on the widened cone's edges, or anywhere near.
                     let (f, s) = match k % 3 {
@@ -1099,15 +1338,20 @@ mod tests {
                         }
                         1 => {
                             let f = rng.random_range(-radius..reach);
-                            let side = (f + radius + camera.height + height) * camera.tan_half_h + radius;
+                            let side =
+                                (f + radius + camera.height + height) * camera.tan_half_h + radius;
                             (f, if k % 4 == 1 { side } else { -side })
                         }
-                        _ => (rng.random_range(-reach..reach), rng.random_range(-reach..reach)),
+                        _ => (
+                            rng.random_range(-reach..reach),
+                            rng.random_range(-reach..reach),
+                        ),
                     };
                     let pos = lens.pos + lens.ahead * f + lens.right * s;
                     let b = Neighbour { pos, radius, body };
                     if camera.candidate(2, 0, &lens, &b).is_some() {
-                        let inside = min.x <= pos.x && pos.x <= max.x && min.y <= pos.y && pos.y <= max.y;
+                        let inside =
+                            min.x <= pos.x && pos.x <= max.x && min.y <= pos.y && pos.y <= max.y;
                         assert!(inside, "{settings:?}: {pos:?} outside {min:?} ..= {max:?}");
                     }
                 }

@@ -26,8 +26,12 @@ pub enum PolicyFileError {
 impl fmt::Display for PolicyFileError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PolicyFileError::Read { path, reason } => write!(f, "cannot read policy file {}: {reason}", path.display()),
-            PolicyFileError::Blob { path, reason } => write!(f, "policy file {}: {reason}", path.display()),
+            PolicyFileError::Read { path, reason } => {
+                write!(f, "cannot read policy file {}: {reason}", path.display())
+            }
+            PolicyFileError::Blob { path, reason } => {
+                write!(f, "policy file {}: {reason}", path.display())
+            }
         }
     }
 }
@@ -36,12 +40,18 @@ impl std::error::Error for PolicyFileError {}
 
 /// Reads and decodes a policy blob file.
 pub fn read(path: &Path) -> Result<PolicyBlob, PolicyFileError> {
-    let bytes = std::fs::read(path).map_err(|reason| PolicyFileError::Read { path: path.to_path_buf(), reason })?;
+    let bytes = std::fs::read(path).map_err(|reason| PolicyFileError::Read {
+        path: path.to_path_buf(),
+        reason,
+    })?;
     decode(path, &bytes)
 }
 
 /// Decodes the bytes of the policy file `path` (already read, for callers
 /// that look at them first).
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<PolicyBlob, PolicyFileError> {
-    PolicyBlob::decode(bytes).map_err(|reason| PolicyFileError::Blob { path: path.to_path_buf(), reason })
+    PolicyBlob::decode(bytes).map_err(|reason| PolicyFileError::Blob {
+        path: path.to_path_buf(),
+        reason,
+    })
 }

@@ -30,7 +30,10 @@ pub struct RenderOptions {
 impl Default for RenderOptions {
     /// 800 pixels, no footprints.
     fn default() -> RenderOptions {
-        RenderOptions { size: 800, footprints: false }
+        RenderOptions {
+            size: 800,
+            footprints: false,
+        }
     }
 }
 

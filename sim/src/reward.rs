@@ -29,7 +29,12 @@ pub enum Reward {
 
 impl Reward {
     /// Every variant, for help texts and sweeps.
-    pub const ALL: [Reward; 4] = [Reward::Reference, Reward::Thesis, Reward::Collision, Reward::CollisionSpread];
+    pub const ALL: [Reward; 4] = [
+        Reward::Reference,
+        Reward::Thesis,
+        Reward::Collision,
+        Reward::CollisionSpread,
+    ];
 
     /// The CLI / config name.
     pub fn name(self) -> &'static str {
@@ -43,7 +48,13 @@ impl Reward {
 
     /// The signal whose change is rewarded, measured on `world`: Eval (pass
     /// it as `eval` when already computed) or Eval'.
-    pub fn signal(self, world: &World, field: &ScalarField, config: &SimConfig, eval: Option<f64>) -> f64 {
+    pub fn signal(
+        self,
+        world: &World,
+        field: &ScalarField,
+        config: &SimConfig,
+        eval: Option<f64>,
+    ) -> f64 {
         let variant = match self {
             Reward::Reference | Reward::Thesis => {
                 return eval.unwrap_or_else(|| eval::eval(world, field, &config.thresholds))
@@ -51,7 +62,14 @@ impl Reward {
             Reward::Collision => EvalPrime::AsWritten,
             Reward::CollisionSpread => EvalPrime::Spread,
         };
-        eval_prime(world, field, &config.thresholds, variant, config.episode.phi, config.episode.nu)
+        eval_prime(
+            world,
+            field,
+            &config.thresholds,
+            variant,
+            config.episode.phi,
+            config.episode.nu,
+        )
     }
 
     /// The reward for a change of signal from `before` to `after`.

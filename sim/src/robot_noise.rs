@@ -7,8 +7,8 @@
 //! and the robot.
 
 use crate::noise::{self, Purpose};
-use crate::rounding::round_half_away;
 use crate::rng::SimRng;
+use crate::rounding::round_half_away;
 use crate::validate::{check, ConfigError};
 use crate::vec2::Vec2;
 use serde::{Deserialize, Serialize};
@@ -88,15 +88,32 @@ impl RobotNoise {
     /// Checks every amount; the error names the setting.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let j = self.rc_jitter;
-        check("noise.rc_jitter", j, (0.0..0.15).contains(&j), "must be in [0, 0.15)")?;
+        check(
+            "noise.rc_jitter",
+            j,
+            (0.0..0.15).contains(&j),
+            "must be in [0, 0.15)",
+        )?;
         let b = self.brightness;
-        check("noise.brightness", b, (0.0..0.15).contains(&b), "must be in [0, 0.15)")?;
+        check(
+            "noise.brightness",
+            b,
+            (0.0..0.15).contains(&b),
+            "must be in [0, 0.15)",
+        )?;
         let p = self.block_jitter_px;
         check("noise.block_jitter_px", p, p >= 0.0, "must not be negative")?;
-        for (name, value) in
-            [("noise.block_miss", self.block_miss), ("noise.spurious_block", self.spurious_block), ("noise.frame_drop", self.frame_drop)]
-        {
-            check(name, value, (0.0..=1.0).contains(&value), "must be in [0, 1]")?;
+        for (name, value) in [
+            ("noise.block_miss", self.block_miss),
+            ("noise.spurious_block", self.spurious_block),
+            ("noise.frame_drop", self.frame_drop),
+        ] {
+            check(
+                name,
+                value,
+                (0.0..=1.0).contains(&value),
+                "must be in [0, 1]",
+            )?;
         }
         Ok(())
     }
@@ -109,7 +126,9 @@ impl RobotNoise {
             return vec![1.0; cols * rows];
         }
         let mut rng = noise::stream(seed, Purpose::Brightness, episode, 0);
-        (0..cols * rows).map(|_| 1.0 + self.brightness * noise::normal(&mut rng)).collect()
+        (0..cols * rows)
+            .map(|_| 1.0 + self.brightness * noise::normal(&mut rng))
+            .collect()
     }
 
     /// The gain at `p` of an arena of `size`: bilinear between the grid's
@@ -141,7 +160,13 @@ impl RobotNoise {
     /// A frame as the camera reports it with this noise: missed blocks
     /// dropped, the others jittered, maybe a spurious one (of signature
     /// `puck` or `robot`) at the end of its signature's blocks.
-    pub fn perturb_frame(&self, frame: &mut Vec<PixyBlock>, puck: u16, robot: u16, rng: &mut SimRng) {
+    pub fn perturb_frame(
+        &self,
+        frame: &mut Vec<PixyBlock>,
+        puck: u16,
+        robot: u16,
+        rng: &mut SimRng,
+    ) {
         if self.block_miss > 0.0 {
             frame.retain(|_| !noise::chance(rng, self.block_miss));
         }
@@ -168,7 +193,10 @@ impl RobotNoise {
                 angle: 0,
             };
             // The Pixy sends signature 1's blocks, then 2's.
-            let at = frame.iter().position(|b| b.signature > signature).unwrap_or(frame.len());
+            let at = frame
+                .iter()
+                .position(|b| b.signature > signature)
+                .unwrap_or(frame.len());
             frame.insert(at, block);
         }
     }
@@ -187,7 +215,14 @@ mod tests {
         let n = RobotNoise::NONE;
         let mut rng = noise::stream(1, Purpose::Camera, 0, 0);
         assert_eq!(n.jitter_discharge(321.5, &mut rng), 321.5);
-        let blocks = vec![PixyBlock { signature: 1, x: 10, y: 20, width: 5, height: 6, angle: 0 }];
+        let blocks = vec![PixyBlock {
+            signature: 1,
+            x: 10,
+            y: 20,
+            width: 5,
+            height: 6,
+            angle: 0,
+        }];
         let mut frame = blocks.clone();
         n.perturb_frame(&mut frame, 1, 2, &mut rng);
         assert_eq!(frame, blocks);
@@ -206,7 +241,10 @@ mod tests {
         let mid = RobotNoise::gain_at(&grid, Vec2::new(100.0, 50.0), size);
         assert!((mid - (grid[0] + grid[1]) / 2.0).abs() < 1e-12);
         // Past the outermost centres the edge values hold.
-        assert_eq!(RobotNoise::gain_at(&grid, Vec2::new(0.0, 0.0), size), grid[0]);
+        assert_eq!(
+            RobotNoise::gain_at(&grid, Vec2::new(0.0, 0.0), size),
+            grid[0]
+        );
     }
 
     #[test]
@@ -216,23 +254,45 @@ mod tests {
         let (mut kept, mut spurious, mut moved) = (0, 0, 0);
         let frames = 20_000;
         for _ in 0..frames {
-            let mut frame = vec![PixyBlock { signature: 1, x: 100, y: 100, width: 10, height: 10, angle: 0 }];
+            let mut frame = vec![PixyBlock {
+                signature: 1,
+                x: 100,
+                y: 100,
+                width: 10,
+                height: 10,
+                angle: 0,
+            }];
             n.perturb_frame(&mut frame, 1, 2, &mut rng);
-            kept += frame.iter().filter(|b| b.width < 40 && b.x.abs_diff(100) < 15).count();
+            kept += frame
+                .iter()
+                .filter(|b| b.width < 40 && b.x.abs_diff(100) < 15)
+                .count();
             moved += frame.iter().filter(|b| b.x != 100).count();
-            spurious += usize::from(frame.len() > 1 || frame.iter().any(|b| b.x.abs_diff(100) >= 15));
+            spurious +=
+                usize::from(frame.len() > 1 || frame.iter().any(|b| b.x.abs_diff(100) >= 15));
         }
         let rate = |n: usize| n as f64 / frames as f64;
         assert!((rate(kept) - 0.9).abs() < 0.01, "kept {}", rate(kept));
-        assert!((rate(spurious) - 0.04).abs() < 0.01, "spurious {}", rate(spurious));
+        assert!(
+            (rate(spurious) - 0.04).abs() < 0.01,
+            "spurious {}",
+            rate(spurious)
+        );
         assert!(rate(moved) > 0.5, "2 pixels of jitter move most blocks");
         assert_eq!(n.scaled(100.0).block_miss, 1.0);
     }
 
     #[test]
     fn bad_amounts_are_named() {
-        let bad = RobotNoise { frame_drop: 2.0, ..RobotNoise::NONE };
-        assert!(bad.validate().unwrap_err().to_string().contains("noise.frame_drop"));
+        let bad = RobotNoise {
+            frame_drop: 2.0,
+            ..RobotNoise::NONE
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("noise.frame_drop"));
         assert!(RobotNoise::randomised().validate().is_ok());
     }
 }

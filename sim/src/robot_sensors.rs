@@ -24,15 +24,15 @@
 //! the firmware binary. The whole model is configured by a
 //! [`RobotSensorConfig`] (JSON, every field optional; `docs/robot-sensors.md`).
 
-use crate::validate::ConfigError;
-use crate::field::ScalarField;
-use crate::photo_sensors::{PhotoSensorConfig, PhotoSensors};
-use crate::pixy_camera::{PixyCamera, PixyCameraConfig};
 use crate::camera_memory::CameraMemory;
+use crate::field::ScalarField;
 use crate::noise::{self, Purpose};
 use crate::photo_sensors::PhotoNoise;
+use crate::photo_sensors::{PhotoSensorConfig, PhotoSensors};
+use crate::pixy_camera::{PixyCamera, PixyCameraConfig};
 use crate::robot_noise::RobotNoise;
 use crate::sensor_model::{Footprint, FootprintKind, SensorMemory, SensorModel};
+use crate::validate::ConfigError;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::MAX_BLOCKS_PER_PERIOD;
@@ -130,7 +130,10 @@ impl RobotSensors {
     /// the blocks it reads (the first [`MAX_BLOCKS_PER_PERIOD`]).
     pub fn reading(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> SensorReading {
         let read = &frame[..frame.len().min(MAX_BLOCKS_PER_PERIOD)];
-        SensorReading::from_parts(self.photo.values(ticks), self.camera.classify().classify(read))
+        SensorReading::from_parts(
+            self.photo.values(ticks),
+            self.camera.classify().classify(read),
+        )
     }
 
     /// Every robot's observation of the last sensing (the world the
@@ -138,7 +141,6 @@ impl RobotSensors {
     pub fn observations(&self) -> &[RobotObservation] {
         &self.observations
     }
-
 
     /// Robot `robot`'s observation of the world, into `observations`: its
     /// field sensors' reading, and the camera frame its link delivers.
@@ -152,7 +154,12 @@ impl RobotSensors {
             let mut rng = noise::stream(seed, Purpose::Discharge, step, robot as u64);
             let arena = world.config().arena();
             let grid = brightness_grid(&mut self.brightness, &self.noise, seed, episode);
-            let noise = PhotoNoise { noise: &self.noise, grid, arena, rng: &mut rng };
+            let noise = PhotoNoise {
+                noise: &self.noise,
+                grid,
+                arena,
+                rng: &mut rng,
+            };
             self.photo.read(pos, direction, field, &layout, Some(noise))
         };
 
@@ -160,10 +167,18 @@ impl RobotSensors {
         self.camera.frame(world, robot, &mut capture);
         let mut rng = noise::stream(seed, Purpose::Camera, step, robot as u64);
         let classify = *self.camera.classify();
-        self.noise.perturb_frame(&mut capture, classify.puck_signature, classify.robot_signature, &mut rng);
+        self.noise.perturb_frame(
+            &mut capture,
+            classify.puck_signature,
+            classify.robot_signature,
+            &mut rng,
+        );
         let link = &mut self.links[robot];
         if link.episode != episode {
-            *link = CameraMemory { episode, ..CameraMemory::default() };
+            *link = CameraMemory {
+                episode,
+                ..CameraMemory::default()
+            };
         }
         if self.latency_frames > 0 {
             std::mem::swap(&mut link.captured, &mut capture);
@@ -186,7 +201,12 @@ impl RobotSensors {
 
 /// The screen's brightness gains of an episode, from `cache` if it holds
 /// that episode's (computed once per episode).
-fn brightness_grid<'a>(cache: &'a mut Option<(u64, u64, Vec<f64>)>, noise: &RobotNoise, seed: u64, episode: u64) -> &'a [f64] {
+fn brightness_grid<'a>(
+    cache: &'a mut Option<(u64, u64, Vec<f64>)>,
+    noise: &RobotNoise,
+    seed: u64,
+    episode: u64,
+) -> &'a [f64] {
     if !matches!(cache, Some((s, e, _)) if *s == seed && *e == episode) {
         *cache = Some((seed, episode, noise.brightness_grid(seed, episode)));
     }
@@ -197,7 +217,8 @@ impl SensorModel for RobotSensors {
     fn sense(&mut self, world: &World, field: &ScalarField, out: &mut [SensorReading]) {
         let robots = world.robots().len();
         self.links.resize(robots, CameraMemory::default());
-        self.observations.resize(robots, RobotObservation::default());
+        self.observations
+            .resize(robots, RobotObservation::default());
         for (i, reading) in out.iter_mut().enumerate().take(robots) {
             self.observe(world, field, i);
             *reading = self.observations[i].reading;
@@ -216,7 +237,9 @@ impl SensorModel for RobotSensors {
 
     /// One camera model: its robots' links.
     fn memory(&self) -> SensorMemory {
-        SensorMemory { cameras: vec![self.links.clone()] }
+        SensorMemory {
+            cameras: vec![self.links.clone()],
+        }
     }
 
     fn restore(&mut self, memory: &SensorMemory) {
@@ -236,10 +259,13 @@ mod tests {
     fn the_reading_is_the_firmware_arithmetic_on_the_raw_stimulus() {
         let config = SimConfig::default();
         // Robot 0 facing +x with five pucks ahead: only four blocks are read.
-        let robots =
-            [(Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie), (Vec2::new(260.0, 430.0), 0.0, RobotKind::Outie)];
-        let pucks: Vec<Vec2> =
-            (0..5).map(|k| Vec2::new(240.0 + 25.0 * f64::from(k), 385.0 + 10.0 * f64::from(k % 2))).collect();
+        let robots = [
+            (Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie),
+            (Vec2::new(260.0, 430.0), 0.0, RobotKind::Outie),
+        ];
+        let pucks: Vec<Vec2> = (0..5)
+            .map(|k| Vec2::new(240.0 + 25.0 * f64::from(k), 385.0 + 10.0 * f64::from(k % 2)))
+            .collect();
         let world = World::scene(&config, &robots, &pucks, 1);
         let field = ScalarField::annulus();
         let mut model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
@@ -273,19 +299,37 @@ mod tests {
         };
         // Captured in period 1, arriving in 2, held through 3 (the camera
         // sends nothing once it sees nothing), gone in 4.
-        assert_eq!([seen(&with_puck, &mut model), seen(&empty, &mut model), seen(&empty, &mut model), seen(&empty, &mut model)], [false, true, true, false]);
+        assert_eq!(
+            [
+                seen(&with_puck, &mut model),
+                seen(&empty, &mut model),
+                seen(&empty, &mut model),
+                seen(&empty, &mut model)
+            ],
+            [false, true, true, false]
+        );
         let mut ideal = RobotSensorConfig::default();
         ideal.camera.latency_frames = 0;
         let mut model = RobotSensors::new(&ideal, 5.0);
-        assert_eq!([seen(&with_puck, &mut model), seen(&empty, &mut model), seen(&empty, &mut model)], [true, true, false]);
+        assert_eq!(
+            [
+                seen(&with_puck, &mut model),
+                seen(&empty, &mut model),
+                seen(&empty, &mut model)
+            ],
+            [true, true, false]
+        );
     }
 
     #[test]
     fn config_files_name_only_what_they_change_and_unknown_keys_are_refused() {
-        let c: RobotSensorConfig = serde_json::from_str(r#"{"camera": {"tilt_deg": 25.0}}"#).unwrap();
+        let c: RobotSensorConfig =
+            serde_json::from_str(r#"{"camera": {"tilt_deg": 25.0}}"#).unwrap();
         assert_eq!(c.camera.tilt_deg, 25.0);
         assert_eq!(c.field, PhotoSensorConfig::default());
-        let e = serde_json::from_str::<RobotSensorConfig>(r#"{"camera": {"tilt": 25.0}}"#).unwrap_err().to_string();
+        let e = serde_json::from_str::<RobotSensorConfig>(r#"{"camera": {"tilt": 25.0}}"#)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("tilt"), "{e}");
     }
 }

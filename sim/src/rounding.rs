@@ -30,7 +30,9 @@ pub fn floor(t: f64) -> f64 {
 pub fn round_half_away(t: f64) -> i64 {
     let whole = t as i64;
     let frac = t - whole as f64;
-    whole.saturating_add(i64::from(frac >= 0.5)).saturating_sub(i64::from(frac <= -0.5))
+    whole
+        .saturating_add(i64::from(frac >= 0.5))
+        .saturating_sub(i64::from(frac <= -0.5))
 }
 
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! controller, sensor model, counts, seed), with the per-field defaults of
 //! the thesis' experiments.
 
+use crate::actuation::ActuationNoise;
 use crate::arena::ArenaSpec;
 use crate::broadphase::BroadPhase;
 use crate::config::{SimConfig, Thresholds};
@@ -10,10 +11,9 @@ use crate::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction, Rando
 use crate::field::ScalarField;
 use crate::field_source::{FieldError, FieldSource};
 use crate::policy_file::{self, PolicyFileError};
+use crate::robot_noise::RobotNoise;
 use crate::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::simulation::Simulation;
-use crate::actuation::ActuationNoise;
-use crate::robot_noise::RobotNoise;
 use crate::validate::{self, ConfigError};
 use shared::ActionTable;
 use std::fmt;
@@ -41,7 +41,9 @@ impl FromStr for ControllerChoice {
             "random" => Ok(ControllerChoice::Random),
             _ => match s.strip_prefix("policy:") {
                 Some(path) if !path.is_empty() => Ok(ControllerChoice::Policy(PathBuf::from(path))),
-                _ => Err(format!("unknown controller {s:?}: expected oc, random or policy:FILE")),
+                _ => Err(format!(
+                    "unknown controller {s:?}: expected oc, random or policy:FILE"
+                )),
             },
         }
     }
@@ -198,12 +200,15 @@ impl Scenario {
 
     /// Loads the field and policy, validates the settings and builds the
     /// simulation and controller. Errors name the offending input.
-    pub fn build(&self) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
+    pub fn build(
+        &self,
+    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
         let mut prepared = self.prepare()?;
         let controller: Box<dyn Controller> = match &self.controller {
-            ControllerChoice::Orbital => {
-                Box::new(OrbitalConstruction::new(OrbitalConfig::default(), &prepared.config().thresholds))
-            }
+            ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(
+                OrbitalConfig::default(),
+                &prepared.config().thresholds,
+            )),
             ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
             ControllerChoice::Policy(path) => {
                 let blob = policy_file::read(path)?;
@@ -223,13 +228,27 @@ impl Scenario {
         if let Arena::Screen(spec) = &self.arena {
             spec.validate()?;
         }
-        validate::check("noise", self.noise, (0.0..=5.0).contains(&self.noise), "must be from 0 to 5 (times the default noise)")?;
-        let sensors = if self.noise > 0.0 { self.sensors.with_noise(&RobotNoise::randomised().scaled(self.noise)) } else { self.sensors.clone() };
+        validate::check(
+            "noise",
+            self.noise,
+            (0.0..=5.0).contains(&self.noise),
+            "must be from 0 to 5 (times the default noise)",
+        )?;
+        let sensors = if self.noise > 0.0 {
+            self.sensors
+                .with_noise(&RobotNoise::randomised().scaled(self.noise))
+        } else {
+            self.sensors.clone()
+        };
         sensors.validate()?;
         let field = Arc::new(self.arena.load(&self.field)?);
         let config = self.config(&field);
         config.validate()?;
-        Ok(PreparedScenario { config, field, sensors })
+        Ok(PreparedScenario {
+            config,
+            field,
+            sensors,
+        })
     }
 }
 
@@ -271,7 +290,12 @@ impl PreparedScenario {
     pub fn simulation(&self, seed: u64) -> Result<Simulation<SelectedSensors>, ScenarioError> {
         self.config.validate()?;
         let sensors = self.sensors.build(&self.config);
-        Ok(Simulation::with_sensors(self.config.clone(), self.field.clone(), sensors, seed)?)
+        Ok(Simulation::with_sensors(
+            self.config.clone(),
+            self.field.clone(),
+            sensors,
+            seed,
+        )?)
     }
 }
 

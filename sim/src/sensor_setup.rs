@@ -64,8 +64,15 @@ impl SensorSetup {
     /// (in every part of a mix; the disc models have none).
     pub fn with_noise(&self, noise: &RobotNoise) -> SensorSetup {
         match self {
-            SensorSetup::Robot(robot) => SensorSetup::Robot(Box::new(RobotSensorConfig { noise: noise.clone(), ..(**robot).clone() })),
-            SensorSetup::Mixed { field, pucks, obstacles } => SensorSetup::Mixed {
+            SensorSetup::Robot(robot) => SensorSetup::Robot(Box::new(RobotSensorConfig {
+                noise: noise.clone(),
+                ..(**robot).clone()
+            })),
+            SensorSetup::Mixed {
+                field,
+                pucks,
+                obstacles,
+            } => SensorSetup::Mixed {
                 field: Box::new(field.with_noise(noise)),
                 pucks: Box::new(pucks.with_noise(noise)),
                 obstacles: Box::new(obstacles.with_noise(noise)),
@@ -79,9 +86,14 @@ impl SensorSetup {
         match self {
             SensorSetup::Disc | SensorSetup::DiscThesis => Ok(()),
             SensorSetup::Robot(robot) => robot.validate(),
-            SensorSetup::Mixed { field, pucks, obstacles } => {
-                field.validate().and(pucks.validate()).and(obstacles.validate())
-            }
+            SensorSetup::Mixed {
+                field,
+                pucks,
+                obstacles,
+            } => field
+                .validate()
+                .and(pucks.validate())
+                .and(obstacles.validate()),
         }
     }
 
@@ -100,8 +112,14 @@ impl SensorSetup {
                 };
                 SelectedSensors::Disc(DiscSensors::new(&discs, radius))
             }
-            SensorSetup::Robot(robot) => SelectedSensors::Robot(Box::new(RobotSensors::new(robot, config.world.unit_mm))),
-            SensorSetup::Mixed { field, pucks, obstacles } => SelectedSensors::Mixed(Box::new(MixedSensors::new(
+            SensorSetup::Robot(robot) => {
+                SelectedSensors::Robot(Box::new(RobotSensors::new(robot, config.world.unit_mm)))
+            }
+            SensorSetup::Mixed {
+                field,
+                pucks,
+                obstacles,
+            } => SelectedSensors::Mixed(Box::new(MixedSensors::new(
                 field.build(config),
                 pucks.build(config),
                 obstacles.build(config),
@@ -164,10 +182,19 @@ mod tests {
     #[test]
     fn names_give_their_models_and_unknown_names_none() {
         assert_eq!(SensorSetup::from_name("disc"), Some(SensorSetup::Disc));
-        assert_eq!(SensorSetup::from_name("disc-thesis"), Some(SensorSetup::DiscThesis));
-        assert_eq!(SensorSetup::from_name("robot"), Some(SensorSetup::Robot(Box::default())));
+        assert_eq!(
+            SensorSetup::from_name("disc-thesis"),
+            Some(SensorSetup::DiscThesis)
+        );
+        assert_eq!(
+            SensorSetup::from_name("robot"),
+            Some(SensorSetup::Robot(Box::default()))
+        );
         assert_eq!(SensorSetup::from_name("pixy"), None);
         let config = SimConfig::default();
-        assert!(matches!(SensorSetup::Robot(Box::default()).build(&config), SelectedSensors::Robot(_)));
+        assert!(matches!(
+            SensorSetup::Robot(Box::default()).build(&config),
+            SelectedSensors::Robot(_)
+        ));
     }
 }

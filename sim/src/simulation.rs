@@ -21,15 +21,15 @@
 //! ended. Both give the same trajectory for the same turns.
 
 use crate::config::{SimConfig, SuccessSignal};
-use crate::validate::ConfigError;
+use crate::control::{Controller, Perception};
+use crate::disc_sensors::DiscSensors;
+use crate::episode::{EpisodeEnd, EpisodeStart, StepOutcome};
 use crate::eval::{eval, eval_prime, EvalPrime, EvalTracker};
 use crate::field::ScalarField;
-use crate::disc_sensors::DiscSensors;
-use crate::sensor_model::{SensorMemory, SensorModel};
-use crate::world::World;
 use crate::rng::SimRng;
-use crate::control::{Controller, Perception};
-use crate::episode::{EpisodeEnd, EpisodeStart, StepOutcome};
+use crate::sensor_model::{SensorMemory, SensorModel};
+use crate::validate::ConfigError;
+use crate::world::World;
 use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
@@ -126,7 +126,11 @@ const CONTROLLER_STREAM: u64 = 0x9E37_79B9_7F4A_7C15;
 
 impl Simulation<DiscSensors> {
     /// A simulation with the reference disc sensors of `config.sensors`.
-    pub fn new(config: SimConfig, field: Arc<ScalarField>, seed: u64) -> Result<Simulation, ConfigError> {
+    pub fn new(
+        config: SimConfig,
+        field: Arc<ScalarField>,
+        seed: u64,
+    ) -> Result<Simulation, ConfigError> {
         let sensors = DiscSensors::new(&config.sensors, config.world.robot_radius);
         Simulation::with_sensors(config, field, sensors, seed)
     }
@@ -135,7 +139,12 @@ impl Simulation<DiscSensors> {
 impl<S: SensorModel> Simulation<S> {
     /// A simulation with any sensor model; the world's generator is seeded
     /// with `seed`, the controller's with a value derived from it.
-    pub fn with_sensors(config: SimConfig, field: Arc<ScalarField>, sensors: S, seed: u64) -> Result<Self, ConfigError> {
+    pub fn with_sensors(
+        config: SimConfig,
+        field: Arc<ScalarField>,
+        sensors: S,
+        seed: u64,
+    ) -> Result<Self, ConfigError> {
         let world = World::new(&config, seed)?;
         let controller_rng = SimRng::seed_from_u64(seed.wrapping_add(CONTROLLER_STREAM));
         let state = SimulationState {
@@ -167,7 +176,13 @@ impl<S: SensorModel> Simulation<S> {
             let e = evaluation.eval(&state.world, &state.config.thresholds);
             state.checked_signal = Some(success_signal(&state.world, &field, &state.config, e));
         }
-        Simulation { state, field, sensors, evaluation, turns: vec![0.0; robots] }
+        Simulation {
+            state,
+            field,
+            sensors,
+            evaluation,
+            turns: vec![0.0; robots],
+        }
     }
 
     /// The state (its sensor memory as of the last snapshot; save a
@@ -179,7 +194,10 @@ impl<S: SensorModel> Simulation<S> {
     /// The state to save for a bit-exact resume, the sensor model's memory
     /// included.
     pub fn snapshot(&self) -> SimulationState {
-        SimulationState { sensor_memory: self.sensors.memory(), ..self.state.clone() }
+        SimulationState {
+            sensor_memory: self.sensors.memory(),
+            ..self.state.clone()
+        }
     }
 
     /// The world.
@@ -215,7 +233,11 @@ impl<S: SensorModel> Simulation<S> {
 
     /// Eval of the current world.
     pub fn eval(&self) -> f64 {
-        eval(&self.state.world, &self.field, &self.state.config.thresholds)
+        eval(
+            &self.state.world,
+            &self.field,
+            &self.state.config.thresholds,
+        )
     }
 
     /// One step driven by `controller`: announce a new episode to it,
@@ -225,9 +247,17 @@ impl<S: SensorModel> Simulation<S> {
     pub fn step<C: Controller + ?Sized>(&mut self, controller: &mut C) -> Option<EpisodeEnd> {
         let s = &mut self.state;
         if s.episode_step == 0 {
-            controller.episode_start(&EpisodeStart { world: &s.world, field: &self.field, config: &s.config });
+            controller.episode_start(&EpisodeStart {
+                world: &s.world,
+                field: &self.field,
+                config: &s.config,
+            });
         }
-        let perception = Perception { readings: &s.readings, robots: s.world.robots(), episode_step: s.episode_step };
+        let perception = Perception {
+            readings: &s.readings,
+            robots: s.world.robots(),
+            episode_step: s.episode_step,
+        };
         let mut turns = std::mem::take(&mut self.turns);
         controller.decide(&perception, &mut turns, &mut s.controller_rng);
         let report = self.advance(&turns, controller.wants_eval_every_step());
@@ -268,7 +298,8 @@ impl<S: SensorModel> Simulation<S> {
         let episode = &s.config.episode;
         let check = s.episode_step % episode.check_interval == 0;
         let eval = (check || eval_every_step).then(|| {
-            self.evaluation.update(&mut s.world, &self.field, &s.config.thresholds);
+            self.evaluation
+                .update(&mut s.world, &self.field, &s.config.thresholds);
             self.evaluation.eval(&s.world, &s.config.thresholds)
         });
         let mut end = None;
@@ -276,7 +307,11 @@ impl<S: SensorModel> Simulation<S> {
             s.totals.eval_sum += e;
             s.totals.eval_checks += 1;
             let signal = success_signal(&s.world, &self.field, &s.config, e);
-            let tested = if episode.stale_eval { s.checked_signal.replace(signal).unwrap_or(signal) } else { signal };
+            let tested = if episode.stale_eval {
+                s.checked_signal.replace(signal).unwrap_or(signal)
+            } else {
+                signal
+            };
             if tested > episode.success_eval {
                 end = Some(EpisodeEnd::Formed);
             }
@@ -292,7 +327,12 @@ impl<S: SensorModel> Simulation<S> {
             Some(EpisodeEnd::Stuck) => s.totals.stuck += 1,
             None => {}
         }
-        StepReport { episode_step: s.episode_step, eval, end, robot_contacts }
+        StepReport {
+            episode_step: s.episode_step,
+            eval,
+            end,
+            robot_contacts,
+        }
     }
 
     /// Starts a new episode: new start positions and headings drawn from
@@ -301,7 +341,8 @@ impl<S: SensorModel> Simulation<S> {
         let s = &mut self.state;
         s.world.reset();
         s.episode_step = 0;
-        self.evaluation.rebuild(&s.world, &self.field, &s.config.thresholds);
+        self.evaluation
+            .rebuild(&s.world, &self.field, &s.config.thresholds);
         self.sensors.sense(&s.world, &self.field, &mut s.readings);
         if s.config.episode.stale_eval {
             let e = self.evaluation.eval(&s.world, &s.config.thresholds);
@@ -324,5 +365,12 @@ fn success_signal(world: &World, field: &ScalarField, config: &SimConfig, eval: 
         SuccessSignal::EvalPrime => EvalPrime::AsWritten,
         SuccessSignal::EvalPrimeSpread => EvalPrime::Spread,
     };
-    eval_prime(world, field, &config.thresholds, variant, config.episode.phi, config.episode.nu)
+    eval_prime(
+        world,
+        field,
+        &config.thresholds,
+        variant,
+        config.episode.phi,
+        config.episode.nu,
+    )
 }

@@ -45,7 +45,11 @@ pub fn check(name: &str, value: f64, ok: bool, expected: &'static str) -> Result
     if ok && value.is_finite() {
         Ok(())
     } else {
-        Err(ConfigError::OutOfRange { name: name.to_string(), value, expected })
+        Err(ConfigError::OutOfRange {
+            name: name.to_string(),
+            value,
+            expected,
+        })
     }
 }
 
@@ -56,6 +60,10 @@ pub fn positive(name: &str, value: f64) -> Result<(), ConfigError> {
 
 /// Checks that `value` is in [0, 1].
 pub fn unit(name: &str, value: f64) -> Result<(), ConfigError> {
-    check(name, value, (0.0..=1.0).contains(&value), "must be in [0, 1]")
+    check(
+        name,
+        value,
+        (0.0..=1.0).contains(&value),
+        "must be in [0, 1]",
+    )
 }
-

@@ -46,14 +46,20 @@ impl Vec2 {
     /// This vector rotated by the rotation whose cosine and sine are `rot`
     /// (clockwise on screen for positive angles).
     pub fn rotated(self, rot: Vec2) -> Vec2 {
-        Vec2 { x: self.x * rot.x - self.y * rot.y, y: self.x * rot.y + self.y * rot.x }
+        Vec2 {
+            x: self.x * rot.x - self.y * rot.y,
+            y: self.x * rot.y + self.y * rot.x,
+        }
     }
 }
 
 impl Add for Vec2 {
     type Output = Vec2;
     fn add(self, o: Vec2) -> Vec2 {
-        Vec2 { x: self.x + o.x, y: self.y + o.y }
+        Vec2 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+        }
     }
 }
 
@@ -67,7 +73,10 @@ impl AddAssign for Vec2 {
 impl Sub for Vec2 {
     type Output = Vec2;
     fn sub(self, o: Vec2) -> Vec2 {
-        Vec2 { x: self.x - o.x, y: self.y - o.y }
+        Vec2 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+        }
     }
 }
 
@@ -81,13 +90,19 @@ impl SubAssign for Vec2 {
 impl Mul<f64> for Vec2 {
     type Output = Vec2;
     fn mul(self, k: f64) -> Vec2 {
-        Vec2 { x: self.x * k, y: self.y * k }
+        Vec2 {
+            x: self.x * k,
+            y: self.y * k,
+        }
     }
 }
 
 impl Neg for Vec2 {
     type Output = Vec2;
     fn neg(self) -> Vec2 {
-        Vec2 { x: -self.x, y: -self.y }
+        Vec2 {
+            x: -self.x,
+            y: -self.y,
+        }
     }
 }

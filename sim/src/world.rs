@@ -7,12 +7,12 @@
 
 use crate::body::{Body, Robot, RobotKind};
 use crate::broadphase::NeighbourIndex;
-use crate::grid::Neighbour;
 use crate::config::{PhysicsConfig, SimConfig, WorldConfig};
-use crate::validate::ConfigError;
+use crate::grid::Neighbour;
 use crate::physics::{candidate_reach, PhysicsScratch, StepContext};
-use crate::vec2::Vec2;
 use crate::rng::SimRng;
+use crate::validate::ConfigError;
+use crate::vec2::Vec2;
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::ops::Range;
@@ -80,20 +80,41 @@ impl World {
     pub fn from_state(state: WorldState) -> World {
         let index = index_of(&state);
         let scratch = PhysicsScratch::new(&state.bodies, state.robots.len());
-        World { state, index, scratch, scratch_speeds: Vec::new() }
+        World {
+            state,
+            index,
+            scratch,
+            scratch_speeds: Vec::new(),
+        }
     }
 
     /// A hand-placed scene (tests, figures): robots at the given positions,
     /// headings and kinds, then pucks at rest; the counts in `config` are
     /// replaced by the scene's.
-    pub fn scene(config: &SimConfig, robots: &[(Vec2, f64, RobotKind)], pucks: &[Vec2], seed: u64) -> World {
+    pub fn scene(
+        config: &SimConfig,
+        robots: &[(Vec2, f64, RobotKind)],
+        pucks: &[Vec2],
+        seed: u64,
+    ) -> World {
         let c = &config.world;
-        let mut bodies: Vec<Body> = robots.iter().map(|&(p, _, _)| Body::new(p, c.robot_radius)).collect();
+        let mut bodies: Vec<Body> = robots
+            .iter()
+            .map(|&(p, _, _)| Body::new(p, c.robot_radius))
+            .collect();
         bodies.extend(pucks.iter().map(|&p| puck(Body::new(p, c.puck_radius), c)));
-        let robot_state = robots.iter().map(|&(_, heading, kind)| Robot::new(heading, kind)).collect();
+        let robot_state = robots
+            .iter()
+            .map(|&(_, heading, kind)| Robot::new(heading, kind))
+            .collect();
         let innies = robots.iter().filter(|r| r.2 == RobotKind::Innie).count();
         World::from_state(WorldState {
-            config: WorldConfig { robots: robots.len(), innies, pucks: pucks.len(), ..c.clone() },
+            config: WorldConfig {
+                robots: robots.len(),
+                innies,
+                pucks: pucks.len(),
+                ..c.clone()
+            },
             physics: config.physics.clone(),
             bodies,
             robots: robot_state,
@@ -224,13 +245,17 @@ impl World {
         let robots = self.state.robots.len() as u32;
         let half = radius + self.state.config.puck_radius;
         let mut found = NONE;
-        self.any_body_in_box(centre - Vec2::new(half, half), centre + Vec2::new(half, half), |row| {
-            for n in row {
-                let hit = (n.body >= robots) & disc_overlaps(centre, radius, n.pos, n.radius);
-                found = if hit { n.body } else { found };
-            }
-            found != NONE
-        });
+        self.any_body_in_box(
+            centre - Vec2::new(half, half),
+            centre + Vec2::new(half, half),
+            |row| {
+                for n in row {
+                    let hit = (n.body >= robots) & disc_overlaps(centre, radius, n.pos, n.radius);
+                    found = if hit { n.body } else { found };
+                }
+                found != NONE
+            },
+        );
         (found != NONE).then_some(found as usize)
     }
 
@@ -238,7 +263,9 @@ impl World {
     /// `radius`: the test of [`World::puck_in_disc`] for one body.
     pub fn puck_overlaps_disc(&self, body: usize, centre: Vec2, radius: f64) -> bool {
         match self.state.bodies.get(body) {
-            Some(b) if body >= self.state.robots.len() => disc_overlaps(centre, radius, b.pos, b.radius),
+            Some(b) if body >= self.state.robots.len() => {
+                disc_overlaps(centre, radius, b.pos, b.radius)
+            }
             _ => false,
         }
     }
@@ -247,14 +274,24 @@ impl World {
     /// at least every body whose centre is closer than `reach` to body
     /// `body`'s (and maybe others), and none are passed after `pred`
     /// returns true.
-    pub fn any_body_around(&self, body: usize, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+    pub fn any_body_around(
+        &self,
+        body: usize,
+        reach: f64,
+        pred: impl FnMut(&[Neighbour]) -> bool,
+    ) -> bool {
         self.index.any_around(&self.state.bodies, body, reach, pred)
     }
 
     /// Whether `pred` holds for some run of bodies; the runs together hold
     /// at least every body whose circle reaches within `reach` of `centre`
     /// (and maybe others), and none are passed after `pred` returns true.
-    pub fn any_body_near(&self, centre: Vec2, reach: f64, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+    pub fn any_body_near(
+        &self,
+        centre: Vec2,
+        reach: f64,
+        pred: impl FnMut(&[Neighbour]) -> bool,
+    ) -> bool {
         let r = reach + self.state.config.max_radius();
         self.any_body_in_box(centre - Vec2::new(r, r), centre + Vec2::new(r, r), pred)
     }
@@ -262,7 +299,12 @@ impl World {
     /// Whether `pred` holds for some run of bodies; the runs together hold
     /// at least every body whose centre lies in the box `min ..= max` (and
     /// maybe others), and none are passed after `pred` returns true.
-    pub fn any_body_in_box(&self, min: Vec2, max: Vec2, pred: impl FnMut(&[Neighbour]) -> bool) -> bool {
+    pub fn any_body_in_box(
+        &self,
+        min: Vec2,
+        max: Vec2,
+        pred: impl FnMut(&[Neighbour]) -> bool,
+    ) -> bool {
         self.index.any_in_box(min, max, pred)
     }
 }
@@ -312,7 +354,11 @@ fn puck(mut body: Body, c: &WorldConfig) -> Body {
 fn start_robots(c: &WorldConfig, rng: &mut SimRng) -> Vec<Robot> {
     (0..c.robots)
         .map(|i| {
-            let kind = if i < c.innies { RobotKind::Innie } else { RobotKind::Outie };
+            let kind = if i < c.innies {
+                RobotKind::Innie
+            } else {
+                RobotKind::Outie
+            };
             Robot::new(rng.random_range(0.0..std::f64::consts::TAU), kind)
         })
         .collect()

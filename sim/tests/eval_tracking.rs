@@ -2,8 +2,8 @@
 //! evaluation of the whole world, at every step and across episode resets.
 
 use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-use sim::{Controller, Perception};
 use sim::{eval, ScalarField, SimConfig, SimRng, Simulation, StepOutcome};
+use sim::{Controller, Perception};
 use std::sync::Arc;
 
 /// Orbital construction that checks each reported Eval against a recount.
@@ -24,7 +24,12 @@ impl Controller for Checker {
     fn observe(&mut self, o: &StepOutcome<'_>) {
         if let Some(reported) = o.eval {
             let fresh = eval(o.world, o.field, &sim::Thresholds::default());
-            assert_eq!(reported.to_bits(), fresh.to_bits(), "step {}: tracked {reported}, recount {fresh}", o.episode_step);
+            assert_eq!(
+                reported.to_bits(),
+                fresh.to_bits(),
+                "step {}: tracked {reported}, recount {fresh}",
+                o.episode_step
+            );
             self.compared += 1;
         }
         self.resets += u64::from(o.end.is_some());
@@ -41,7 +46,12 @@ fn tracked_eval_equals_a_recount_every_step_and_at_checks() {
         let thresholds = config.thresholds.clone();
         let mut sim = Simulation::new(config, Arc::new(ScalarField::annulus()), 11).unwrap();
         let oc = OrbitalConstruction::new(OrbitalConfig::default(), &thresholds);
-        let mut checker = Checker { oc, every_step, compared: 0, resets: 0 };
+        let mut checker = Checker {
+            oc,
+            every_step,
+            compared: 0,
+            resets: 0,
+        };
         sim.run(&mut checker, 10_000);
         assert_eq!(checker.compared, if every_step { 10_000 } else { 100 });
         assert!(checker.resets >= 3, "the run must cross episode resets");

@@ -2,9 +2,9 @@
 //! thesis' Figure 6, on the annulus: A and C orbit clockwise (right >= mid
 //! >= left), B does not and turns to realign.
 
+use shared::SensorReading;
 use sim::controllers::{OrbitalConfig, OrbitalConstruction};
 use sim::{DiscSensors, RobotKind, ScalarField, SensorModel, SimConfig, Thresholds, Vec2, World};
-use shared::SensorReading;
 use std::f64::consts::FRAC_PI_2;
 
 fn read(pos: Vec2, heading: f64, kind: RobotKind, pucks: &[Vec2]) -> SensorReading {
@@ -36,10 +36,18 @@ fn agent_a_left_of_centre_heading_up_orbits_clockwise() {
     let r = read(outer, up, RobotKind::Outie, &[]);
     assert!(clockwise(&r), "{r:?}");
     assert!(r.mid.to_f32() < 0.6);
-    assert_eq!(oc().turn(&r, RobotKind::Outie), 0.3 * 0.3, "below T_o: gentle right, inwards");
+    assert_eq!(
+        oc().turn(&r, RobotKind::Outie),
+        0.3 * 0.3,
+        "below T_o: gentle right, inwards"
+    );
     let r = read(inner, up, RobotKind::Outie, &[]);
     assert!(clockwise(&r) && r.mid.to_f32() > 0.6, "{r:?}");
-    assert_eq!(oc().turn(&r, RobotKind::Outie), -0.3 * 0.3, "above T_o: gentle left, outwards");
+    assert_eq!(
+        oc().turn(&r, RobotKind::Outie),
+        -0.3 * 0.3,
+        "above T_o: gentle left, outwards"
+    );
     // an innie orbits at T_i = 0.8 instead: still inside it, so it turns in
     assert_eq!(oc().turn(&r, RobotKind::Innie), 0.3 * 0.3);
 }
@@ -51,16 +59,28 @@ fn agent_a_nudges_pucks_by_kind() {
     let left_puck = beside(pos, up, -30.0, 40.0);
     let r = read(pos, up, RobotKind::Outie, &[left_puck]);
     assert!(clockwise(&r) && r.puck_left);
-    assert_eq!(oc().turn(&r, RobotKind::Outie), -0.3, "an outie turns into a puck on its left");
+    assert_eq!(
+        oc().turn(&r, RobotKind::Outie),
+        -0.3,
+        "an outie turns into a puck on its left"
+    );
 
     let right_puck = beside(pos, up, 45.0, 30.0);
     let r = read(pos, up, RobotKind::Innie, &[right_puck]);
     assert!(clockwise(&r) && r.puck_right);
-    assert_eq!(oc().turn(&r, RobotKind::Innie), 0.3, "an innie turns into a puck on its right");
+    assert_eq!(
+        oc().turn(&r, RobotKind::Innie),
+        0.3,
+        "an innie turns into a puck on its right"
+    );
 
     let r = read(pos, up, RobotKind::Innie, &[beside(pos, up, -45.0, 30.0)]);
     assert!(r.puck_left && !r.puck_right);
-    assert_eq!(oc().turn(&r, RobotKind::Innie).abs(), 0.09, "an innie ignores pucks on its left");
+    assert_eq!(
+        oc().turn(&r, RobotKind::Innie).abs(),
+        0.09,
+        "an innie ignores pucks on its left"
+    );
 }
 
 #[test]
@@ -71,7 +91,10 @@ fn agent_b_heading_the_wrong_way_realigns() {
     assert_eq!(oc().turn(&r, RobotKind::Outie), 0.3);
     // heading straight at the centre, mid is the highest: turn left
     let r = read(Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie, &[]);
-    assert!(r.mid >= r.left && r.mid >= r.right && !clockwise(&r), "{r:?}");
+    assert!(
+        r.mid >= r.left && r.mid >= r.right && !clockwise(&r),
+        "{r:?}"
+    );
     assert_eq!(oc().turn(&r, RobotKind::Outie), -0.3);
 }
 

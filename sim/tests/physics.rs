@@ -1,9 +1,9 @@
 //! Physics: impulses, walls, sliding pucks, and grid vs all-pairs identity.
 
+use shared::ActionTable;
 use sim::controllers::RandomTurns;
 use sim::physics::elastic_impulse;
 use sim::{Body, BroadPhase, RobotKind, SimConfig, Simulation, Vec2, World, WorldState};
-use shared::ActionTable;
 use std::sync::Arc;
 
 fn close(a: f64, b: f64) -> bool {
@@ -17,12 +17,23 @@ fn impulse_between_unequal_bodies_conserves_momentum_and_energy() {
     a.vel = Vec2::new(1.0, 0.5);
     b.vel = Vec2::new(-1.0, 0.0);
     let momentum = |a: &Body, b: &Body| a.vel * a.mass + b.vel * b.mass;
-    let energy = |a: &Body, b: &Body| 0.5 * (a.mass * a.vel.length_squared() + b.mass * b.vel.length_squared());
+    let energy = |a: &Body, b: &Body| {
+        0.5 * (a.mass * a.vel.length_squared() + b.mass * b.vel.length_squared())
+    };
     let (p0, e0) = (momentum(&a, &b), energy(&a, &b));
     elastic_impulse(&mut a, &mut b);
     // masses 100 and 50; along x: k = 2, p = 4 / 150; v_a = 1 - p 50, v_b = -1 + p 100
-    assert!(close(a.vel.x, -1.0 / 3.0) && close(b.vel.x, 5.0 / 3.0), "{:?} {:?}", a.vel, b.vel);
-    assert_eq!((a.vel.y, b.vel.y), (0.5, 0.0), "no change across the centre line");
+    assert!(
+        close(a.vel.x, -1.0 / 3.0) && close(b.vel.x, 5.0 / 3.0),
+        "{:?} {:?}",
+        a.vel,
+        b.vel
+    );
+    assert_eq!(
+        (a.vel.y, b.vel.y),
+        (0.5, 0.0),
+        "no change across the centre line"
+    );
     let p1 = momentum(&a, &b);
     assert!(close(p0.x, p1.x) && close(p0.y, p1.y));
     assert!(close(e0, energy(&a, &b)));
@@ -33,8 +44,12 @@ fn head_on() -> World {
     let mut config = SimConfig::default();
     config.world.puck_radius = 5.0;
     config.world.forward_speed = 1.0;
-    let world =
-        World::scene(&config, &[(Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie)], &[Vec2::new(115.5, 100.0)], 1);
+    let world = World::scene(
+        &config,
+        &[(Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie)],
+        &[Vec2::new(115.5, 100.0)],
+        1,
+    );
     let mut state: WorldState = world.state().clone();
     state.bodies[1].vel = Vec2::new(-1.0, 0.0);
     World::from_state(state)
@@ -47,10 +62,18 @@ fn a_contact_step_matches_the_hand_computed_result() {
     // integrate: robot 101 (v 0.6), puck 114.5 (v -0.6); overlap 1.5 split
     // by mass shares 1/3, 2/3; impulse k = 1.2, p = 2.4 / 150.
     let (r, p) = (w.bodies()[0], w.bodies()[1]);
-    assert!(close(r.pos.x, 100.5) && close(p.pos.x, 115.5), "{:?} {:?}", r.pos, p.pos);
+    assert!(
+        close(r.pos.x, 100.5) && close(p.pos.x, 115.5),
+        "{:?} {:?}",
+        r.pos,
+        p.pos
+    );
     assert!(close(r.vel.x, 0.6 - 2.4 / 150.0 * 50.0), "{:?}", r.vel);
     assert!(close(p.vel.x, -0.6 + 2.4 / 150.0 * 100.0), "{:?}", p.vel);
-    assert!(close(r.vel.x * r.mass + p.vel.x * p.mass, 0.6 * 100.0 - 0.6 * 50.0));
+    assert!(close(
+        r.vel.x * r.mass + p.vel.x * p.mass,
+        0.6 * 100.0 - 0.6 * 50.0
+    ));
     assert_eq!(w.contacts().len(), 1);
 }
 
@@ -58,21 +81,29 @@ fn a_contact_step_matches_the_hand_computed_result() {
 fn a_wall_contact_reverses_the_velocity_into_the_wall() {
     let config = SimConfig::default();
     let robot_far = (Vec2::new(400.0, 400.0), 0.0, RobotKind::Outie);
-    let mut state = World::scene(&config, &[robot_far], &[Vec2::new(10.5, 400.0)], 1).state().clone();
+    let mut state = World::scene(&config, &[robot_far], &[Vec2::new(10.5, 400.0)], 1)
+        .state()
+        .clone();
     state.bodies[1].vel = Vec2::new(-2.0, 0.5);
     let mut w = World::from_state(state);
     w.step(&[0.0]);
     let p = w.bodies()[1];
     // after integration v = (-1.2, 0.3); the wall reflects x and keeps y
     assert!(close(p.vel.x, 1.2) && close(p.vel.y, 0.3), "{:?}", p.vel);
-    assert!(close(p.pos.x, 10.0), "pushed out to touch the wall: {:?}", p.pos);
+    assert!(
+        close(p.pos.x, 10.0),
+        "pushed out to touch the wall: {:?}",
+        p.pos
+    );
 }
 
 #[test]
 fn pushed_pucks_slow_down_and_stop() {
     let config = SimConfig::default();
     let robot_far = (Vec2::new(700.0, 700.0), 0.0, RobotKind::Outie);
-    let mut state = World::scene(&config, &[robot_far], &[Vec2::new(300.0, 300.0)], 1).state().clone();
+    let mut state = World::scene(&config, &[robot_far], &[Vec2::new(300.0, 300.0)], 1)
+        .state()
+        .clone();
     state.bodies[1].vel = Vec2::new(1.5, -0.5);
     let mut w = World::from_state(state);
     let mut last_speed = f64::INFINITY;
@@ -119,13 +150,23 @@ fn grid_and_all_pairs_agree_in_a_rectangular_arena_and_every_body_stays_inside_i
     let grid = dense_run(BroadPhase::Grid, (700.0, 330.0), 6_000);
     let naive = dense_run(BroadPhase::Naive, (700.0, 330.0), 6_000);
     assert!(grid == naive, "trajectories differ");
-    let (bodies, ..): (Vec<Body>, serde_json::Value, serde_json::Value, u64) = serde_json::from_str(&grid).unwrap();
+    let (bodies, ..): (Vec<Body>, serde_json::Value, serde_json::Value, u64) =
+        serde_json::from_str(&grid).unwrap();
     // Within the walls, up to the overlap a step's motion can leave before
     // the next step resolves it (speed 2, overlap threshold 0.1).
     let slack = 2.1;
     for b in &bodies {
-        assert!(b.pos.x >= b.radius - slack && b.pos.x <= 700.0 - b.radius + slack, "{b:?}");
-        assert!(b.pos.y >= b.radius - slack && b.pos.y <= 330.0 - b.radius + slack, "{b:?}");
+        assert!(
+            b.pos.x >= b.radius - slack && b.pos.x <= 700.0 - b.radius + slack,
+            "{b:?}"
+        );
+        assert!(
+            b.pos.y >= b.radius - slack && b.pos.y <= 330.0 - b.radius + slack,
+            "{b:?}"
+        );
     }
-    assert!(bodies.iter().any(|b| b.pos.y > 300.0) && bodies.iter().any(|b| b.pos.x > 650.0), "the far walls are reached");
+    assert!(
+        bodies.iter().any(|b| b.pos.y > 300.0) && bodies.iter().any(|b| b.pos.x > 650.0),
+        "the far walls are reached"
+    );
 }

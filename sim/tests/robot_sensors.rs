@@ -1,12 +1,12 @@
 //! The robot sensor model end to end: deterministic, and sensing only what
 //! the robot's camera can see.
 
+use shared::{ActionTable, SensorReading};
 use sim::controllers::RandomTurns;
 use sim::{
-    DiscSensorConfig, DiscSensors, RobotKind, RobotSensorConfig, RobotSensors, ScalarField, SensorModel, SimConfig,
-    Simulation, Vec2, World,
+    DiscSensorConfig, DiscSensors, RobotKind, RobotSensorConfig, RobotSensors, ScalarField,
+    SensorModel, SimConfig, Simulation, Vec2, World,
 };
-use shared::{ActionTable, SensorReading};
 use std::sync::Arc;
 
 #[test]
@@ -14,10 +14,18 @@ fn the_same_seed_gives_the_same_trajectory_with_the_robot_model() {
     let run = || {
         let config = SimConfig::default();
         let sensors = RobotSensors::new(&RobotSensorConfig::default(), config.world.unit_mm);
-        let mut sim = Simulation::with_sensors(config, Arc::new(ScalarField::annulus()), sensors, 5).unwrap();
+        let mut sim =
+            Simulation::with_sensors(config, Arc::new(ScalarField::annulus()), sensors, 5).unwrap();
         let mut controller = RandomTurns::new(ActionTable::default());
         sim.run(&mut controller, 500);
-        (sim.world().bodies().iter().map(|b| (b.pos.x, b.pos.y)).collect::<Vec<_>>(), sim.readings().to_vec())
+        (
+            sim.world()
+                .bodies()
+                .iter()
+                .map(|b| (b.pos.x, b.pos.y))
+                .collect::<Vec<_>>(),
+            sim.readings().to_vec(),
+        )
     };
     assert_eq!(run(), run());
 }
@@ -50,22 +58,39 @@ fn noisy(noise: f64, seed: u64) -> Simulation<sim::SelectedSensors> {
     let mut config = SimConfig::default();
     tv.apply(&mut config, &field);
     config.world.actuation = sim::actuation::ActuationNoise::randomised().scaled(noise);
-    let robot = RobotSensorConfig { noise: sim::robot_noise::RobotNoise::randomised().scaled(noise), ..RobotSensorConfig::default() };
+    let robot = RobotSensorConfig {
+        noise: sim::robot_noise::RobotNoise::randomised().scaled(noise),
+        ..RobotSensorConfig::default()
+    };
     let sensors = sim::SensorSetup::Robot(Box::new(robot)).build(&config);
     Simulation::with_sensors(config, Arc::new(field), sensors, seed).unwrap()
 }
 
-fn trajectory(sim: &mut Simulation<sim::SelectedSensors>, steps: u64) -> (Vec<(f64, f64)>, Vec<SensorReading>) {
+fn trajectory(
+    sim: &mut Simulation<sim::SelectedSensors>,
+    steps: u64,
+) -> (Vec<(f64, f64)>, Vec<SensorReading>) {
     let mut controller = RandomTurns::new(ActionTable::default());
     sim.run(&mut controller, steps);
-    (sim.world().bodies().iter().map(|b| (b.pos.x, b.pos.y)).collect(), sim.readings().to_vec())
+    (
+        sim.world()
+            .bodies()
+            .iter()
+            .map(|b| (b.pos.x, b.pos.y))
+            .collect(),
+        sim.readings().to_vec(),
+    )
 }
 
 #[test]
 fn the_same_seed_gives_the_same_noise_and_zero_noise_is_the_noiseless_model() {
     let a = trajectory(&mut noisy(1.0, 3), 3000);
     assert_eq!(a, trajectory(&mut noisy(1.0, 3), 3000));
-    assert_ne!(a, trajectory(&mut noisy(1.0, 4), 3000), "another seed, other noise");
+    assert_ne!(
+        a,
+        trajectory(&mut noisy(1.0, 4), 3000),
+        "another seed, other noise"
+    );
     let quiet = trajectory(&mut noisy(0.0, 3), 3000);
     assert_ne!(a, quiet, "the noise changes the run");
     // Zero noise, given explicitly, is the model without noise.

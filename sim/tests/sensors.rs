@@ -1,10 +1,10 @@
 //! Sensor golden cases: which disc sees what, and which field cells the
 //! field sensors read.
 
+use shared::{FieldValue, SensorReading};
 use sim::{
     DiscSensorConfig, DiscSensors, RobotKind, ScalarField, SensorModel, SimConfig, Vec2, World,
 };
-use shared::{FieldValue, SensorReading};
 
 const R: f64 = 10.0;
 const ROBOT: Vec2 = Vec2::new(400.0, 400.0);
@@ -33,11 +33,20 @@ fn flags(r: &SensorReading) -> [bool; 4] {
 fn a_puck_in_a_left_disc_sets_the_left_bit_only() {
     let c = SimConfig::default();
     for (angle, dist) in [(-30.0, 4.0), (-60.0, 7.0)] {
-        assert_eq!(flags(&read(&c, RobotKind::Outie, &[at(angle, dist)], &[])), [true, false, false, false]);
-        assert_eq!(flags(&read(&c, RobotKind::Outie, &[at(-angle, dist)], &[])), [false, true, false, false]);
+        assert_eq!(
+            flags(&read(&c, RobotKind::Outie, &[at(angle, dist)], &[])),
+            [true, false, false, false]
+        );
+        assert_eq!(
+            flags(&read(&c, RobotKind::Outie, &[at(-angle, dist)], &[])),
+            [false, true, false, false]
+        );
     }
     // innie discs sit elsewhere: (-45, 3r) and (-70, 6.5r)
-    assert_eq!(flags(&read(&c, RobotKind::Innie, &[at(-45.0, 3.0)], &[])), [true, false, false, false]);
+    assert_eq!(
+        flags(&read(&c, RobotKind::Innie, &[at(-45.0, 3.0)], &[])),
+        [true, false, false, false]
+    );
 }
 
 #[test]
@@ -57,11 +66,20 @@ fn obstacle_sensors_see_any_body_by_default_and_only_robots_in_the_thesis_setup(
     let touching = at(-45.0, 1.0) + Vec2::from_angle((-45.0f64).to_radians()) * 12.0;
     let r = read(&c, RobotKind::Outie, &[touching], &[]);
     assert!(r.obstacle_left && !r.obstacle_right, "{r:?}");
-    assert_eq!(flags(&read(&c, RobotKind::Outie, &[], &[touching])), [false, false, true, false]);
+    assert_eq!(
+        flags(&read(&c, RobotKind::Outie, &[], &[touching])),
+        [false, false, true, false]
+    );
 
-    let thesis = SimConfig { sensors: DiscSensorConfig::thesis_obstacles(), ..SimConfig::default() };
+    let thesis = SimConfig {
+        sensors: DiscSensorConfig::thesis_obstacles(),
+        ..SimConfig::default()
+    };
     let right = at(45.0, 1.0) + Vec2::from_angle(45f64.to_radians()) * 25.0;
-    assert!(!read(&thesis, RobotKind::Outie, &[right], &[]).obstacle_right, "pucks are not obstacles");
+    assert!(
+        !read(&thesis, RobotKind::Outie, &[right], &[]).obstacle_right,
+        "pucks are not obstacles"
+    );
     assert!(read(&thesis, RobotKind::Outie, &[], &[right]).obstacle_right);
 }
 
@@ -73,7 +91,10 @@ fn field_sensors_read_the_rounded_cells_and_zero_past_the_edge() {
     // mid at (420, 400) -> (33.6, 32) -> cell (34, 32); left (414.1, 385.9) ->
     // (33, 31); right (414.1, 414.1) -> (33, 33)
     let r = read(&c, RobotKind::Outie, &[], &[]);
-    assert_eq!((r.left, r.mid, r.right), (cell(33, 31), cell(34, 32), cell(33, 33)));
+    assert_eq!(
+        (r.left, r.mid, r.right),
+        (cell(33, 31), cell(34, 32), cell(33, 33))
+    );
 
     // near the right wall: the mid point at x = 790 reads cell 63, at
     // x >= 793.75 the index rounds to 64, outside the grid: 0.
@@ -109,7 +130,11 @@ fn readings_do_not_depend_on_what_the_sensors_saw_before() {
         sim.step(&mut oc);
         if step == 1500 {
             // another world, with other pucks at the remembered indices
-            remembering.sense(&World::new(&config, 99).expect("valid config"), &field, &mut out);
+            remembering.sense(
+                &World::new(&config, 99).expect("valid config"),
+                &field,
+                &mut out,
+            );
         }
         let world = sim.world();
         remembering.sense(world, &field, &mut out);
@@ -118,5 +143,8 @@ fn readings_do_not_depend_on_what_the_sensors_saw_before() {
         assert_eq!(out, sim.readings(), "step {step}");
         hits += out.iter().filter(|r| r.puck_left || r.puck_right).count();
     }
-    assert!(hits > 3000, "the run must exercise the puck sensors ({hits} readings with a puck)");
+    assert!(
+        hits > 3000,
+        "the run must exercise the puck sensors ({hits} readings with a puck)"
+    );
 }

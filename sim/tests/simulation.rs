@@ -1,12 +1,15 @@
 //! Whole simulations: determinism, checkpoints, Eval, and the control that
 //! orbital construction builds the annulus where random turning does not.
 
-use sim::controllers::{OrbitalConfig, OrbitalConstruction, RandomTurns};
-use sim::{Controller, Perception};
-use sim::scenario::{ControllerChoice, Scenario};
-use sim::{eval, eval_prime, EvalPrime, ScalarField, SimConfig, SimRng, Simulation, StepOutcome, Vec2, World};
-use sim::{RobotKind, SimulationState};
 use shared::ActionTable;
+use sim::controllers::{OrbitalConfig, OrbitalConstruction, RandomTurns};
+use sim::scenario::{ControllerChoice, Scenario};
+use sim::{
+    eval, eval_prime, EvalPrime, ScalarField, SimConfig, SimRng, Simulation, StepOutcome, Vec2,
+    World,
+};
+use sim::{Controller, Perception};
+use sim::{RobotKind, SimulationState};
 use std::sync::Arc;
 
 fn standard(seed: u64) -> Simulation {
@@ -31,7 +34,10 @@ fn same_seed_same_trajectory_even_beside_other_threads() {
         final_state(&sim)
     };
     let alone = run(5);
-    let threads: Vec<_> = [5, 6, 5].into_iter().map(|s| std::thread::spawn(move || run(s))).collect();
+    let threads: Vec<_> = [5, 6, 5]
+        .into_iter()
+        .map(|s| std::thread::spawn(move || run(s)))
+        .collect();
     let results: Vec<String> = threads.into_iter().map(|t| t.join().unwrap()).collect();
     assert!(results[0] == alone && results[2] == alone);
     assert!(results[1] != alone, "another seed gives another trajectory");
@@ -50,14 +56,22 @@ fn a_caller_driving_the_step_api_gets_the_controller_loops_trajectory() {
     let mut controller = oc();
     driven.run(&mut controller, 6000);
     let ends = driven.totals().formations + driven.totals().stuck;
-    assert!(ends >= 3, "episodes should end and reset within the run: {:?}", driven.totals());
+    assert!(
+        ends >= 3,
+        "episodes should end and reset within the run: {:?}",
+        driven.totals()
+    );
 
     let mut external = short();
     let policy = oc();
     let mut turns = vec![0.0f32; external.world().robots().len()];
     let mut external_ends = 0;
     for _ in 0..6000 {
-        for ((turn, reading), robot) in turns.iter_mut().zip(external.readings()).zip(external.world().robots()) {
+        for ((turn, reading), robot) in turns
+            .iter_mut()
+            .zip(external.readings())
+            .zip(external.world().robots())
+        {
             *turn = policy.turn(reading, robot.kind);
         }
         let report = external.advance(&turns, false);
@@ -100,12 +114,21 @@ fn eval_is_one_in_the_band_and_falls_outside_it() {
 
     // two robots on cells equally far from the centre: the as-written
     // robot term is exactly 1 (no pucks: Eval 1)
-    let robots = [(Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie), (Vec2::new(600.0, 400.0), 0.0, RobotKind::Outie)];
+    let robots = [
+        (Vec2::new(200.0, 400.0), 0.0, RobotKind::Outie),
+        (Vec2::new(600.0, 400.0), 0.0, RobotKind::Outie),
+    ];
     let two = World::scene(&c, &robots, &[], 1);
-    assert_eq!(eval_prime(&two, &f, &c.thresholds, EvalPrime::AsWritten, 0.6, 0.4), 1.0);
+    assert_eq!(
+        eval_prime(&two, &f, &c.thresholds, EvalPrime::AsWritten, 0.6, 0.4),
+        1.0
+    );
     // 400 apart in an 800 arena: spread term 400 / (800 sqrt 2)
     let spread = eval_prime(&two, &f, &c.thresholds, EvalPrime::Spread, 0.6, 0.4);
-    assert!((spread - (0.6 + 0.4 * 400.0 / (800.0 * 2f64.sqrt()))).abs() < 1e-9, "{spread}");
+    assert!(
+        (spread - (0.6 + 0.4 * 400.0 / (800.0 * 2f64.sqrt()))).abs() < 1e-9,
+        "{spread}"
+    );
 }
 
 /// Counts what a controller is told.
@@ -133,10 +156,19 @@ impl<C: Controller> Controller for Recorder<C> {
 fn eval_is_reported_at_checks_or_every_step_on_request() {
     for every_step in [false, true] {
         let mut sim = standard(2);
-        let mut rec = Recorder { inner: oc(), every_step, evals: 0, ends: 0 };
+        let mut rec = Recorder {
+            inner: oc(),
+            every_step,
+            evals: 0,
+            ends: 0,
+        };
         sim.run(&mut rec, 1000);
         assert_eq!(rec.evals, if every_step { 1000 } else { 10 });
-        assert_eq!(sim.totals().eval_checks, 10, "the mean uses the checks only");
+        assert_eq!(
+            sim.totals().eval_checks,
+            10,
+            "the mean uses the checks only"
+        );
     }
 }
 
@@ -146,23 +178,42 @@ fn eval_is_reported_at_checks_or_every_step_on_request() {
 fn orbital_construction_forms_the_annulus_and_random_does_not() {
     const STEPS: u64 = 40_000;
     let run = |controller| {
-        let scenario = Scenario { controller, ..Scenario::default() };
+        let scenario = Scenario {
+            controller,
+            ..Scenario::default()
+        };
         let (mut sim, mut c) = scenario.build().unwrap();
-        let mut rec = Recorder { inner: &mut c, every_step: false, evals: 0, ends: 0 };
+        let mut rec = Recorder {
+            inner: &mut c,
+            every_step: false,
+            evals: 0,
+            ends: 0,
+        };
         sim.run(&mut rec, STEPS);
         (sim.totals().clone(), rec.ends)
     };
     let (oc, oc_ends) = run(ControllerChoice::Orbital);
     let (random, _) = run(ControllerChoice::Random);
-    assert!(oc.formations >= 1, "orbital construction formed nothing in {STEPS} steps");
-    assert_eq!(oc_ends, oc.formations + oc.stuck, "every ended episode was reported");
+    assert!(
+        oc.formations >= 1,
+        "orbital construction formed nothing in {STEPS} steps"
+    );
+    assert_eq!(
+        oc_ends,
+        oc.formations + oc.stuck,
+        "every ended episode was reported"
+    );
     assert_eq!(random.formations, 0);
     assert!(oc.mean_eval() > random.mean_eval());
 }
 
 /// The annulus with 4 innies, seed 4, checks every `interval` steps against
 /// `threshold`, and `more` episode settings.
-fn checked(interval: u64, threshold: f64, more: impl FnOnce(&mut sim::EpisodeConfig)) -> Simulation {
+fn checked(
+    interval: u64,
+    threshold: f64,
+    more: impl FnOnce(&mut sim::EpisodeConfig),
+) -> Simulation {
     let mut config = SimConfig::default();
     config.world.innies = 4;
     config.episode.check_interval = interval;
@@ -179,7 +230,14 @@ fn signals_at_checks(interval: u64, checks: usize) -> Vec<(f64, f64)> {
     let mut controller = oc();
     let measure = |sim: &Simulation| {
         let c = sim.config();
-        let prime = eval_prime(sim.world(), sim.field(), &c.thresholds, EvalPrime::AsWritten, c.episode.phi, c.episode.nu);
+        let prime = eval_prime(
+            sim.world(),
+            sim.field(),
+            &c.thresholds,
+            EvalPrime::AsWritten,
+            c.episode.phi,
+            c.episode.nu,
+        );
         (sim.eval(), prime)
     };
     let mut out = vec![measure(&sim)];
@@ -191,7 +249,12 @@ fn signals_at_checks(interval: u64, checks: usize) -> Vec<(f64, f64)> {
 }
 
 /// The step of the first formation with these episode settings, seed 4.
-fn first_formation(interval: u64, threshold: f64, stale: bool, signal: sim::SuccessSignal) -> Option<u64> {
+fn first_formation(
+    interval: u64,
+    threshold: f64,
+    stale: bool,
+    signal: sim::SuccessSignal,
+) -> Option<u64> {
     let mut sim = checked(interval, threshold, |e| {
         e.stale_eval = stale;
         e.success_signal = signal;
@@ -202,7 +265,9 @@ fn first_formation(interval: u64, threshold: f64, stale: bool, signal: sim::Succ
 
 /// The first check (from 1) whose value exceeds every earlier one and the start's.
 fn first_record(values: &[f64]) -> usize {
-    (1..values.len()).find(|&k| values[k] > values[..k].iter().cloned().fold(f64::MIN, f64::max)).unwrap()
+    (1..values.len())
+        .find(|&k| values[k] > values[..k].iter().cloned().fold(f64::MIN, f64::max))
+        .unwrap()
 }
 
 #[test]
@@ -212,8 +277,14 @@ fn a_stale_check_forms_one_check_after_the_world_formed() {
     let k = first_record(&evals);
     // a threshold just below check k's Eval, above every earlier one
     let threshold = evals[k] - 1e-12;
-    assert_eq!(first_formation(500, threshold, false, sim::SuccessSignal::Eval), Some(500 * k as u64));
-    assert_eq!(first_formation(500, threshold, true, sim::SuccessSignal::Eval), Some(500 * (k as u64 + 1)));
+    assert_eq!(
+        first_formation(500, threshold, false, sim::SuccessSignal::Eval),
+        Some(500 * k as u64)
+    );
+    assert_eq!(
+        first_formation(500, threshold, true, sim::SuccessSignal::Eval),
+        Some(500 * (k as u64 + 1))
+    );
 }
 
 #[test]
@@ -222,10 +293,17 @@ fn checks_can_test_eval_prime_instead_of_eval() {
     let primes: Vec<f64> = signals.iter().map(|s| s.1).collect();
     let k = first_record(&primes);
     let threshold = primes[k] - 1e-12;
-    assert_eq!(first_formation(500, threshold, false, sim::SuccessSignal::EvalPrime), Some(500 * k as u64));
+    assert_eq!(
+        first_formation(500, threshold, false, sim::SuccessSignal::EvalPrime),
+        Some(500 * k as u64)
+    );
     // Eval crosses that threshold at another check (or never) in this run
     let by_eval = signals.iter().position(|s| s.0 > threshold);
-    assert_ne!(by_eval, Some(k), "the test needs Eval and Eval' to differ: {signals:?}");
+    assert_ne!(
+        by_eval,
+        Some(k),
+        "the test needs Eval and Eval' to differ: {signals:?}"
+    );
 }
 
 #[test]
@@ -241,12 +319,17 @@ fn a_checkpoint_of_a_stale_checking_run_resumes_bit_exactly() {
     let mut controller = oc();
     let mut straight = stale();
     straight.run(&mut controller, 9000);
-    assert!(straight.totals().formations > 0, "the run should form: {:?}", straight.totals());
+    assert!(
+        straight.totals().formations > 0,
+        "the run should form: {:?}",
+        straight.totals()
+    );
 
     let mut first = stale();
     first.run(&mut controller, 4500);
     assert!(first.state().checked_signal.is_some());
-    let state: SimulationState = serde_json::from_str(&serde_json::to_string(first.state()).unwrap()).unwrap();
+    let state: SimulationState =
+        serde_json::from_str(&serde_json::to_string(first.state()).unwrap()).unwrap();
     let sensors = sim::DiscSensors::new(&state.config.sensors, state.config.world.robot_radius);
     let mut resumed = Simulation::resume(state, Arc::new(ScalarField::annulus()), sensors);
     resumed.run(&mut controller, 4500);

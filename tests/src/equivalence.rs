@@ -7,10 +7,12 @@
 //! `docs/equivalence.md` describes the checks and their figures.
 
 use anyhow::{bail, Context, Result};
+use shared::{
+    ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, Role, State,
+};
 use sim::scenario::{Arena, ControllerChoice, Scenario};
 use sim::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::{ArenaSpec, FieldSource, RobotObservation, RobotSensors};
-use shared::{ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, Role, State};
 use std::path::Path;
 
 /// CPU cycles per Timer3 tick (clk/64): the RC time resolution.
@@ -71,7 +73,12 @@ pub fn sample_states(
             if samples.len() == count {
                 break;
             }
-            samples.push(Sample { field: name.clone(), step: sim.totals().steps, robot, observation: observation.clone() });
+            samples.push(Sample {
+                field: name.clone(),
+                step: sim.totals().steps,
+                robot,
+                observation: observation.clone(),
+            });
         }
     }
     Ok(samples)
@@ -103,12 +110,18 @@ impl<'a> Expectation<'a> {
     /// Expectations of `policy` on a robot of `role` (the firmware's, from
     /// its robot id) with sensor model `model`.
     pub fn new(model: &'a RobotSensors, policy: &'a PolicyBlob, role: Role) -> Expectation<'a> {
-        Expectation { model, policy, role }
+        Expectation {
+            model,
+            policy,
+            role,
+        }
     }
 
     /// The state of raw times (ticks) and a camera frame.
     pub fn state(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> State {
-        self.policy.hasher().hash_as(&self.model.reading(ticks, frame), self.role)
+        self.policy
+            .hasher()
+            .hash_as(&self.model.reading(ticks, frame), self.role)
     }
 
     /// Everything the firmware must do with raw times and a frame.
@@ -116,7 +129,12 @@ impl<'a> Expectation<'a> {
         let state = self.state(ticks, frame);
         let action = self.policy.table().action(state);
         let motors = RobotProfile::ZUMO.action_motors(self.policy.actions());
-        Expected { state, action, command: motors.command(action), outputs: motors.outputs(action) }
+        Expected {
+            state,
+            action,
+            command: motors.command(action),
+            outputs: motors.outputs(action),
+        }
     }
 }
 
@@ -125,7 +143,13 @@ impl<'a> Expectation<'a> {
 /// firmware must disagree with expectations computed from it.)
 pub fn mirrored(ticks: &[u16; 3], frame: &[PixyBlock]) -> ([u16; 3], Vec<PixyBlock>) {
     let width = shared::camera::IMAGE_WIDTH - 1;
-    let frame = frame.iter().map(|b| PixyBlock { x: width - b.x, ..*b }).collect();
+    let frame = frame
+        .iter()
+        .map(|b| PixyBlock {
+            x: width - b.x,
+            ..*b
+        })
+        .collect();
     ([ticks[2], ticks[1], ticks[0]], frame)
 }
 
@@ -135,7 +159,11 @@ pub fn mirrored(ticks: &[u16; 3], frame: &[PixyBlock]) -> ([u16; 3], Vec<PixyBlo
 pub fn is_robust(ticks: &[u16; 3], state_of: &impl Fn(&[u16; 3]) -> State) -> bool {
     let state = state_of(ticks);
     let m = EDGE_MARGIN_TICKS;
-    (-m..=m).all(|a| (-m..=m).all(|b| (-m..=m).all(|c| moved(ticks, [a, b, c]).is_none_or(|t| state_of(&t) == state))))
+    (-m..=m).all(|a| {
+        (-m..=m).all(|b| {
+            (-m..=m).all(|c| moved(ticks, [a, b, c]).is_none_or(|t| state_of(&t) == state))
+        })
+    })
 }
 
 /// `ticks` moved by `delta`, or `None` if a time would leave 0..=65535.
@@ -165,7 +193,10 @@ pub fn nudge(ticks: &[u16; 3], state_of: &impl Fn(&[u16; 3]) -> State) -> Option
         return Some(*ticks);
     }
     let state = state_of(ticks);
-    let candidates: Vec<[u16; 3]> = moves(NUDGE_REACH).into_iter().filter_map(|d| moved(ticks, d)).collect();
+    let candidates: Vec<[u16; 3]> = moves(NUDGE_REACH)
+        .into_iter()
+        .filter_map(|d| moved(ticks, d))
+        .collect();
     candidates
         .iter()
         .find(|t| state_of(t) == state && is_robust(t, state_of))
@@ -176,8 +207,14 @@ pub fn nudge(ticks: &[u16; 3], state_of: &impl Fn(&[u16; 3]) -> State) -> Option
 /// Explains an end-to-end disagreement: a move of each time by at most its
 /// resolution (one tick) under which the times hash to `firmware_state`
 /// (the camera's blocks are served exactly, so they never move).
-pub fn explain(ticks: &[u16; 3], firmware_state: State, state_of: &impl Fn(&[u16; 3]) -> State) -> Option<[i32; 3]> {
-    moves(1).into_iter().find(|d| moved(ticks, *d).is_some_and(|t| state_of(&t) == firmware_state))
+pub fn explain(
+    ticks: &[u16; 3],
+    firmware_state: State,
+    state_of: &impl Fn(&[u16; 3]) -> State,
+) -> Option<[i32; 3]> {
+    moves(1)
+        .into_iter()
+        .find(|d| moved(ticks, *d).is_some_and(|t| state_of(&t) == firmware_state))
 }
 
 /// The RC delay (CPU cycles after the pin becomes an input) of a discharge
@@ -195,7 +232,9 @@ pub fn cycles_of_ticks(ticks: u16, latency_us: f64) -> u64 {
 
 /// Reads a policy of `policies/` (by file name); the error says how to get one.
 pub fn read_policy(file: &str) -> Result<(std::path::PathBuf, PolicyBlob)> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies").join(file);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../policies")
+        .join(file);
     if !path.exists() {
         bail!(
             "{} is missing: train it with `host train --sensors robot` (policies/README.md)",
@@ -211,7 +250,10 @@ pub fn check_elf_embeds(elf: &Path, policy: &PolicyBlob, rebuild: &str) -> Resul
     let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
     let table = policy.table().packed();
     if !bytes.windows(table.len()).any(|w| w == table) {
-        bail!("{} does not embed this policy's table (a stale build): rebuild it with `{rebuild}`", elf.display());
+        bail!(
+            "{} does not embed this policy's table (a stale build): rebuild it with `{rebuild}`",
+            elf.display()
+        );
     }
     Ok(())
 }
@@ -219,8 +261,8 @@ pub fn check_elf_embeds(elf: &Path, policy: &PolicyBlob, rebuild: &str) -> Resul
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sim::RobotSensorConfig;
     use shared::StateHasher;
+    use sim::RobotSensorConfig;
 
     /// A toy state: the mid time's bin of 10 ticks, and left < right.
     fn toy(t: &[u16; 3]) -> State {
@@ -230,9 +272,15 @@ mod tests {
     #[test]
     fn robustness_means_two_ticks_from_every_edge() {
         assert!(is_robust(&[5, 15, 50], &toy));
-        assert!(!is_robust(&[5, 18, 50], &toy), "18 + 2 crosses the bin edge at 20");
+        assert!(
+            !is_robust(&[5, 18, 50], &toy),
+            "18 + 2 crosses the bin edge at 20"
+        );
         assert!(!is_robust(&[5, 11, 50], &toy));
-        assert!(!is_robust(&[49, 15, 50], &toy), "left and right within 2 ticks");
+        assert!(
+            !is_robust(&[49, 15, 50], &toy),
+            "left and right within 2 ticks"
+        );
     }
 
     #[test]
@@ -242,7 +290,10 @@ mod tests {
         assert_eq!(n, [5, 17, 50]);
         assert_eq!(toy(&n), toy(&[5, 18, 50]));
         let n = nudge(&[49, 15, 50], &toy).unwrap();
-        assert!(is_robust(&n, &toy) && toy(&n) == toy(&[49, 15, 50]), "{n:?}");
+        assert!(
+            is_robust(&n, &toy) && toy(&n) == toy(&[49, 15, 50]),
+            "{n:?}"
+        );
     }
 
     #[test]
@@ -260,7 +311,14 @@ mod tests {
         let policy = read_policy("robot-annulus-10bit.policy").unwrap().1;
         assert_eq!(policy.hasher(), StateHasher::OriginalObstacle);
         let e = Expectation::new(&model, &policy, shared::Role::Outie);
-        let puck = PixyBlock { signature: 1, x: 40, y: 150, width: 30, height: 20, angle: 0 };
+        let puck = PixyBlock {
+            signature: 1,
+            x: 40,
+            y: 150,
+            width: 30,
+            height: 20,
+            angle: 0,
+        };
         let ticks = [100, 200, 300];
         let (mt, mf) = mirrored(&ticks, &[puck]);
         assert_eq!(mt, [300, 200, 100]);

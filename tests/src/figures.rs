@@ -60,8 +60,13 @@ pub fn compiler_of(elf: &Path) -> String {
         .position(|w| w == needle)
         .and_then(|i| {
             let rest = &bytes[i..];
-            let end = rest.iter().position(|b| *b == 0 || *b == b'(').unwrap_or(rest.len().min(40));
-            std::str::from_utf8(&rest[..end]).ok().map(|s| s.trim().replace("rustc version", "rustc"))
+            let end = rest
+                .iter()
+                .position(|b| *b == 0 || *b == b'(')
+                .unwrap_or(rest.len().min(40));
+            std::str::from_utf8(&rest[..end])
+                .ok()
+                .map(|s| s.trim().replace("rustc version", "rustc"))
         })
         .unwrap_or_else(|| "an unknown compiler".to_string())
 }
@@ -74,7 +79,10 @@ pub fn workspace() -> PathBuf {
 impl Figures {
     /// Figures measured on firmware built by `compiler` ([`compiler_of`]).
     pub fn new(compiler: &str) -> Figures {
-        Figures { compiler: compiler.to_string(), ..Figures::default() }
+        Figures {
+            compiler: compiler.to_string(),
+            ..Figures::default()
+        }
     }
 
     /// Adds a table row that does not depend on the compiler.
@@ -88,13 +96,19 @@ impl Figures {
     }
 
     fn compiler_line(&self) -> String {
-        format!("Compiler-dependent figures below: firmware built by {}.", self.compiler)
+        format!(
+            "Compiler-dependent figures below: firmware built by {}.",
+            self.compiler
+        )
     }
 
     /// The section's lines between the markers: a table header, the fixed
     /// rows, the compiler line, then the compiler's rows.
     fn body(&self, header: &[&str]) -> String {
-        let mut out = vec![row(header), row(&header.iter().map(|_| "---").collect::<Vec<_>>())];
+        let mut out = vec![
+            row(header),
+            row(&header.iter().map(|_| "---").collect::<Vec<_>>()),
+        ];
         out.extend(self.fixed.iter().cloned());
         out.push(String::new());
         out.push(self.compiler_line());
@@ -114,7 +128,8 @@ impl Figures {
         let end = format!("<!-- figures:{name} end -->");
         let body = self.body(header);
         let _guard = WRITING.lock().unwrap_or_else(|e| e.into_inner());
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         let (Some(b), Some(e)) = (text.find(&begin), text.find(&end)) else {
             bail!("{doc} has no section `{begin}` ... `{end}`: add the two marker lines, then run `{command}`");
         };
@@ -132,13 +147,20 @@ impl Figures {
         }
         let committed_lines: Vec<&str> = committed.lines().collect();
         let split = |lines: &[&str]| -> (Vec<String>, Option<String>, Vec<String>) {
-            match lines.iter().position(|l| l.starts_with("Compiler-dependent figures below")) {
+            match lines
+                .iter()
+                .position(|l| l.starts_with("Compiler-dependent figures below"))
+            {
                 Some(i) => (
                     lines[..i].iter().map(|s| s.to_string()).collect(),
                     Some(lines[i].to_string()),
                     lines[i + 1..].iter().map(|s| s.to_string()).collect(),
                 ),
-                None => (lines.iter().map(|s| s.to_string()).collect(), None, Vec::new()),
+                None => (
+                    lines.iter().map(|s| s.to_string()).collect(),
+                    None,
+                    Vec::new(),
+                ),
             }
         };
         let body_lines: Vec<&str> = body.lines().collect();
@@ -167,15 +189,25 @@ impl Figures {
 }
 
 fn row(cells: &[impl AsRef<str>]) -> String {
-    format!("| {} |", cells.iter().map(|c| c.as_ref()).collect::<Vec<_>>().join(" | "))
+    format!(
+        "| {} |",
+        cells
+            .iter()
+            .map(|c| c.as_ref())
+            .collect::<Vec<_>>()
+            .join(" | ")
+    )
 }
 
 /// Writes `text` to `path` through a temporary file in the same directory.
 fn write_atomically(path: &Path, text: &str) -> Result<()> {
     let dir = path.parent().unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(|| format!("cannot write in {}", dir.display()))?;
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("cannot write in {}", dir.display()))?;
     std::io::Write::write_all(&mut tmp, text.as_bytes())?;
-    tmp.persist(path).map_err(|e| e.error).with_context(|| format!("cannot replace {}", path.display()))?;
+    tmp.persist(path)
+        .map_err(|e| e.error)
+        .with_context(|| format!("cannot replace {}", path.display()))?;
     Ok(())
 }
 
@@ -214,23 +246,39 @@ mod tests {
         let path = doc(dir.path(), &text);
         let rel = path.to_str().unwrap();
         // Paths are taken relative to the workspace; an absolute one replaces it.
-        assert_eq!(f.check(rel, "x", &["figure", "value"], "make it").unwrap(), Outcome::Current);
+        assert_eq!(
+            f.check(rel, "x", &["figure", "value"], "make it").unwrap(),
+            Outcome::Current
+        );
 
         let mut other = Figures::new("rustc 1.99.0");
         other.fixed(&["states", "1,020"]);
         other.compiled(&["cycles", "950"]);
-        let Outcome::OtherCompiler(m) = other.check(rel, "x", &["figure", "value"], "make it").unwrap() else { panic!() };
-        assert!(m.contains("rustc 1.95.0") && m.contains("rustc 1.99.0") && m.contains("`make it`"), "{m}");
+        let Outcome::OtherCompiler(m) = other
+            .check(rel, "x", &["figure", "value"], "make it")
+            .unwrap()
+        else {
+            panic!()
+        };
+        assert!(
+            m.contains("rustc 1.95.0") && m.contains("rustc 1.99.0") && m.contains("`make it`"),
+            "{m}"
+        );
 
         let mut stale = Figures::new("rustc 1.95.0");
         stale.fixed(&["states", "1,021"]);
         stale.compiled(&["cycles", "900"]);
-        let e = stale.check(rel, "x", &["figure", "value"], "make it").unwrap_err().to_string();
+        let e = stale
+            .check(rel, "x", &["figure", "value"], "make it")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("stale") && e.contains("`make it`"), "{e}");
         let mut slower = Figures::new("rustc 1.95.0");
         slower.fixed(&["states", "1,020"]);
         slower.compiled(&["cycles", "901"]);
-        assert!(slower.check(rel, "x", &["figure", "value"], "make it").is_err());
+        assert!(slower
+            .check(rel, "x", &["figure", "value"], "make it")
+            .is_err());
         assert_eq!(thousands(1_234_567), "1,234,567");
         assert_eq!(thousands(12), "12");
     }

@@ -98,7 +98,10 @@ pub fn firmware_elf() -> PathBuf {
 /// The ELF a build wrote to `target/avr-none/<dir>/firmware.elf`; panics
 /// saying to run `build` (the command that writes it) if it is missing.
 pub fn firmware_elf_in(dir: &str, build: &str) -> PathBuf {
-    let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/avr-none").join(dir).join("firmware.elf");
+    let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../target/avr-none")
+        .join(dir)
+        .join("firmware.elf");
     assert!(
         elf.exists(),
         "the firmware ELF {} is missing: run `{build}` (needs gcc-avr, avr-libc and the rust-src \
@@ -116,7 +119,12 @@ thread_local! {
     static LAST_AVR: Cell<*mut ffi::avr_t> = const { Cell::new(null_mut()) };
 }
 
-unsafe extern "C" fn capture_handle(avr: *mut ffi::avr_t, _: c_int, _: *const c_char, _: *mut ffi::__va_list_tag) {
+unsafe extern "C" fn capture_handle(
+    avr: *mut ffi::avr_t,
+    _: c_int,
+    _: *const c_char,
+    _: *mut ffi::__va_list_tag,
+) {
     if !avr.is_null() {
         LAST_AVR.with(|c| c.set(avr));
     }
@@ -135,7 +143,10 @@ fn load(elf: &Path) -> (AvrTester, *mut ffi::avr_t) {
     LAST_AVR.with(|c| c.set(null_mut()));
     let tester = AvrTester::atmega32u4().with_clock_of_16_mhz().load(elf);
     let avr = LAST_AVR.with(|c| c.get());
-    assert!(!avr.is_null(), "simavr did not pass its handle to the logger");
+    assert!(
+        !avr.is_null(),
+        "simavr did not pass its handle to the logger"
+    );
     (tester, avr)
 }
 
@@ -195,18 +206,32 @@ impl Encoder {
     }
 }
 
-unsafe extern "C" fn on_encoder_edge(_: *mut ffi::avr_t, when: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+unsafe extern "C" fn on_encoder_edge(
+    _: *mut ffi::avr_t,
+    when: ffi::avr_cycle_count_t,
+    param: *mut c_void,
+) -> u64 {
     // SAFETY: `param` is a boxed `Encoder` of the `Zumo`, which outlives the core's timers.
     let e = unsafe { &mut *(param as *mut Encoder) };
-    let Some((every, forward)) = e.every else { return 0 };
-    e.phase = if forward { (e.phase + 1) % 4 } else { (e.phase + 3) % 4 };
+    let Some((every, forward)) = e.every else {
+        return 0;
+    };
+    e.phase = if forward {
+        (e.phase + 1) % 4
+    } else {
+        (e.phase + 3) % 4
+    };
     e.steps += if forward { 1 } else { -1 };
     // SAFETY: the core is live while it runs its timers.
     unsafe { e.drive() };
     when + every
 }
 
-unsafe extern "C" fn on_pullup_check(avr: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+unsafe extern "C" fn on_pullup_check(
+    avr: *mut ffi::avr_t,
+    _: ffi::avr_cycle_count_t,
+    param: *mut c_void,
+) -> u64 {
     // SAFETY: as in `on_discharged`.
     let sensor = unsafe { &*(param as *const RcSensor) };
     // SAFETY: simavr passes its live core.
@@ -282,11 +307,19 @@ impl ExternalPins {
         };
         let (mask, value) = &mut self.ports[index];
         *mask |= pin.mask();
-        *value = if high { *value | pin.mask() } else { *value & !pin.mask() };
+        *value = if high {
+            *value | pin.mask()
+        } else {
+            *value & !pin.mask()
+        };
         // SAFETY: the caller's contract.
         unsafe {
             set_external(self.avr, pin.port, *mask, *value);
-            let irq = ffi::avr_io_getirq(self.avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit));
+            let irq = ffi::avr_io_getirq(
+                self.avr,
+                ioctl(b'i', b'o', b'g', pin.port.letter()),
+                c_int::from(pin.bit),
+            );
             ffi::avr_raise_irq(irq, u32::from(high));
         }
     }
@@ -307,7 +340,13 @@ unsafe fn set_external(avr: *mut ffi::avr_t, port: Port, mask: u8, value: u8) {
     ext.set_mask(u64::from(mask));
     ext.set_value(u64::from(value));
     // SAFETY: the caller's contract; `ext` is the ioport's external-state record.
-    unsafe { ffi::avr_ioctl(avr, ioctl(b'i', b'o', b'p', port.letter()), &mut ext as *mut _ as *mut c_void) };
+    unsafe {
+        ffi::avr_ioctl(
+            avr,
+            ioctl(b'i', b'o', b'p', port.letter()),
+            &mut ext as *mut _ as *mut c_void,
+        )
+    };
 }
 
 /// The emulated Pixy: a byte queue refilled with the current scene once per
@@ -378,7 +417,12 @@ unsafe extern "C" fn on_uart(_: *mut ffi::avr_irq_t, value: u32, param: *mut c_v
     state.uart.push(value as u8);
 }
 
-unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v: u8, param: *mut c_void) {
+unsafe extern "C" fn on_gpior0(
+    avr: *mut ffi::avr_t,
+    addr: ffi::avr_io_addr_t,
+    v: u8,
+    param: *mut c_void,
+) {
     // SAFETY: simavr passes its live core and an address inside its data
     // space; `param` is the boxed `State`, as in `on_uart`.
     unsafe {
@@ -389,7 +433,11 @@ unsafe extern "C" fn on_gpior0(avr: *mut ffi::avr_t, addr: ffi::avr_io_addr_t, v
     }
 }
 
-unsafe extern "C" fn on_discharged(avr: *mut ffi::avr_t, _: ffi::avr_cycle_count_t, param: *mut c_void) -> u64 {
+unsafe extern "C" fn on_discharged(
+    avr: *mut ffi::avr_t,
+    _: ffi::avr_cycle_count_t,
+    param: *mut c_void,
+) -> u64 {
     // SAFETY: `param` points into the boxed `State`'s sensors (registered in
     // `on_ddr`); its IRQ is the pin's, valid while the core lives.
     let sensor = unsafe { &*(param as *const RcSensor) };
@@ -425,16 +473,30 @@ unsafe fn on_ddr(port: Port, value: u32, param: *mut c_void) {
             // SAFETY: the core is live; the sensor lives in the boxed
             // state, which outlives every timer of the core.
             unsafe {
-                ffi::avr_cycle_timer_register(state.avr, PULLUP_CHECK_CYCLES, Some(on_pullup_check), sensor as *mut c_void);
+                ffi::avr_cycle_timer_register(
+                    state.avr,
+                    PULLUP_CHECK_CYCLES,
+                    Some(on_pullup_check),
+                    sensor as *mut c_void,
+                );
                 if let Some(delay) = state.delays[i] {
-                    ffi::avr_cycle_timer_register(state.avr, delay, Some(on_discharged), sensor as *mut c_void);
+                    ffi::avr_cycle_timer_register(
+                        state.avr,
+                        delay,
+                        Some(on_discharged),
+                        sensor as *mut c_void,
+                    );
                 }
             }
         } else if old & mask == 0 && new & mask != 0 {
             // SAFETY: as above; cancelling an unregistered timer is a no-op.
             unsafe {
                 ffi::avr_cycle_timer_cancel(state.avr, Some(on_discharged), sensor as *mut c_void);
-                ffi::avr_cycle_timer_cancel(state.avr, Some(on_pullup_check), sensor as *mut c_void);
+                ffi::avr_cycle_timer_cancel(
+                    state.avr,
+                    Some(on_pullup_check),
+                    sensor as *mut c_void,
+                );
             }
         }
     }
@@ -484,7 +546,13 @@ impl Zumo {
         let pullup_on = Rc::new(Cell::new(0));
         let pin_irq = |pin: Pin| {
             // SAFETY: `avr` is the core just loaded; null IRQs are checked below.
-            unsafe { ffi::avr_io_getirq(avr, ioctl(b'i', b'o', b'g', pin.port.letter()), c_int::from(pin.bit)) }
+            unsafe {
+                ffi::avr_io_getirq(
+                    avr,
+                    ioctl(b'i', b'o', b'g', pin.port.letter()),
+                    c_int::from(pin.bit),
+                )
+            }
         };
         let mut state = Box::new(State {
             avr,
@@ -500,10 +568,21 @@ impl Zumo {
                 pullup_on: pullup_on.clone(),
             }),
         });
-        let mut external = Box::new(ExternalPins { avr, ports: [(0, 0); 5] });
+        let mut external = Box::new(ExternalPins {
+            avr,
+            ports: [(0, 0); 5],
+        });
         let external_ptr = &mut *external as *mut ExternalPins;
         let encoder = |xor: Pin, b: Pin| {
-            Box::new(Encoder { avr, pins: external_ptr, xor, b, phase: 0, every: None, steps: 0 })
+            Box::new(Encoder {
+                avr,
+                pins: external_ptr,
+                xor,
+                b,
+                phase: 0,
+                every: None,
+                steps: 0,
+            })
         };
         let encoders = [
             encoder(pins::ENCODER_LEFT_XOR, pins::ENCODER_LEFT_B),
@@ -520,15 +599,33 @@ impl Zumo {
         // SAFETY: `avr` is the live core; the callbacks get the boxed state,
         // which `Zumo` drops after the simulator (field order).
         unsafe {
-            assert!(state.sensors.iter().all(|s| !s.irq.is_null()), "no field sensor pins");
+            assert!(
+                state.sensors.iter().all(|s| !s.irq.is_null()),
+                "no field sensor pins"
+            );
             // USART1: bytes out, not to stdout.
             let mut flags: u32 = 0;
-            ffi::avr_ioctl(avr, ioctl(b'u', b'a', b'g', b'1'), &mut flags as *mut u32 as *mut c_void);
+            ffi::avr_ioctl(
+                avr,
+                ioctl(b'u', b'a', b'g', b'1'),
+                &mut flags as *mut u32 as *mut c_void,
+            );
             flags &= !ffi::AVR_UART_FLAG_STDIO;
-            ffi::avr_ioctl(avr, ioctl(b'u', b'a', b's', b'1'), &mut flags as *mut u32 as *mut c_void);
-            let uart = ffi::avr_io_getirq(avr, ioctl(b'u', b'a', b'r', b'1'), ffi::UART_IRQ_OUTPUT as c_int);
+            ffi::avr_ioctl(
+                avr,
+                ioctl(b'u', b'a', b's', b'1'),
+                &mut flags as *mut u32 as *mut c_void,
+            );
+            let uart = ffi::avr_io_getirq(
+                avr,
+                ioctl(b'u', b'a', b'r', b'1'),
+                ffi::UART_IRQ_OUTPUT as c_int,
+            );
             ffi::avr_irq_register_notify(uart, Some(on_uart), state_ptr as *mut c_void);
-            for (port, f) in [(Port::F, on_ddr_f as unsafe extern "C" fn(_, _, _)), (Port::D, on_ddr_d)] {
+            for (port, f) in [
+                (Port::F, on_ddr_f as unsafe extern "C" fn(_, _, _)),
+                (Port::D, on_ddr_d),
+            ] {
                 let irq = ffi::avr_io_getirq(
                     avr,
                     ioctl(b'i', b'o', b'g', port.letter()),
@@ -554,9 +651,19 @@ impl Zumo {
             bytes: VecDeque::new(),
             last_frame: 0,
         }));
-        let mut zumo =
-            Zumo { tester, state, pixy: pixy.clone(), encoders, i2c, external, decoded: 0, pullup_on };
-        zumo.tester.twi0().attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
+        let mut zumo = Zumo {
+            tester,
+            state,
+            pixy: pixy.clone(),
+            encoders,
+            i2c,
+            external,
+            decoded: 0,
+            pullup_on,
+        };
+        zumo.tester
+            .twi0()
+            .attach_slave_fn(move |p| pixy.borrow_mut().on_packet(p));
         zumo.set_button(pins::BUTTON_A, false);
         zumo.set_button(pins::BUTTON_B_LED_GREEN, false);
         zumo
@@ -565,17 +672,37 @@ impl Zumo {
     /// Stores bytes in the simulated EEPROM.
     pub fn write_eeprom(&mut self, offset: u16, bytes: &[u8]) {
         let mut copy = bytes.to_vec();
-        let mut desc = EepromDesc { ee: copy.as_mut_ptr(), offset, size: copy.len() as u32 };
+        let mut desc = EepromDesc {
+            ee: copy.as_mut_ptr(),
+            offset,
+            size: copy.len() as u32,
+        };
         // SAFETY: simavr copies `size` bytes from `ee`, which holds them.
-        let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b's', b'p'), &mut desc as *mut _ as *mut c_void) };
+        let r = unsafe {
+            ffi::avr_ioctl(
+                self.state.avr,
+                ioctl(b'e', b'e', b's', b'p'),
+                &mut desc as *mut _ as *mut c_void,
+            )
+        };
         assert_eq!(r, 0, "EEPROM write refused");
     }
 
     /// Reads bytes of the simulated EEPROM.
     pub fn read_eeprom(&mut self, offset: u16, len: usize) -> Vec<u8> {
-        let mut desc = EepromDesc { ee: null_mut(), offset, size: len as u32 };
+        let mut desc = EepromDesc {
+            ee: null_mut(),
+            offset,
+            size: len as u32,
+        };
         // SAFETY: simavr points `ee` at its EEPROM at `offset`.
-        let r = unsafe { ffi::avr_ioctl(self.state.avr, ioctl(b'e', b'e', b'g', b'p'), &mut desc as *mut _ as *mut c_void) };
+        let r = unsafe {
+            ffi::avr_ioctl(
+                self.state.avr,
+                ioctl(b'e', b'e', b'g', b'p'),
+                &mut desc as *mut _ as *mut c_void,
+            )
+        };
         assert_eq!(r, 0, "EEPROM read refused");
         // SAFETY: the read succeeded, so `ee` points at `len` bytes of the
         // core's EEPROM (offset + len within it, or simavr refuses).
@@ -620,7 +747,9 @@ impl Zumo {
             e.every = (rate != 0).then(|| (CLOCK_HZ / u64::from(rate.unsigned_abs()), rate > 0));
             if let Some((every, _)) = e.every {
                 // SAFETY: as above.
-                unsafe { ffi::avr_cycle_timer_register(e.avr, every, Some(on_encoder_edge), param) };
+                unsafe {
+                    ffi::avr_cycle_timer_register(e.avr, every, Some(on_encoder_edge), param)
+                };
             }
         }
     }
@@ -697,7 +826,10 @@ impl Zumo {
     /// The procedure with a white screen of 100, 110, 120 ticks and a black
     /// one of 400, 410, 420 ticks.
     pub fn calibrate(&mut self) {
-        self.calibrate_ticks([Some(100), Some(110), Some(120)], [Some(400), Some(410), Some(420)]);
+        self.calibrate_ticks(
+            [Some(100), Some(110), Some(120)],
+            [Some(400), Some(410), Some(420)],
+        );
     }
 
     /// Runs the firmware for `ms` simulated milliseconds.
@@ -716,13 +848,19 @@ impl Zumo {
         while self.state.decisions == before {
             self.tester.run();
             // SAFETY: as above.
-            assert!(unsafe { (*self.state.avr).cycle } < deadline, "no decision within 100 ms");
+            assert!(
+                unsafe { (*self.state.avr).cycle } < deadline,
+                "no decision within 100 ms"
+            );
         }
         self.state.decisions
     }
 
     fn data(&self, addr: usize) -> u8 {
-        assert!(addr < RAM_END, "data address {addr:#x} outside the 32U4's data space");
+        assert!(
+            addr < RAM_END,
+            "data address {addr:#x} outside the 32U4's data space"
+        );
         // SAFETY: the core is live and `addr` lies in its data space.
         unsafe { *(*self.state.avr).data.add(addr) }
     }
@@ -739,7 +877,10 @@ impl Zumo {
     /// Direction pin levels (left, right); high = reverse.
     pub fn directions(&self) -> (bool, bool) {
         let b = self.data(PORTB);
-        (b & pins::DIR_LEFT.mask() != 0, b & pins::DIR_RIGHT.mask() != 0)
+        (
+            b & pins::DIR_LEFT.mask() != 0,
+            b & pins::DIR_RIGHT.mask() != 0,
+        )
     }
 
     /// Fills the free SRAM between the statics and the stack pointer with a
@@ -754,7 +895,9 @@ impl Zumo {
 
     /// Lowest SRAM address the stack has written since [`Zumo::paint_stack`].
     pub fn stack_low_water(&self) -> usize {
-        (STATICS_END..RAM_END).find(|a| self.data(*a) != PAINT).unwrap_or(RAM_END)
+        (STATICS_END..RAM_END)
+            .find(|a| self.data(*a) != PAINT)
+            .unwrap_or(RAM_END)
     }
 
     /// The word at SRAM 0x0800 (the bootloader's key).
@@ -773,7 +916,10 @@ impl Zumo {
     /// it discharged.
     pub fn frames(&mut self) -> Vec<Result<LogFrame, LogError>> {
         let pullups = self.pullup_on.get();
-        assert_eq!(pullups, 0, "the firmware left a field sensor's pull-up on while it discharged ({pullups} times)");
+        assert_eq!(
+            pullups, 0,
+            "the firmware left a field sensor's pull-up on while it discharged ({pullups} times)"
+        );
         let uart = &self.state.uart;
         let mut out = Vec::new();
         let mut start = self.decoded;
@@ -800,7 +946,13 @@ impl Zumo {
 
     /// Cycles between consecutive period starts.
     pub fn period_cycles(&self) -> Vec<u64> {
-        let starts: Vec<u64> = self.state.marks.iter().filter(|m| m.0 == 4).map(|m| m.1).collect();
+        let starts: Vec<u64> = self
+            .state
+            .marks
+            .iter()
+            .filter(|m| m.0 == 4)
+            .map(|m| m.1)
+            .collect();
         starts.windows(2).map(|w| w[1] - w[0]).collect()
     }
 

@@ -19,14 +19,17 @@
 //! `FIRMWARE_OUT`); a missing or stale one fails with the command to run.
 
 use firmware::calibration_record;
-use sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
 use rand::{RngExt, SeedableRng};
-use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, RunMode, State, StateHasher};
+use shared::{
+    ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, RunMode, State,
+    StateHasher,
+};
+use sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
 use std::collections::HashMap;
 use std::time::Instant;
 use tests::equivalence::{
-    check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, mirrored, nudge, read_policy, sample_states, Expectation,
-    Expected, Sample,
+    check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, mirrored, nudge, read_policy,
+    sample_states, Expectation, Expected, Sample,
 };
 use tests::figures::{compiler_of, thousands, Figures, Outcome};
 use tests::zumo::{firmware_elf_in, Zumo};
@@ -104,11 +107,20 @@ fn driving_zumo(elf: &std::path::Path, model: &RobotSensors, latency_us: f64) ->
     z.run_ms(40);
     let cal = model.calibration();
     let screen = |ticks: [u16; 3]| ticks.map(|t| Some(cycles_of_ticks(t, latency_us)));
-    z.calibrate_cycles(screen(cal.ranges.map(|r| r.bright)), screen(cal.ranges.map(|r| r.dark)));
-    let record: [u8; calibration_record::RECORD_LEN] =
-        z.read_eeprom(0, calibration_record::RECORD_LEN).try_into().expect("a record's bytes");
+    z.calibrate_cycles(
+        screen(cal.ranges.map(|r| r.bright)),
+        screen(cal.ranges.map(|r| r.dark)),
+    );
+    let record: [u8; calibration_record::RECORD_LEN] = z
+        .read_eeprom(0, calibration_record::RECORD_LEN)
+        .try_into()
+        .expect("a record's bytes");
     let stored = calibration_record::decode(&record);
-    assert_eq!(stored, Ok(cal), "the procedure must store the simulator's calibration (PhotoSensorConfig::calibration)");
+    assert_eq!(
+        stored,
+        Ok(cal),
+        "the procedure must store the simulator's calibration (PhotoSensorConfig::calibration)"
+    );
     z.press_a();
     z.run_to_decision();
     z
@@ -143,9 +155,19 @@ fn play(z: &mut Zumo, stimuli: &[Stimulus<'_>], holding: &mut bool) -> Vec<Obser
     periods
         .into_iter()
         .map(|(tick, duties, directions)| {
-            let frame = *frames.get(&tick).unwrap_or_else(|| panic!("no log frame for period {tick}"));
-            assert_eq!((frame.mode, frame.faults), (RunMode::Driving, Faults::NONE), "period {tick}: {frame:?}");
-            Observed { frame, duties, directions }
+            let frame = *frames
+                .get(&tick)
+                .unwrap_or_else(|| panic!("no log frame for period {tick}"));
+            assert_eq!(
+                (frame.mode, frame.faults),
+                (RunMode::Driving, Faults::NONE),
+                "period {tick}: {frame:?}"
+            );
+            Observed {
+                frame,
+                duties,
+                directions,
+            }
         })
         .collect()
 }
@@ -164,14 +186,20 @@ fn random_policy(like: &PolicyBlob, seed: u64) -> PolicyBlob {
     let mut rng = SimRng::seed_from_u64(seed);
     let mut table = PolicyTable::new(like.hasher());
     for s in 0..like.hasher().num_states() as u16 {
-        table.set(State(s), ActionId(rng.random_range(0..like.actions().len() as u8)));
+        table.set(
+            State(s),
+            ActionId(rng.random_range(0..like.actions().len() as u8)),
+        );
     }
     PolicyBlob::new(*like.actions(), table, like.provenance().clone()).expect("a valid blob")
 }
 
 fn samples_of(policy: &std::path::Path) -> Vec<Sample> {
-    let fields =
-        [(FieldSource::Annulus, 11), (FieldSource::Letter(Letter::T), 12), (FieldSource::Letter(Letter::L), 13)];
+    let fields = [
+        (FieldSource::Annulus, 11),
+        (FieldSource::Letter(Letter::T), 12),
+        (FieldSource::Letter(Letter::L), 13),
+    ];
     let mut samples = Vec::new();
     for (field, seed) in fields {
         let name = field.to_string();
@@ -203,7 +231,12 @@ fn percent(n: usize, of: usize) -> f64 {
 fn equivalence(v: &Variant) {
     let started = Instant::now();
     let (path, policy) = read_policy(v.policy).unwrap_or_else(|e| panic!("{e:#}"));
-    assert_eq!(policy.hasher(), v.hasher, "{} has the wrong hasher", path.display());
+    assert_eq!(
+        policy.hasher(),
+        v.hasher,
+        "{} has the wrong hasher",
+        path.display()
+    );
     let elf = firmware_elf_in(v.elf_dir, v.build);
     check_elf_embeds(&elf, &policy, v.build).unwrap_or_else(|e| panic!("{e:#}"));
 
@@ -227,14 +260,24 @@ fn equivalence(v: &Variant) {
                 .unwrap_or_else(|| panic!("no robust stimulus near {:?}", s.observation.ticks))
         })
         .collect();
-    let nudged_count = samples.iter().zip(&nudged).filter(|(s, n)| s.observation.ticks != **n).count();
-    let expected: Vec<Expected> =
-        samples.iter().zip(&nudged).map(|(s, t)| expectation.expect(t, &s.observation.frame)).collect();
+    let nudged_count = samples
+        .iter()
+        .zip(&nudged)
+        .filter(|(s, n)| s.observation.ticks != **n)
+        .count();
+    let expected: Vec<Expected> = samples
+        .iter()
+        .zip(&nudged)
+        .map(|(s, t)| expectation.expect(t, &s.observation.frame))
+        .collect();
     let mut histogram = [0usize; 4];
     for e in &expected {
         histogram[e.action.index()] += 1;
     }
-    assert!(histogram.iter().all(|&n| n > 0), "the sample does not exercise all four actions: {histogram:?}");
+    assert!(
+        histogram.iter().all(|&n| n > 0),
+        "the sample does not exercise all four actions: {histogram:?}"
+    );
 
     let mut z = driving_zumo(&elf, &model, config.field.poll_latency_us);
     let mut holding = false;
@@ -284,16 +327,28 @@ fn equivalence(v: &Variant) {
     // End to end: the model's own discharge times, not nudged.
     let stimuli: Vec<Stimulus<'_>> = samples
         .iter()
-        .map(|s| Stimulus { cycles: s.observation.discharge_us.map(cycles_of_us), frame: &s.observation.frame })
+        .map(|s| Stimulus {
+            cycles: s.observation.discharge_us.map(cycles_of_us),
+            frame: &s.observation.frame,
+        })
         .collect();
     let observed_e2e = play(&mut z, &stimuli, &mut holding);
     let (mut agree, mut explained, mut unexplained) = (0, Vec::new(), Vec::new());
-    let offsets = offsets_of(samples.iter().zip(&observed_e2e).map(|(s, o)| (&s.observation.ticks, &o.frame)));
+    let offsets = offsets_of(
+        samples
+            .iter()
+            .zip(&observed_e2e)
+            .map(|(s, o)| (&s.observation.ticks, &o.frame)),
+    );
     for (s, o) in samples.iter().zip(&observed_e2e) {
         let ticks = &s.observation.ticks;
         // Whatever state the firmware reached, it must act on it as the policy says.
         let own = expectation.expect(ticks, &s.observation.frame);
-        assert_eq!(o.frame.action, policy.table().action(o.frame.state), "the firmware's action is not its state's");
+        assert_eq!(
+            o.frame.action,
+            policy.table().action(o.frame.state),
+            "the firmware's action is not its state's"
+        );
         if o.frame.state == own.state {
             agree += 1;
         } else {
@@ -309,14 +364,24 @@ fn equivalence(v: &Variant) {
     let e2e_action_agree = samples
         .iter()
         .zip(&observed_e2e)
-        .filter(|(s, o)| expectation.expect(&s.observation.ticks, &s.observation.frame).action == o.frame.action)
+        .filter(|(s, o)| {
+            expectation
+                .expect(&s.observation.ticks, &s.observation.frame)
+                .action
+                == o.frame.action
+        })
         .count();
 
     let cycles = z.decision_cycles();
     let worst = *cycles.iter().max().expect("decision markers");
     let mean = cycles.iter().sum::<u64>() as f64 / cycles.len() as f64;
     let n = samples.len();
-    println!("== {} ({} hasher), {}", v.policy, v.hasher.name(), elf.display());
+    println!(
+        "== {} ({} hasher), {}",
+        v.policy,
+        v.hasher.name(),
+        elf.display()
+    );
     println!("samples: {n} (annulus, letter:T, letter:L; {PER_FIELD} each); actions over the sample {histogram:?}");
     println!(
         "exact check: {exact}/{n} match ({:.1} %), {nudged_count} stimuli nudged ({:.1} %)",
@@ -345,27 +410,61 @@ fn equivalence(v: &Variant) {
     );
     println!("wall time {:.1} s", started.elapsed().as_secs_f64());
 
-    let pct = |k: usize| format!("{} / {} ({:.1} %)", thousands(k as u64), thousands(n as u64), percent(k, n));
+    let pct = |k: usize| {
+        format!(
+            "{} / {} ({:.1} %)",
+            thousands(k as u64),
+            thousands(n as u64),
+            percent(k, n)
+        )
+    };
     let offsets_text = |o: &[(i32, usize)]| {
-        o.iter().map(|(d, c)| format!("{d:+}: {}", thousands(*c as u64))).collect::<Vec<_>>().join(", ").replace("+0", "0")
+        o.iter()
+            .map(|(d, c)| format!("{d:+}: {}", thousands(*c as u64)))
+            .collect::<Vec<_>>()
+            .join(", ")
+            .replace("+0", "0")
     };
     let mut figures = Figures::new(&compiler_of(&elf));
     figures.fixed(&["states checked", &thousands(n as u64)]);
-    figures.fixed(&["actions over the sample (0..3)", &histogram.map(|h| thousands(h as u64)).join(", ")]);
-    figures.fixed(&["calibration by the procedure (white, then black) = the simulator's", "yes"]);
+    figures.fixed(&[
+        "actions over the sample (0..3)",
+        &histogram.map(|h| thousands(h as u64)).join(", "),
+    ]);
+    figures.fixed(&[
+        "calibration by the procedure (white, then black) = the simulator's",
+        "yes",
+    ]);
     figures.fixed(&["exact check", &pct(exact)]);
     figures.fixed(&["stimuli nudged", &pct(nudged_count)]);
     figures.fixed(&["mirrored expectations mismatch", &pct(mirror_mismatches)]);
     figures.fixed(&["another policy mismatches", &pct(other_mismatches)]);
-    figures.compiled(&["firmware raw time - stimulus ticks (exact check, per reading)", &offsets_text(&exact_offsets)]);
+    figures.compiled(&[
+        "firmware raw time - stimulus ticks (exact check, per reading)",
+        &offsets_text(&exact_offsets),
+    ]);
     figures.compiled(&["end-to-end state agreement", &pct(agree)]);
     figures.compiled(&["end-to-end action agreement", &pct(e2e_action_agree)]);
-    figures.compiled(&["disagreements explained by a one-tick move", &thousands(explained.len() as u64)]);
-    figures.compiled(&["unexplained disagreements", &thousands(unexplained.len() as u64)]);
-    figures.compiled(&["firmware raw time - model ticks (end to end, per reading)", &offsets_text(&offsets)]);
+    figures.compiled(&[
+        "disagreements explained by a one-tick move",
+        &thousands(explained.len() as u64),
+    ]);
+    figures.compiled(&[
+        "unexplained disagreements",
+        &thousands(unexplained.len() as u64),
+    ]);
+    figures.compiled(&[
+        "firmware raw time - model ticks (end to end, per reading)",
+        &offsets_text(&offsets),
+    ]);
     figures.compiled(&[
         "cycles per decision (min / mean / max)",
-        &format!("{} / {} / {}", thousands(*cycles.iter().min().unwrap_or(&0)), thousands(mean.round() as u64), thousands(worst)),
+        &format!(
+            "{} / {} / {}",
+            thousands(*cycles.iter().min().unwrap_or(&0)),
+            thousands(mean.round() as u64),
+            thousands(worst)
+        ),
     ]);
 
     assert!(
@@ -382,8 +481,14 @@ fn equivalence(v: &Variant) {
         other_mismatches * 4 >= n,
         "another policy mismatches only {other_mismatches} of {n}: the check is too weak"
     );
-    assert!(unexplained.is_empty(), "unexplained end-to-end disagreements: {unexplained:#?}");
-    assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles, budget {BUDGET_CYCLES}");
+    assert!(
+        unexplained.is_empty(),
+        "unexplained end-to-end disagreements: {unexplained:#?}"
+    );
+    assert!(
+        worst <= BUDGET_CYCLES,
+        "a decision took {worst} cycles, budget {BUDGET_CYCLES}"
+    );
 
     let header = ["figure", &format!("{} ({})", v.policy, v.hasher.name())];
     match figures.check("docs/equivalence.md", v.elf_dir, &header, REGENERATE) {

@@ -10,14 +10,35 @@ use firmware::calibration_record;
 use firmware::config::{CAMERA, PERIOD_TICKS, RC_TIMEOUT_TICKS};
 use firmware::decision::Decider;
 use firmware::embedded;
-use shared::{FieldCalibration, Faults, LogFrame, MotorCommand, PixyBlock, RunMode, SensorRange};
-use tests::zumo::{pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED};
+use shared::{Faults, FieldCalibration, LogFrame, MotorCommand, PixyBlock, RunMode, SensorRange};
+use tests::zumo::{
+    pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED,
+};
 
-const CALIBRATION: FieldCalibration = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+const CALIBRATION: FieldCalibration = FieldCalibration {
+    ranges: [SensorRange {
+        bright: 40,
+        dark: 440,
+    }; 3],
+};
 /// Left 0.35, mid 0.6 (bin 9 of 16), right 0.725.
 const SENSOR_TICKS: [Option<u16>; 3] = [Some(300), Some(200), Some(150)];
-const PUCK_LEFT: PixyBlock = PixyBlock { signature: 1, x: 60, y: 150, width: 20, height: 14, angle: 0 };
-const ROBOT_RIGHT: PixyBlock = PixyBlock { signature: 2, x: 250, y: 180, width: 40, height: 30, angle: 0 };
+const PUCK_LEFT: PixyBlock = PixyBlock {
+    signature: 1,
+    x: 60,
+    y: 150,
+    width: 20,
+    height: 14,
+    angle: 0,
+};
+const ROBOT_RIGHT: PixyBlock = PixyBlock {
+    signature: 2,
+    x: 250,
+    y: 180,
+    width: 40,
+    height: 30,
+    angle: 0,
+};
 const BUDGET_CYCLES: u64 = 2_000;
 
 fn calibrated_zumo() -> Zumo {
@@ -28,8 +49,11 @@ fn calibrated_zumo() -> Zumo {
 }
 
 fn decoded(z: &mut Zumo) -> Vec<LogFrame> {
-    let frames: Vec<LogFrame> =
-        z.frames().into_iter().map(|f| f.unwrap_or_else(|e| panic!("undecodable log frame: {e}"))).collect();
+    let frames: Vec<LogFrame> = z
+        .frames()
+        .into_iter()
+        .map(|f| f.unwrap_or_else(|e| panic!("undecodable log frame: {e}")))
+        .collect();
     assert!(!frames.is_empty(), "no log frames on USART1");
     for pair in frames.windows(2) {
         assert_eq!(pair[1].tick, pair[0].tick + 1, "a log frame was lost");
@@ -40,7 +64,14 @@ fn decoded(z: &mut Zumo) -> Vec<LogFrame> {
 /// The frame's decision, recomputed on the host from its raw times.
 fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutputs {
     let scales = CALIBRATION.scales();
-    let decider = Decider::new(&scales, CAMERA, embedded::HASHER, shared::Role::Outie, &embedded::POLICY[..], embedded::MOTORS);
+    let decider = Decider::new(
+        &scales,
+        CAMERA,
+        embedded::HASHER,
+        shared::Role::Outie,
+        &embedded::POLICY[..],
+        embedded::MOTORS,
+    );
     let expected = decider.decide(&frame.raw_times, blocks);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);
@@ -59,9 +90,16 @@ fn boots_starts_with_button_a_reads_sensors_and_camera_and_drives() {
     z.run_ms(100);
     let idle = decoded(&mut z);
     let last = idle.last().unwrap();
-    assert_eq!((last.mode, last.faults, last.motors), (RunMode::Idle, Faults::NONE, MotorCommand::default()));
+    assert_eq!(
+        (last.mode, last.faults, last.motors),
+        (RunMode::Idle, Faults::NONE, MotorCommand::default())
+    );
     assert_eq!(z.duties(), (0, 0));
-    assert_ne!(z.boot_key(), 0x7777, "the bootloader key must not be left at 0x0800");
+    assert_ne!(
+        z.boot_key(),
+        0x7777,
+        "the bootloader key must not be left at 0x0800"
+    );
 
     z.press_a();
     z.run_ms(200);
@@ -70,7 +108,11 @@ fn boots_starts_with_button_a_reads_sensors_and_camera_and_drives() {
     assert_eq!((last.mode, last.faults), (RunMode::Driving, Faults::NONE));
     for (got, want) in last.raw_times.iter().zip(SENSOR_TICKS) {
         let want = want.unwrap();
-        assert!(got.abs_diff(want) <= 2, "raw times {:?}, emulated {SENSOR_TICKS:?}", last.raw_times);
+        assert!(
+            got.abs_diff(want) <= 2,
+            "raw times {:?}, emulated {SENSOR_TICKS:?}",
+            last.raw_times
+        );
     }
     assert!(last.blobs.puck_left && !last.blobs.puck_right && last.blobs.obstacle_right);
     let outputs = check_decision(&last, &[PUCK_LEFT, ROBOT_RIGHT]);
@@ -80,14 +122,27 @@ fn boots_starts_with_button_a_reads_sensors_and_camera_and_drives() {
 
     let cycles = z.decision_cycles();
     let worst = *cycles.iter().max().expect("no decision markers seen");
-    println!("decision cycles over {} decisions: min {}, max {worst}", cycles.len(), cycles.iter().min().unwrap());
-    assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles, budget {BUDGET_CYCLES}");
+    println!(
+        "decision cycles over {} decisions: min {}, max {worst}",
+        cycles.len(),
+        cycles.iter().min().unwrap()
+    );
+    assert!(
+        worst <= BUDGET_CYCLES,
+        "a decision took {worst} cycles, budget {BUDGET_CYCLES}"
+    );
 
     // The stack stays above the bootloader key at 0x0800 (the firmware
     // clears it at start-up; nothing else may write it).
     let low = z.stack_low_water();
-    println!("stack low water {low:#06x}: {} bytes of stack", 0x0B00 - low);
-    assert!(low > 0x0801, "the stack reached {low:#06x}, over the bootloader key at 0x0800");
+    println!(
+        "stack low water {low:#06x}: {} bytes of stack",
+        0x0B00 - low
+    );
+    assert!(
+        low > 0x0801,
+        "the stack reached {low:#06x}, over the bootloader key at 0x0800"
+    );
 
     // A again stops.
     z.press_a();
@@ -137,7 +192,14 @@ fn a_silent_camera_or_blind_sensors_stop_the_motors_until_readings_return() {
     z.connect_pixy(false);
     z.run_ms(120);
     let last = *decoded(&mut z).last().unwrap();
-    assert_eq!((last.mode, last.faults, last.motors), (RunMode::Driving, Faults::CAMERA_SILENT, MotorCommand::default()));
+    assert_eq!(
+        (last.mode, last.faults, last.motors),
+        (
+            RunMode::Driving,
+            Faults::CAMERA_SILENT,
+            MotorCommand::default()
+        )
+    );
     assert_eq!(z.duties(), (0, 0));
 
     z.connect_pixy(true);
@@ -151,7 +213,10 @@ fn a_silent_camera_or_blind_sensors_stop_the_motors_until_readings_return() {
     z.run_ms(120);
     let last = *decoded(&mut z).last().unwrap();
     assert_eq!(last.raw_times, [RC_TIMEOUT_TICKS; 3]);
-    assert_eq!((last.faults, last.motors), (Faults::SENSORS_TIMEOUT, MotorCommand::default()));
+    assert_eq!(
+        (last.faults, last.motors),
+        (Faults::SENSORS_TIMEOUT, MotorCommand::default())
+    );
     assert_eq!(z.duties(), (0, 0));
 
     z.set_sensor_ticks(SENSOR_TICKS);
@@ -169,22 +234,44 @@ fn button_b_then_the_white_and_black_screens_store_each_sensors_readings_standin
     z.set_sensor_ticks([Some(250), Some(300), Some(200)]);
     z.press_b();
     z.run_ms(200);
-    z.calibrate_ticks([Some(38), Some(40), Some(43)], [Some(425), Some(440), Some(455)]);
+    z.calibrate_ticks(
+        [Some(38), Some(40), Some(43)],
+        [Some(425), Some(440), Some(455)],
+    );
     let frames = decoded(&mut z);
-    let calibrating: Vec<_> = frames.iter().filter(|f| f.mode == RunMode::Calibrating).collect();
-    assert!(calibrating.len() >= 2 * firmware::screen_calibration::WINDOW, "{} calibrating frames", calibrating.len());
-    assert!(calibrating.iter().all(|f| f.motors == MotorCommand::default()), "the robot must stand still");
+    let calibrating: Vec<_> = frames
+        .iter()
+        .filter(|f| f.mode == RunMode::Calibrating)
+        .collect();
+    assert!(
+        calibrating.len() >= 2 * firmware::screen_calibration::WINDOW,
+        "{} calibrating frames",
+        calibrating.len()
+    );
+    assert!(
+        calibrating
+            .iter()
+            .all(|f| f.motors == MotorCommand::default()),
+        "the robot must stand still"
+    );
     let last = frames.last().unwrap();
     assert_eq!((last.mode, last.faults), (RunMode::Idle, Faults::NONE));
 
-    let stored = calibration_record::decode(&z.read_eeprom(0, 16).try_into().unwrap()).expect("a stored calibration");
+    let stored = calibration_record::decode(&z.read_eeprom(0, 16).try_into().unwrap())
+        .expect("a stored calibration");
     // Each reading is the screen's time, to the tick the poll loop reads it in
     // (`docs/equivalence.md` checks it exactly, from mid-tick stimuli).
     for (range, want) in stored.ranges.iter().zip([(38, 425), (40, 440), (43, 455)]) {
-        assert!(range.bright.abs_diff(want.0) <= 1 && range.dark.abs_diff(want.1) <= 1, "{stored:?}");
+        assert!(
+            range.bright.abs_diff(want.0) <= 1 && range.dark.abs_diff(want.1) <= 1,
+            "{stored:?}"
+        );
     }
     // The log carries the new calibration in the frame after it took effect.
-    assert_eq!(frames.iter().rev().find_map(|f| f.calibration), Some(stored));
+    assert_eq!(
+        frames.iter().rev().find_map(|f| f.calibration),
+        Some(stored)
+    );
 
     z.set_sensor_ticks(SENSOR_TICKS);
     z.press_a();
@@ -223,13 +310,32 @@ fn encoder_edges_are_counted_per_period_in_the_log_and_the_robot_id_with_them() 
     z.set_wheel_counts_per_second([0, 0]);
     z.run_ms(60);
     let frames = decoded(&mut z);
-    let logged = frames.iter().fold([0i64; 2], |acc, f| [acc[0] + i64::from(f.encoder_counts[0]), acc[1] + i64::from(f.encoder_counts[1])]);
+    let logged = frames.iter().fold([0i64; 2], |acc, f| {
+        [
+            acc[0] + i64::from(f.encoder_counts[0]),
+            acc[1] + i64::from(f.encoder_counts[1]),
+        ]
+    });
     let counts: Vec<[i16; 2]> = frames.iter().map(|f| f.encoder_counts).collect();
-    assert_eq!(logged, z.encoder_steps(), "every edge counted once, with its sign: {counts:?}");
+    assert_eq!(
+        logged,
+        z.encoder_steps(),
+        "every edge counted once, with its sign: {counts:?}"
+    );
     assert_eq!(z.encoder_steps(), [1_200, -500]);
-    let steady: Vec<[i16; 2]> = frames.iter().map(|f| f.encoder_counts).filter(|c| c[0] != 0).collect();
-    assert!(steady.iter().filter(|c| **c == [60, -25]).count() >= 15, "{steady:?}");
-    assert!(frames.iter().all(|f| f.robot_id == 0), "the default build has robot id 0");
+    let steady: Vec<[i16; 2]> = frames
+        .iter()
+        .map(|f| f.encoder_counts)
+        .filter(|c| c[0] != 0)
+        .collect();
+    assert!(
+        steady.iter().filter(|c| **c == [60, -25]).count() >= 15,
+        "{steady:?}"
+    );
+    assert!(
+        frames.iter().all(|f| f.robot_id == 0),
+        "the default build has robot id 0"
+    );
 }
 
 /// 400 ms of the heaviest periods: driving, both wheels at 6,000 counts/s
@@ -241,7 +347,14 @@ fn heaviest_periods() -> Zumo {
     z.press_a();
     z.set_wheel_counts_per_second([6_000, 6_000]);
     z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
-    let cc = |i: u16| PixyBlock { signature: 0o12, x: 10 + 30 * i, y: 150, width: 20, height: 20, angle: -45 };
+    let cc = |i: u16| PixyBlock {
+        signature: 0o12,
+        x: 10 + 30 * i,
+        y: 150,
+        width: 20,
+        height: 20,
+        angle: -45,
+    };
     z.show(&(0..8).map(cc).collect::<Vec<_>>());
     z.run_ms(400);
     z
@@ -253,19 +366,34 @@ fn odometry_at_full_speed_and_the_largest_frames_do_not_delay_the_control_period
     let frames = decoded(&mut z);
     let last = frames.last().unwrap();
     assert_eq!(last.blocks, 4);
-    assert!(last.encoder_counts.iter().all(|c| (119..=121).contains(c)), "{:?}", last.encoder_counts);
+    assert!(
+        last.encoder_counts.iter().all(|c| (119..=121).contains(c)),
+        "{:?}",
+        last.encoder_counts
+    );
     let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
     let periods = z.period_cycles();
     assert!(periods.len() >= 20);
     // Each period starts on time, within what the two wheels' encoder
     // interrupts (about 65 cycles each with their entry and exit, and at
     // 6,000 counts/s they can fall together) shift the poll of the timer.
-    assert!(periods.iter().all(|p| p.abs_diff(period) < 3 * CYCLES_PER_TICK), "periods (cycles): {periods:?}");
+    assert!(
+        periods
+            .iter()
+            .all(|p| p.abs_diff(period) < 3 * CYCLES_PER_TICK),
+        "periods (cycles): {periods:?}"
+    );
     let work = *z.period_work_cycles().iter().max().unwrap();
     println!("period work, odometry at 6,000 counts/s, 8 colour-code blocks, sensors near timeout: {work} of {period} cycles");
-    assert!(work < period, "a period's work took {work} cycles, longer than the period");
+    assert!(
+        work < period,
+        "a period's work took {work} cycles, longer than the period"
+    );
     let worst = *z.decision_cycles().iter().max().unwrap();
-    assert!(worst <= BUDGET_CYCLES, "a decision took {worst} cycles with the encoders running");
+    assert!(
+        worst <= BUDGET_CYCLES,
+        "a decision took {worst} cycles with the encoders running"
+    );
 }
 
 #[test]
@@ -276,10 +404,24 @@ fn colour_codes_garbage_resync_words_and_long_frames_are_read_as_the_pixy_means_
     z.run_ms(60);
     // A colour-code puck on the left (signature 0o12 is not a puck: it is ignored
     // unless configured), a normal robot block, more blocks than the firmware reads.
-    let cc_robot = PixyBlock { signature: 0o12, x: 280, y: 170, width: 30, height: 30, angle: 90 };
+    let cc_robot = PixyBlock {
+        signature: 0o12,
+        x: 280,
+        y: 170,
+        width: 30,
+        height: 30,
+        angle: 90,
+    };
     let many: Vec<PixyBlock> = [PUCK_LEFT, cc_robot, ROBOT_RIGHT]
         .into_iter()
-        .chain((0..5).map(|i| PixyBlock { signature: 1, x: 300, y: 120 + i, width: 5, height: 5, angle: 0 }))
+        .chain((0..5).map(|i| PixyBlock {
+            signature: 1,
+            x: 300,
+            y: 120 + i,
+            width: 5,
+            height: 5,
+            angle: 0,
+        }))
         .collect();
     let first_four = &many[..4];
     // Garbage, then an odd byte: the syncs that follow read one byte off (0x55AA)
@@ -294,7 +436,11 @@ fn colour_codes_garbage_resync_words_and_long_frames_are_read_as_the_pixy_means_
     assert_eq!(last.faults, Faults::NONE);
     assert_eq!(last.blocks, 4, "the first four blocks of the frame");
     check_decision(&last, first_four);
-    assert_eq!(u16::from_le_bytes([bytes[10], bytes[11]]), PIXY_SYNC_SWAPPED, "the test serves a misaligned sync");
+    assert_eq!(
+        u16::from_le_bytes([bytes[10], bytes[11]]),
+        PIXY_SYNC_SWAPPED,
+        "the test serves a misaligned sync"
+    );
 
     // A block with a bad checksum is dropped; the rest of the frame is used.
     let mut words = pixy_frame_words(&[PUCK_LEFT, ROBOT_RIGHT]);
@@ -327,15 +473,25 @@ fn a_device_holding_sda_low_is_clocked_free_and_the_camera_reads_again() {
     let frames = decoded(&mut z);
     assert_eq!(frames.last().unwrap().faults, Faults::CAMERA_SILENT);
     assert_eq!(z.duties(), (0, 0));
-    assert!(z.scl_clocks_while_sda_held() >= 9, "the firmware clocks SCL to free the bus");
+    assert!(
+        z.scl_clocks_while_sda_held() >= 9,
+        "the firmware clocks SCL to free the bus"
+    );
     let period = u64::from(PERIOD_TICKS) * CYCLES_PER_TICK;
-    assert!(z.period_cycles().iter().rev().take(5).all(|p| p.abs_diff(period) < CYCLES_PER_TICK), "{:?}", z.period_cycles());
+    assert!(
+        z.period_cycles()
+            .iter()
+            .rev()
+            .take(5)
+            .all(|p| p.abs_diff(period) < CYCLES_PER_TICK),
+        "{:?}",
+        z.period_cycles()
+    );
     z.hold_sda_low(Some(1));
     z.run_ms(60);
     let last = *decoded(&mut z).last().unwrap();
     assert_eq!((last.faults, last.blocks), (Faults::NONE, 1));
 }
-
 
 /// Flash (.text + .data) and static RAM (.data + .bss) of an ELF, from `avr-size -B`.
 fn sizes(elf: &std::path::Path) -> (u64, u64) {
@@ -343,9 +499,18 @@ fn sizes(elf: &std::path::Path) -> (u64, u64) {
         .arg("-B")
         .arg(elf)
         .output()
-        .unwrap_or_else(|e| panic!("cannot run avr-size ({e}): install binutils-avr (`scripts/setup`)"));
+        .unwrap_or_else(|e| {
+            panic!("cannot run avr-size ({e}): install binutils-avr (`scripts/setup`)")
+        });
     let text = String::from_utf8_lossy(&out.stdout);
-    let n: Vec<u64> = text.lines().nth(1).unwrap_or("").split_whitespace().take(3).filter_map(|v| v.parse().ok()).collect();
+    let n: Vec<u64> = text
+        .lines()
+        .nth(1)
+        .unwrap_or("")
+        .split_whitespace()
+        .take(3)
+        .filter_map(|v| v.parse().ok())
+        .collect();
     assert_eq!(n.len(), 3, "avr-size output: {text}");
     (n[0] + n[1], n[1] + n[2])
 }
@@ -357,18 +522,32 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
     const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
     let elf = firmware_elf();
     let mut figures = Figures::new(&compiler_of(&elf));
-    figures.fixed(&["log frame, longest", &format!("{} bytes", LogFrame::MAX_ENCODED_LEN), "-", "`shared::LogFrame::MAX_ENCODED_LEN`"]);
+    figures.fixed(&[
+        "log frame, longest",
+        &format!("{} bytes", LogFrame::MAX_ENCODED_LEN),
+        "-",
+        "`shared::LogFrame::MAX_ENCODED_LEN`",
+    ]);
 
     let build = "scripts/test (or scripts/build-firmware with FIRMWARE_OUT, docs/equivalence.md)";
     let (flash, ram) = sizes(&elf);
     let (flash10, _) = sizes(&firmware_elf_in("robot-annulus-10bit", build));
     figures.compiled(&[
         "flash (.text + .data)",
-        &format!("{} bytes (10-bit policy: {})", thousands(flash), thousands(flash10)),
+        &format!(
+            "{} bytes (10-bit policy: {})",
+            thousands(flash),
+            thousands(flash10)
+        ),
         "16,384",
         "`scripts/build-firmware` (avr-size -B)",
     ]);
-    figures.compiled(&["static RAM (.data + .bss)", &format!("{} bytes", thousands(ram)), "1,024", "`scripts/build-firmware`"]);
+    figures.compiled(&[
+        "static RAM (.data + .bss)",
+        &format!("{} bytes", thousands(ram)),
+        "1,024",
+        "`scripts/build-firmware`",
+    ]);
 
     // Driving with the camera and sensors busy: decisions and the stack.
     let mut z = calibrated_zumo();
@@ -388,7 +567,11 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
     ]);
     figures.compiled(&[
         "one decision (this test's driving run)",
-        &format!("{} to {} cycles", thousands(*cycles.iter().min().unwrap()), thousands(*cycles.iter().max().unwrap())),
+        &format!(
+            "{} to {} cycles",
+            thousands(*cycles.iter().min().unwrap()),
+            thousands(*cycles.iter().max().unwrap())
+        ),
         "2,000",
         "this test; over the trained policies: `docs/equivalence.md`",
     ]);
@@ -405,7 +588,12 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
         "this test",
     ]);
 
-    match figures.check("docs/firmware.md", "firmware", &["figure", "value", "budget", "measured by"], REGENERATE) {
+    match figures.check(
+        "docs/firmware.md",
+        "firmware",
+        &["figure", "value", "budget", "measured by"],
+        REGENERATE,
+    ) {
         Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
         Ok(_) => {}
         Err(e) => panic!("{e:#}"),

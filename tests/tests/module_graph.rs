@@ -26,7 +26,11 @@ fn code_of(source: &str) -> String {
     let mut lines = source.lines().peekable();
     while let Some(line) = lines.next() {
         let trimmed = line.trim();
-        if trimmed == "#[cfg(test)]" && lines.peek().is_some_and(|next| next.trim_start().starts_with("mod ")) {
+        if trimmed == "#[cfg(test)]"
+            && lines
+                .peek()
+                .is_some_and(|next| next.trim_start().starts_with("mod "))
+        {
             break;
         }
         let mut in_string = false;
@@ -55,7 +59,10 @@ fn declared_children(code: &str) -> Vec<String> {
     code.lines()
         .filter_map(|l| {
             let l = l.trim();
-            let l = l.strip_prefix("pub(crate) ").or_else(|| l.strip_prefix("pub ")).unwrap_or(l);
+            let l = l
+                .strip_prefix("pub(crate) ")
+                .or_else(|| l.strip_prefix("pub "))
+                .unwrap_or(l);
             let name = l.strip_prefix("mod ")?.strip_suffix(';')?;
             Some(name.trim().to_string())
         })
@@ -67,11 +74,15 @@ fn crate_modules(root: &Path) -> Vec<ModuleFile> {
     let mut out = Vec::new();
     let mut queue = vec![(root.to_path_buf(), Vec::<String>::new())];
     while let Some((path, module)) = queue.pop() {
-        let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let source =
+            std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let code = code_of(&source);
         let children = declared_children(&code);
         // Children of lib.rs and mod.rs sit beside them; of a.rs, in a/.
-        let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or_default();
+        let stem = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or_default();
         let dir = if stem == "lib" || stem == "mod" || stem == "main" {
             path.parent().unwrap().to_path_buf()
         } else {
@@ -86,7 +97,12 @@ fn crate_modules(root: &Path) -> Vec<ModuleFile> {
             m.push(child.clone());
             queue.push((file, m));
         }
-        out.push(ModuleFile { path, module, children, code });
+        out.push(ModuleFile {
+            path,
+            module,
+            children,
+            code,
+        });
     }
     out
 }
@@ -168,14 +184,17 @@ fn named_paths(code: &str) -> Vec<(Vec<String>, bool)> {
     let mut rest = code;
     let mut outside_use = String::new();
     while let Some(at) = rest.find("use ") {
-        let boundary = at == 0 || !rest.as_bytes()[at - 1].is_ascii_alphanumeric() && rest.as_bytes()[at - 1] != b'_';
+        let boundary = at == 0
+            || !rest.as_bytes()[at - 1].is_ascii_alphanumeric() && rest.as_bytes()[at - 1] != b'_';
         if !boundary {
             outside_use.push_str(&rest[..at + 4]);
             rest = &rest[at + 4..];
             continue;
         }
         outside_use.push_str(&rest[..at]);
-        let Some(end) = rest[at..].find(';') else { break };
+        let Some(end) = rest[at..].find(';') else {
+            break;
+        };
         for path in expand_use_tree(&rest[at + 4..at + end]) {
             out.push((path, true));
         }
@@ -186,14 +205,23 @@ fn named_paths(code: &str) -> Vec<(Vec<String>, bool)> {
     let mut i = 0;
     while i < chars.len() {
         let starts = |w: &str| outside_use[char_offset(&chars, i)..].starts_with(w);
-        let boundary = i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == ':');
+        let boundary = i == 0
+            || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_' || chars[i - 1] == ':');
         if boundary && (starts("crate::") || starts("super::") || starts("self::")) {
             let mut j = i;
-            while j < chars.len() && (chars[j].is_alphanumeric() || chars[j] == '_' || chars[j] == ':') {
+            while j < chars.len()
+                && (chars[j].is_alphanumeric() || chars[j] == '_' || chars[j] == ':')
+            {
                 j += 1;
             }
             let text: String = chars[i..j].iter().collect();
-            out.push((text.split("::").filter(|s| !s.is_empty()).map(str::to_string).collect(), false));
+            out.push((
+                text.split("::")
+                    .filter(|s| !s.is_empty())
+                    .map(str::to_string)
+                    .collect(),
+                false,
+            ));
             i = j;
         } else {
             i += 1;
@@ -315,7 +343,11 @@ fn circles(edges: &BTreeMap<usize, BTreeSet<usize>>, nodes: usize) -> Vec<Vec<us
 fn file_circles(root: &Path) -> Vec<String> {
     let files = crate_modules(root);
     let modules: BTreeSet<Vec<String>> = files.iter().map(|f| f.module.clone()).collect();
-    let by_module: BTreeMap<Vec<String>, usize> = files.iter().enumerate().map(|(i, f)| (f.module.clone(), i)).collect();
+    let by_module: BTreeMap<Vec<String>, usize> = files
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.module.clone(), i))
+        .collect();
     let mut edges: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
     for (i, f) in files.iter().enumerate() {
         for (path, in_use) in named_paths(&f.code) {
@@ -330,7 +362,10 @@ fn file_circles(root: &Path) -> Vec<String> {
     circles(&edges, files.len())
         .into_iter()
         .map(|c| {
-            let mut names: Vec<String> = c.iter().map(|&i| files[i].path.display().to_string()).collect();
+            let mut names: Vec<String> = c
+                .iter()
+                .map(|&i| files[i].path.display().to_string())
+                .collect();
             names.sort();
             names.join(" <-> ")
         })
@@ -355,15 +390,30 @@ fn no_module_of_any_crate_imports_from_a_module_that_imports_from_it() {
 fn the_checker_finds_a_circle_through_a_re_export() {
     let dir = tempfile::tempdir().unwrap();
     let src = dir.path();
-    std::fs::write(src.join("lib.rs"), "pub mod a;\npub mod b;\npub use a::A;\n").unwrap();
+    std::fs::write(
+        src.join("lib.rs"),
+        "pub mod a;\npub mod b;\npub use a::A;\n",
+    )
+    .unwrap();
     std::fs::write(src.join("a.rs"), "use crate::b::B;\npub struct A(B);\n").unwrap();
-    std::fs::write(src.join("b.rs"), "// use crate::A; is only a comment\npub struct B;\n").unwrap();
+    std::fs::write(
+        src.join("b.rs"),
+        "// use crate::A; is only a comment\npub struct B;\n",
+    )
+    .unwrap();
     assert!(file_circles(&src.join("lib.rs")).is_empty());
     std::fs::write(src.join("b.rs"), "pub struct B(Box<crate::A>);\n").unwrap();
     let found = file_circles(&src.join("lib.rs"));
     assert_eq!(found.len(), 1, "{found:?}");
-    assert!(found[0].contains("a.rs") && found[0].contains("lib.rs") && found[0].contains("b.rs"), "{found:?}");
+    assert!(
+        found[0].contains("a.rs") && found[0].contains("lib.rs") && found[0].contains("b.rs"),
+        "{found:?}"
+    );
     // A nested use tree with self and a rename.
-    std::fs::write(src.join("b.rs"), "use super::{a::{self as x, A}};\npub struct B;\n").unwrap();
+    std::fs::write(
+        src.join("b.rs"),
+        "use super::{a::{self as x, A}};\npub struct B;\n",
+    )
+    .unwrap();
     assert_eq!(file_circles(&src.join("lib.rs")).len(), 1);
 }

@@ -8,7 +8,8 @@ fn shipped_policies_decode() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "policy") {
             let bytes = std::fs::read(&path).unwrap();
-            shared::PolicyBlob::decode(&bytes).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            shared::PolicyBlob::decode(&bytes)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             count += 1;
         }
     }

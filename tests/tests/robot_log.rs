@@ -22,7 +22,14 @@ use std::sync::mpsc::{channel, Receiver};
 use std::time::Duration;
 use tests::zumo::Zumo;
 
-const PUCK_LEFT: PixyBlock = PixyBlock { signature: 1, x: 60, y: 150, width: 20, height: 14, angle: 0 };
+const PUCK_LEFT: PixyBlock = PixyBlock {
+    signature: 1,
+    x: 60,
+    y: 150,
+    width: 20,
+    height: 14,
+    angle: 0,
+};
 /// A guard against a hung test, not a timing assertion.
 const EVENT_TIMEOUT: Duration = Duration::from_secs(60);
 
@@ -38,7 +45,11 @@ fn session() -> Vec<u8> {
     // The wheels turn while it drives (30 and 28 counts per period).
     z.set_wheel_counts_per_second([1_500, 1_400]);
     for i in 0..40u16 {
-        z.set_sensor_ticks([Some(120 + i * 7), Some(380 - i * 6), Some(150 + (i * 37) % 200)]);
+        z.set_sensor_ticks([
+            Some(120 + i * 7),
+            Some(380 - i * 6),
+            Some(150 + (i * 37) % 200),
+        ]);
         z.run_ms(20);
     }
     z.connect_pixy(false);
@@ -53,7 +64,11 @@ fn session() -> Vec<u8> {
 
 /// The frames of a raw stream, decoded.
 fn frames_of(stream: &[u8]) -> Vec<LogFrame> {
-    stream.split(|b| *b == 0).filter(|c| !c.is_empty()).map(|c| LogFrame::decode(c).expect("a firmware frame decodes")).collect()
+    stream
+        .split(|b| *b == 0)
+        .filter(|c| !c.is_empty())
+        .map(|c| LogFrame::decode(c).expect("a firmware frame decodes"))
+        .collect()
 }
 
 #[derive(Debug, PartialEq)]
@@ -66,7 +81,9 @@ enum Event {
 
 fn wait_for(events: &Receiver<Event>, wanted: Event) {
     loop {
-        let e = events.recv_timeout(EVENT_TIMEOUT).unwrap_or_else(|_| panic!("no {wanted:?} from the monitor"));
+        let e = events
+            .recv_timeout(EVENT_TIMEOUT)
+            .unwrap_or_else(|_| panic!("no {wanted:?} from the monitor"));
         if e == wanted {
             return;
         }
@@ -87,7 +104,11 @@ fn plug(link: &Path) -> TTYPort {
 
 /// Monitors `stream` through two successive pseudo-terminals (the first
 /// unplugged after `split` bytes) and returns the recorded log's path.
-fn record_through_ptys(stream: &[u8], split: usize, dir: &Path) -> (std::path::PathBuf, monitor::LiveStatus) {
+fn record_through_ptys(
+    stream: &[u8],
+    split: usize,
+    dir: &Path,
+) -> (std::path::PathBuf, monitor::LiveStatus) {
     let total = stream.iter().filter(|b| **b == 0).count() as u64;
     let first_part = stream[..split].iter().filter(|b| **b == 0).count() as u64;
     let link = dir.join("robot");
@@ -99,16 +120,28 @@ fn record_through_ptys(stream: &[u8], split: usize, dir: &Path) -> (std::path::P
     let out_path = out.clone();
     let monitor = std::thread::spawn(move || {
         let mut log = log_file::LogWriter::create(&out_path, false).unwrap();
-        let mut opener = SerialOpener { port, baud: monitor::DEFAULT_BAUD };
-        let options = MonitorOptions { max_frames: Some(total), reopen_interval: Duration::from_millis(20) };
-        monitor::run(&mut opener, &mut log, &options, &AtomicBool::new(false), &mut |e| {
-            let _ = tx.send(match e {
-                MonitorEvent::Connected => Event::Connected,
-                MonitorEvent::Frame(s) => Event::Frames(s.frames),
-                MonitorEvent::Lost(_) => Event::Lost,
-                MonitorEvent::OpenFailed(_) => Event::OpenFailed,
-            });
-        })
+        let mut opener = SerialOpener {
+            port,
+            baud: monitor::DEFAULT_BAUD,
+        };
+        let options = MonitorOptions {
+            max_frames: Some(total),
+            reopen_interval: Duration::from_millis(20),
+        };
+        monitor::run(
+            &mut opener,
+            &mut log,
+            &options,
+            &AtomicBool::new(false),
+            &mut |e| {
+                let _ = tx.send(match e {
+                    MonitorEvent::Connected => Event::Connected,
+                    MonitorEvent::Frame(s) => Event::Frames(s.frames),
+                    MonitorEvent::Lost(_) => Event::Lost,
+                    MonitorEvent::OpenFailed(_) => Event::OpenFailed,
+                });
+            },
+        )
         .unwrap()
     });
 
@@ -141,17 +174,37 @@ fn monitor_records_the_firmware_over_a_pty_across_unplugging_and_replay_finds_no
     let frames = frames_of(&stream);
     assert!(frames.len() > 80, "{} frames", frames.len());
     // Unplug between two frames, in the middle of driving.
-    let driving = frames.iter().position(|f| f.mode == RunMode::Driving).expect("the robot drove");
-    let split = stream.iter().enumerate().filter(|(_, b)| **b == 0).nth(driving + 10).unwrap().0 + 1;
+    let driving = frames
+        .iter()
+        .position(|f| f.mode == RunMode::Driving)
+        .expect("the robot drove");
+    let split = stream
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| **b == 0)
+        .nth(driving + 10)
+        .unwrap()
+        .0
+        + 1;
 
     let dir = tempfile::tempdir().unwrap();
     let (log, status) = record_through_ptys(&stream, split, dir.path());
-    assert_eq!((status.frames, status.decode_errors, status.disconnects), (frames.len() as u64, 0, 1));
+    assert_eq!(
+        (status.frames, status.decode_errors, status.disconnects),
+        (frames.len() as u64, 0, 1)
+    );
 
     let recording = log_file::read(&log).unwrap();
     assert_eq!(recording.kind, SourceKind::Recorded);
-    let recorded: Vec<&[u8]> = recording.entries.iter().map(|e| e.frame.as_deref().unwrap()).collect();
-    let sent: Vec<&[u8]> = stream.split(|b| *b == 0).filter(|c| !c.is_empty()).collect();
+    let recorded: Vec<&[u8]> = recording
+        .entries
+        .iter()
+        .map(|e| e.frame.as_deref().unwrap())
+        .collect();
+    let sent: Vec<&[u8]> = stream
+        .split(|b| *b == 0)
+        .filter(|c| !c.is_empty())
+        .collect();
     assert_eq!(recorded, sent, "the log holds exactly the bytes sent");
 
     let policy = PolicyBlob::decode(embedded::POLICY_BLOB).unwrap();
@@ -160,9 +213,17 @@ fn monitor_records_the_firmware_over_a_pty_across_unplugging_and_replay_finds_no
     println!("{report}");
 
     // The raw serial stream, replayed as a capture, says the same.
-    let raw = replay(&log_file::parse(&stream).unwrap(), &policy, None, Default::default());
+    let raw = replay(
+        &log_file::parse(&stream).unwrap(),
+        &policy,
+        None,
+        Default::default(),
+    );
     assert_eq!(raw.source, SourceKind::RawCapture.to_string());
-    assert_eq!((raw.frames, raw.diverged, raw.first_fault_episodes.clone()), (report.frames, 0, report.first_fault_episodes.clone()));
+    assert_eq!(
+        (raw.frames, raw.diverged, raw.first_fault_episodes.clone()),
+        (report.frames, 0, report.first_fault_episodes.clone())
+    );
 
     // Another policy: the replay catches every decision it would change.
     let mut table = PolicyTable::new(policy.hasher());
@@ -177,7 +238,11 @@ fn monitor_records_the_firmware_over_a_pty_across_unplugging_and_replay_finds_no
 }
 
 fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
-    assert_eq!((r.frames, r.damaged, r.diverged), (frames.len() as u64, 0, 0), "{r}");
+    assert_eq!(
+        (r.frames, r.damaged, r.diverged),
+        (frames.len() as u64, 0, 0),
+        "{r}"
+    );
     assert_eq!((r.missing_ticks, r.restarts), (0, 0));
     // Every frame's values were re-derived from its raw times: the first
     // frame carries the start-up calibration, the procedure's follows it.
@@ -185,21 +250,35 @@ fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
     assert_eq!(r.calibrations.len(), 2, "{:?}", r.calibrations);
     assert_eq!(r.calibrations[0], firmware::config::UNCALIBRATED);
     for (range, offset) in r.calibrations[1].ranges.iter().zip([0, 10, 20]) {
-        assert!(range.bright.abs_diff(100 + offset) <= 2 && range.dark.abs_diff(400 + offset) <= 2, "{range:?}");
+        assert!(
+            range.bright.abs_diff(100 + offset) <= 2 && range.dark.abs_diff(400 + offset) <= 2,
+            "{range:?}"
+        );
     }
     let count = |m: RunMode| frames.iter().filter(|f| f.mode == m).count() as u64;
     assert_eq!(
         r.modes,
-        ModeCounts { idle: count(RunMode::Idle), driving: count(RunMode::Driving), calibrating: count(RunMode::Calibrating) }
+        ModeCounts {
+            idle: count(RunMode::Idle),
+            driving: count(RunMode::Driving),
+            calibrating: count(RunMode::Calibrating)
+        }
     );
     assert!(r.modes.calibrating >= 14 && r.policy_drove >= 40, "{r}");
     // The encoders' counts: robot 0, every period the policy drove, 30 and 28 counts.
     assert_eq!(r.motion.len(), 1, "{r}");
     assert_eq!(r.motion[0].id, 0);
     let measured: u64 = r.motion[0].actions.iter().map(|a| a.periods).sum();
-    assert!(measured + 3 >= r.policy_drove && measured > 30, "{measured} of {} periods measured", r.policy_drove);
+    assert!(
+        measured + 3 >= r.policy_drove && measured > 30,
+        "{measured} of {} periods measured",
+        r.policy_drove
+    );
     let fit = r.motion[0].fit.expect("a fit");
-    assert!(fit.wheel_speed_factor > 0.0 && fit.turn_bias > 0.0, "{fit:?}");
+    assert!(
+        fit.wheel_speed_factor > 0.0 && fit.turn_bias > 0.0,
+        "{fit:?}"
+    );
     let mut actions = vec![0u64; r.actions.len()];
     let mut states = std::collections::BTreeSet::new();
     for f in frames.iter().filter(|f| f.policy_drove()) {
@@ -210,10 +289,23 @@ fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
     assert_eq!(r.coverage.states, states.len());
     assert!(states.iter().all(|s| s.index() < r.coverage.of));
     // Before calibrating: no calibration; the silent camera: one episode.
-    let silent: Vec<&LogFrame> = frames.iter().filter(|f| f.faults.contains(Faults::CAMERA_SILENT)).collect();
+    let silent: Vec<&LogFrame> = frames
+        .iter()
+        .filter(|f| f.faults.contains(Faults::CAMERA_SILENT))
+        .collect();
     assert!(!silent.is_empty());
-    let episodes: Vec<_> = r.first_fault_episodes.iter().filter(|e| e.fault == "camera silent").collect();
+    let episodes: Vec<_> = r
+        .first_fault_episodes
+        .iter()
+        .filter(|e| e.fault == "camera silent")
+        .collect();
     assert_eq!(episodes.len(), 1, "{:?}", r.first_fault_episodes);
-    assert_eq!((episodes[0].first_tick, episodes[0].last_tick), (silent[0].tick, silent.last().unwrap().tick));
-    assert!(r.first_fault_episodes.iter().any(|e| e.fault == "no calibration" && e.first_tick == 1));
+    assert_eq!(
+        (episodes[0].first_tick, episodes[0].last_tick),
+        (silent[0].tick, silent.last().unwrap().tick)
+    );
+    assert!(r
+        .first_fault_episodes
+        .iter()
+        .any(|e| e.fault == "no calibration" && e.first_tick == 1));
 }

@@ -25,7 +25,9 @@ impl Value {
     /// As a table cell: `mean ± half-width`, or `–`.
     pub fn cell(self) -> String {
         match self {
-            Value::Mean { ci, n } if n > 1 => format!("{} ± {}", number(ci.mean), number(ci.half_width)),
+            Value::Mean { ci, n } if n > 1 => {
+                format!("{} ± {}", number(ci.mean), number(ci.half_width))
+            }
             Value::Mean { ci, .. } => number(ci.mean),
             Value::Derived(v) if v.is_finite() => number(v),
             _ => "–".into(),
@@ -52,11 +54,15 @@ pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialRe
         if values.is_empty() {
             Value::Missing
         } else {
-            Value::Mean { ci: MeanCi::of(&values), n: values.len() }
+            Value::Mean {
+                ci: MeanCi::of(&values),
+                n: values.len(),
+            }
         }
     };
     let mean_formations = |ts: &[TrialResult]| {
-        (!ts.is_empty()).then(|| ts.iter().map(|t| t.formations as f64).sum::<f64>() / ts.len() as f64)
+        (!ts.is_empty())
+            .then(|| ts.iter().map(|t| t.formations as f64).sum::<f64>() / ts.len() as f64)
     };
     match metric {
         Metric::Formations => mean_of(&|t| Some(t.formations as f64)),
@@ -67,10 +73,12 @@ pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialRe
         },
         Metric::FirstFormation => mean_of(&|t| t.formation_steps.first().map(|&s| s as f64)),
         Metric::CollisionsPer1000 => mean_of(&|t| Some(t.collisions_per_1000)),
-        Metric::FormationsRatio => match (mean_formations(trials), reference.and_then(mean_formations)) {
-            (Some(a), Some(b)) if b > 0.0 => Value::Derived(a / b),
-            _ => Value::Missing,
-        },
+        Metric::FormationsRatio => {
+            match (mean_formations(trials), reference.and_then(mean_formations)) {
+                (Some(a), Some(b)) if b > 0.0 => Value::Derived(a / b),
+                _ => Value::Missing,
+            }
+        }
         Metric::StatesVisited => mean_of(&|t| t.states_visited.map(|v| v as f64)),
         Metric::StepsPerSecond => mean_of(&|t| Some(t.steps_per_second)),
     }

@@ -26,11 +26,17 @@ pub struct MergeReport {
 
 /// Joins the shards in `dirs` into `out` (`None`: `out/experiments/<name>`).
 pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<MergeReport> {
-    let manifests = dirs.iter().map(|d| Ok((d.clone(), ShardManifest::read(d)?))).collect::<Result<Vec<_>>>()?;
+    let manifests = dirs
+        .iter()
+        .map(|d| Ok((d.clone(), ShardManifest::read(d)?)))
+        .collect::<Result<Vec<_>>>()?;
     check_complete(&manifests)?;
     let run = &manifests[0].1;
     let spec = run.spec()?;
-    let out = out.map_or_else(|| Path::new("out/experiments").join(&spec.name), Path::to_path_buf);
+    let out = out.map_or_else(
+        || Path::new("out/experiments").join(&spec.name),
+        Path::to_path_buf,
+    );
     let mut shard_dirs = vec![Path::new(""); run.shard.count];
     for (dir, m) in &manifests {
         shard_dirs[m.shard.index] = dir;
@@ -55,14 +61,20 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<MergeReport> {
             );
         };
         let from = trial_path(dir, plan);
-        let bytes = std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
+        let bytes =
+            std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
         crate::atomic::write(&trial_path(&out, plan), &bytes)?;
         results.push(result);
     }
 
     let pretrained = join_pretrained(&shard_dirs, &out)?;
     let outputs = outputs::write(&spec, &out, &results, run.scale, run.seed)?;
-    Ok(MergeReport { dir: out, trials: results.len(), pretrained, outputs })
+    Ok(MergeReport {
+        dir: out,
+        trials: results.len(),
+        pretrained,
+        outputs,
+    })
 }
 
 /// Copies every shard's pre-trained tables into `out/pretrained`, checking
@@ -75,12 +87,18 @@ fn join_pretrained(shard_dirs: &[&Path], out: &Path) -> Result<usize> {
             continue;
         };
         for entry in entries {
-            let path = entry.with_context(|| format!("cannot list {}", dir.join("pretrained").display()))?.path();
+            let path = entry
+                .with_context(|| format!("cannot list {}", dir.join("pretrained").display()))?
+                .path();
             if path.extension().is_none_or(|e| e != "ckpt") {
                 continue;
             }
-            let bytes = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            let bytes =
+                std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
             match tables.get(&name) {
                 Some((first, seen)) if *seen != bytes => bail!(
                     "the pre-trained tables {} and {} differ, though they are of the same settings and seed",

@@ -15,9 +15,18 @@ use std::path::{Path, PathBuf};
 
 /// Writes every report into `dir`: [`write_reports`] and `trials.json`;
 /// returns the paths.
-pub fn write(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
+pub fn write(
+    spec: &ExperimentSpec,
+    dir: &Path,
+    results: &[TrialResult],
+    scale: f64,
+    seed: u64,
+) -> Result<Vec<PathBuf>> {
     let path = dir.join("trials.json");
-    crate::atomic::write(&path, &serde_json::to_vec_pretty(results).context("cannot encode the trials")?)?;
+    crate::atomic::write(
+        &path,
+        &serde_json::to_vec_pretty(results).context("cannot encode the trials")?,
+    )?;
     let mut written = vec![path];
     written.extend(write_reports(spec, dir, results, scale, seed)?);
     Ok(written)
@@ -25,7 +34,13 @@ pub fn write(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: 
 
 /// Writes `trials.csv`, `table.md` and the figures into `dir` (what the
 /// published results hold besides the trial files); returns the paths.
-pub fn write_reports(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult], scale: f64, seed: u64) -> Result<Vec<PathBuf>> {
+pub fn write_reports(
+    spec: &ExperimentSpec,
+    dir: &Path,
+    results: &[TrialResult],
+    scale: f64,
+    seed: u64,
+) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     let path = dir.join("trials.csv");
     crate::atomic::write(&path, csv(spec, results).as_bytes())?;
@@ -45,7 +60,11 @@ pub fn write_reports(spec: &ExperimentSpec, dir: &Path, results: &[TrialResult],
 
 /// The trials of one arm.
 fn of_arm(results: &[TrialResult], arm: &str) -> Vec<TrialResult> {
-    results.iter().filter(|r| r.arm == arm).cloned().collect::<Vec<_>>()
+    results
+        .iter()
+        .filter(|r| r.arm == arm)
+        .cloned()
+        .collect::<Vec<_>>()
 }
 
 /// One line per trial.
@@ -100,7 +119,12 @@ fn distinct<'a>(items: impl Iterator<Item = &'a str>) -> Vec<&'a str> {
 }
 
 /// One figure of an arm over its trials (ratios over the arm's reference).
-fn arm_value(spec: &ExperimentSpec, results: &[TrialResult], arm: &ArmSpec, m: Metric) -> figures::Value {
+fn arm_value(
+    spec: &ExperimentSpec,
+    results: &[TrialResult],
+    arm: &ArmSpec,
+    m: Metric,
+) -> figures::Value {
     let reference = spec.ratio_reference(arm).map(|r| of_arm(results, &r.name));
     figures::value(m, &of_arm(results, &arm.name), reference.as_deref())
 }
@@ -111,7 +135,12 @@ pub fn markdown(spec: &ExperimentSpec, results: &[TrialResult], scale: f64, seed
     if !spec.thesis.is_empty() {
         let _ = writeln!(md, "Reproduces the thesis' {}.\n", spec.thesis);
     }
-    let trials = spec.arms.iter().map(|a| results.iter().filter(|r| r.arm == a.name).count()).max().unwrap_or(0);
+    let trials = spec
+        .arms
+        .iter()
+        .map(|a| results.iter().filter(|r| r.arm == a.name).count())
+        .max()
+        .unwrap_or(0);
     let _ = writeln!(
         md,
         "Ours: mean ± 95 % confidence half-width over {trials} trials per arm, scale {scale} of the thesis' step counts, experiment seed {seed}. Thesis: the published figure where there is one, \"–\" where it gives none.{}\n",
@@ -134,7 +163,11 @@ pub fn table(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
     let value = |arm: &ArmSpec, m: Metric| arm_value(spec, results, arm, m);
     let rows = distinct(spec.arms.iter().map(|a| a.row.as_str()));
     let columns = distinct(spec.arms.iter().map(|a| a.column.as_str()));
-    let find = |row: &str, column: &str| spec.arms.iter().find(|a| a.row == row && a.column == column);
+    let find = |row: &str, column: &str| {
+        spec.arms
+            .iter()
+            .find(|a| a.row == row && a.column == column)
+    };
     let mut md = String::new();
 
     // header
@@ -148,10 +181,18 @@ pub fn table(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
                 }
                 _ => m.label().to_string(),
             };
-            let label = if column.is_empty() { label } else { format!("{column}: {label}") };
+            let label = if column.is_empty() {
+                label
+            } else {
+                format!("{column}: {label}")
+            };
             let _ = write!(header, " {label} |");
             rule.push_str("---:|");
-            if spec.arms.iter().any(|a| a.column == *column && a.thesis.contains_key(&m)) {
+            if spec
+                .arms
+                .iter()
+                .any(|a| a.column == *column && a.thesis.contains_key(&m))
+            {
                 header.push_str(" thesis |");
                 rule.push_str("---:|");
             }
@@ -165,8 +206,14 @@ pub fn table(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
             for &m in &t.metrics {
                 let ours = arm.map_or_else(|| "".to_string(), |a| value(a, m).cell());
                 let _ = write!(md, " {ours} |");
-                if spec.arms.iter().any(|a| a.column == *column && a.thesis.contains_key(&m)) {
-                    let thesis = arm.and_then(|a| a.thesis.get(&m)).map_or_else(|| "–".to_string(), |&v| figures::number(v));
+                if spec
+                    .arms
+                    .iter()
+                    .any(|a| a.column == *column && a.thesis.contains_key(&m))
+                {
+                    let thesis = arm
+                        .and_then(|a| a.thesis.get(&m))
+                        .map_or_else(|| "–".to_string(), |&v| figures::number(v));
                     let _ = write!(md, " {thesis} |");
                 }
             }
@@ -199,7 +246,14 @@ pub fn every_figure(spec: &ExperimentSpec, results: &[TrialResult]) -> String {
     for arm in &spec.arms {
         let trials = of_arm(results, &arm.name);
         let steps = trials.first().map_or(0, |t| t.steps);
-        let _ = write!(md, "| {} | {} | {} | {} |", arm.name, arm.controller.name(), trials.len(), steps);
+        let _ = write!(
+            md,
+            "| {} | {} | {} | {} |",
+            arm.name,
+            arm.controller.name(),
+            trials.len(),
+            steps
+        );
         for m in all {
             let _ = write!(md, " {} |", arm_value(spec, results, arm, m).cell());
         }
@@ -218,7 +272,13 @@ fn title(spec: &ExperimentSpec, f: &FigureSpec) -> String {
 }
 
 /// Draws one figure.
-fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], plans: &[TrialPlan], path: &Path) -> Result<()> {
+fn draw(
+    spec: &ExperimentSpec,
+    f: &FigureSpec,
+    results: &[TrialResult],
+    plans: &[TrialPlan],
+    path: &Path,
+) -> Result<()> {
     let arms: Vec<&ArmSpec> = if f.arms.is_empty() {
         spec.arms.iter().collect()
     } else {
@@ -233,43 +293,80 @@ fn draw(spec: &ExperimentSpec, f: &FigureSpec, results: &[TrialResult], plans: &
                     let trials = of_arm(results, &arm.name);
                     let steps = trials.iter().map(|t| t.steps).max().unwrap_or(0);
                     let n = spec.sample_points;
-                    let x: Vec<f64> = (0..n).map(|i| steps as f64 * i as f64 / (n - 1) as f64).collect();
+                    let x: Vec<f64> = (0..n)
+                        .map(|i| steps as f64 * i as f64 / (n - 1) as f64)
+                        .collect();
                     let series = trials
                         .iter()
-                        .map(|t| x.iter().map(|&x| t.formation_steps.partition_point(|&s| s as f64 <= x) as f64).collect())
+                        .map(|t| {
+                            x.iter()
+                                .map(|&x| {
+                                    t.formation_steps.partition_point(|&s| s as f64 <= x) as f64
+                                })
+                                .collect()
+                        })
                         .collect();
-                    Band { name: arm.name.clone(), x, trials: series }
+                    Band {
+                        name: arm.name.clone(),
+                        x,
+                        trials: series,
+                    }
                 })
                 .collect();
             let spread = match f.band {
                 BandKind::Ci95 => Spread::Ci95,
                 BandKind::MinMax => Spread::MinMax,
             };
-            chart::mean_with_band(path, Labels { title: &title, x: "step", y: "formations" }, &bands, spread)
+            chart::mean_with_band(
+                path,
+                Labels {
+                    title: &title,
+                    x: "step",
+                    y: "formations",
+                },
+                &bands,
+                spread,
+            )
         }
         FigureKind::Collisions => {
             let series: Vec<Scatter> = arms
                 .iter()
                 .map(|arm| {
                     let trials = of_arm(results, &arm.name);
-                    let blocks = trials.iter().map(|t| t.collisions_per_block.len()).min().unwrap_or(0);
+                    let blocks = trials
+                        .iter()
+                        .map(|t| t.collisions_per_block.len())
+                        .min()
+                        .unwrap_or(0);
                     let points = (0..blocks)
                         .map(|b| {
-                            let mean = trials.iter().map(|t| t.collisions_per_block[b] as f64).sum::<f64>()
+                            let mean = trials
+                                .iter()
+                                .map(|t| t.collisions_per_block[b] as f64)
+                                .sum::<f64>()
                                 / trials.len() as f64;
                             (((b as u64 + 1) * BLOCK_STEPS) as f64, mean)
                         })
                         .collect();
-                    Scatter { name: arm.name.clone(), points }
+                    Scatter {
+                        name: arm.name.clone(),
+                        points,
+                    }
                 })
                 .collect();
             chart::points_with_trend(
                 path,
-                Labels { title: &title, x: "step", y: "collisions per 1000 steps (mean over trials)" },
+                Labels {
+                    title: &title,
+                    x: "step",
+                    y: "collisions per 1000 steps (mean over trials)",
+                },
                 &series,
             )
         }
         FigureKind::Fields => chart::tiles(path, &title, &pictures::fields(spec, f)?),
-        FigureKind::Snapshots => chart::tiles(path, &title, &pictures::snapshots(f, plans, results)?),
+        FigureKind::Snapshots => {
+            chart::tiles(path, &title, &pictures::snapshots(f, plans, results)?)
+        }
     }
 }

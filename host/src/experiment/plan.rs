@@ -11,9 +11,9 @@ use super::spec::{ArmController, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
 use crate::train::format2::TrainConfigV2;
 use crate::train::{OutputConfig, TrainConfig};
-use sim::scenario::{orbital_innies, THESIS_ROBOTS};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
+use sim::scenario::{orbital_innies, THESIS_ROBOTS};
 use std::path::PathBuf;
 
 /// Version of `TrialResult`'s layout and meaning, and of the
@@ -67,7 +67,9 @@ pub fn mix(mut z: u64) -> u64 {
 
 /// 64-bit FNV-1a.
 pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xCBF2_9CE4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3))
+    bytes.iter().fold(0xCBF2_9CE4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01B3)
+    })
 }
 
 /// The seed of trial `trial` of arm `arm` (see the module docs).
@@ -95,7 +97,10 @@ enum Hashed {
     V2(TrainConfigV2),
     Current(TrainConfig),
     /// Settings with the robot's senses, and the version of their model.
-    RobotSenses { model: u32, settings: Box<Hashed> },
+    RobotSenses {
+        model: u32,
+        settings: Box<Hashed>,
+    },
 }
 
 /// [`Hashed`] settings of `config`.
@@ -111,7 +116,10 @@ fn hashed(config: &TrainConfig) -> Hashed {
         (None, None) => Hashed::Current(c),
     };
     if robot_senses {
-        Hashed::RobotSenses { model: sim::robot_sensors::MODEL_VERSION, settings: Box::new(settings) }
+        Hashed::RobotSenses {
+            model: sim::robot_sensors::MODEL_VERSION,
+            settings: Box::new(settings),
+        }
     } else {
         settings
     }
@@ -136,7 +144,13 @@ pub fn plans(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64) -> Vec
 
 /// [`plans`] with the hashes that result format `format` gave them (to
 /// tell whether a stored trial of an earlier format is of these settings).
-pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u64, format: u32) -> Vec<TrialPlan> {
+pub fn plans_of_format(
+    spec: &ExperimentSpec,
+    trials: usize,
+    scale: f64,
+    seed: u64,
+    format: u32,
+) -> Vec<TrialPlan> {
     let mut out = Vec::new();
     for arm in &spec.arms {
         for trial in 0..trials {
@@ -150,7 +164,10 @@ pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u
                 pre.steps = scaled(p.steps, scale);
                 pre.seed = trial_seed(seed, "pretrain", trial);
                 pre.output = OutputConfig::default();
-                PretrainPlan { hash: hash(&(format, hashed(&pre))), config: pre }
+                PretrainPlan {
+                    hash: hash(&(format, hashed(&pre))),
+                    config: pre,
+                }
             });
             let trial_hash = match &arm.policy {
                 // an unreadable file hashes as none: its trials fail naming it
@@ -158,7 +175,12 @@ pub fn plans_of_format(spec: &ExperimentSpec, trials: usize, scale: f64, seed: u
                     let blob = std::fs::read(path).map(|b| hash(&b)).ok();
                     hash(&(format, arm.controller, hashed(&config), blob))
                 }
-                None => hash(&(format, arm.controller, hashed(&config), pretrain.as_ref().map(|p| &p.hash))),
+                None => hash(&(
+                    format,
+                    arm.controller,
+                    hashed(&config),
+                    pretrain.as_ref().map(|p| &p.hash),
+                )),
             };
             out.push(TrialPlan {
                 experiment: spec.name.clone(),

@@ -34,7 +34,15 @@ pub struct Document {
 pub const DOCUMENTS: [Document; 2] = [
     Document {
         dir: "reproduction",
-        experiments: &["annulus", "transfer", "letters", "letters-generated", "state-bits", "obstacle", "collisions"],
+        experiments: &[
+            "annulus",
+            "transfer",
+            "letters",
+            "letters-generated",
+            "state-bits",
+            "obstacle",
+            "collisions",
+        ],
     },
     Document {
         dir: "robot-sensors",
@@ -50,7 +58,9 @@ pub const DOCUMENTS: [Document; 2] = [
 impl Document {
     /// The document of a built-in experiment.
     pub fn of(experiment: &str) -> Option<Document> {
-        DOCUMENTS.into_iter().find(|d| d.experiments.contains(&experiment))
+        DOCUMENTS
+            .into_iter()
+            .find(|d| d.experiments.contains(&experiment))
     }
 
     /// The rendered file.
@@ -70,7 +80,11 @@ impl Document {
             for stale in &published.stale {
                 log(&format!("left out: {stale}"));
             }
-            out.push(Source { spec, published, dir });
+            out.push(Source {
+                spec,
+                published,
+                dir,
+            });
         }
         Ok(out)
     }
@@ -78,7 +92,8 @@ impl Document {
     /// The document the template and the trials give.
     pub fn render(&self, docs: &Path, sources: &[Source]) -> Result<String> {
         let path = docs.join(self.dir).join("template.md");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         let body = template::render(&text, sources).with_context(|| path.display().to_string())?;
         let dir = self.dir;
         Ok(format!(
@@ -98,7 +113,10 @@ pub fn documents(names: &[String]) -> Result<Vec<Document>> {
         .map(|n| {
             DOCUMENTS.into_iter().find(|d| d.dir == n).with_context(|| {
                 let known: Vec<&str> = DOCUMENTS.iter().map(|d| d.dir).collect();
-                format!("unknown document {n:?}: expected one of {}", known.join(", "))
+                format!(
+                    "unknown document {n:?}: expected one of {}",
+                    known.join(", ")
+                )
             })
         })
         .collect()
@@ -107,13 +125,24 @@ pub fn documents(names: &[String]) -> Result<Vec<Document>> {
 /// Writes the documents' experiment reports (an experiment without trials
 /// gets its empty tables and the figures that need none) and the
 /// documents; returns the files written.
-pub fn write(docs: &Path, documents: &[Document], scale: f64, log: &dyn Fn(&str)) -> Result<Vec<PathBuf>> {
+pub fn write(
+    docs: &Path,
+    documents: &[Document],
+    scale: f64,
+    log: &dyn Fn(&str),
+) -> Result<Vec<PathBuf>> {
     let mut written = Vec::new();
     for &document in documents {
         let sources = document.sources(docs, scale, log)?;
         let doc = document.render(docs, &sources)?;
         for s in &sources {
-            written.extend(outputs::write_reports(&s.spec, &s.dir, &s.published.results, scale, s.spec.seed)?);
+            written.extend(outputs::write_reports(
+                &s.spec,
+                &s.dir,
+                &s.published.results,
+                scale,
+                s.spec.seed,
+            )?);
         }
         let path = document.path(docs);
         crate::atomic::write(&path, doc.as_bytes())?;
@@ -129,11 +158,14 @@ pub fn check(docs: &Path, documents: &[Document], log: &dyn Fn(&str)) -> Result<
     for &document in documents {
         let rendered = document.render(docs, &document.sources(docs, 1.0, log)?)?;
         let path = document.path(docs);
-        let committed = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let committed = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         if committed != rendered {
-            let line = committed.lines().zip(rendered.lines()).position(|(a, b)| a != b).unwrap_or_else(|| {
-                committed.lines().count().min(rendered.lines().count())
-            });
+            let line = committed
+                .lines()
+                .zip(rendered.lines())
+                .position(|(a, b)| a != b)
+                .unwrap_or_else(|| committed.lines().count().min(rendered.lines().count()));
             bail!(
                 "{} is not what the published trials and docs/{}/template.md give (first difference at line {}); regenerate it with `{COMMAND}`",
                 path.display(),
@@ -154,7 +186,10 @@ mod tests {
     #[test]
     fn every_built_in_experiment_is_in_exactly_one_document() {
         for (name, _) in BUILT_IN {
-            let n = DOCUMENTS.iter().filter(|d| d.experiments.contains(&name)).count();
+            let n = DOCUMENTS
+                .iter()
+                .filter(|d| d.experiments.contains(&name))
+                .count();
             assert_eq!(n, 1, "{name}");
         }
         let listed: usize = DOCUMENTS.iter().map(|d| d.experiments.len()).sum();

@@ -33,7 +33,10 @@ impl ReusableTrials {
         let mut by_hash = HashMap::new();
         for dir in dirs {
             if !dir.is_dir() {
-                bail!("--reuse {}: not a directory (another run's output directory was expected)", dir.display());
+                bail!(
+                    "--reuse {}: not a directory (another run's output directory was expected)",
+                    dir.display()
+                );
             }
             for file in stored_files(dir)?.into_iter().flat_map(|(_, files)| files) {
                 if let Some(result) = TrialResult::read_current(&file) {

@@ -50,7 +50,15 @@ impl Default for RunOptions {
     /// 10 trials at full scale, the default directory, seed and threads,
     /// unsharded, nothing reused.
     fn default() -> RunOptions {
-        RunOptions { trials: 10, scale: 1.0, out: None, seed: None, threads: None, shard: None, reuse: Vec::new() }
+        RunOptions {
+            trials: 10,
+            scale: 1.0,
+            out: None,
+            seed: None,
+            threads: None,
+            shard: None,
+            reuse: Vec::new(),
+        }
     }
 }
 
@@ -78,7 +86,15 @@ pub struct RunReport {
 /// A file name for an arm: its name with anything but letters, digits,
 /// `-` and `_` replaced by `_`.
 pub fn slug(name: &str) -> String {
-    name.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' }).collect()
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// Progress lines, from any thread.
@@ -105,19 +121,25 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
         spec.arms.len(),
         options.trials,
         options.scale,
-        options.shard.map_or_else(String::new, |s| format!(", shard {s}: {} trials", plans.len())),
+        options.shard.map_or_else(String::new, |s| format!(
+            ", shard {s}: {} trials",
+            plans.len()
+        )),
         dir.display()
     ));
     let workers = Workers::new(options.threads)?;
     // a shard's manifest first, so that merge can name an unfinished shard
     let manifest = match options.shard {
-        Some(shard) => Some(ShardManifest::new(spec, shard, options.trials, options.scale, seed).write(&dir)?),
+        Some(shard) => {
+            Some(ShardManifest::new(spec, shard, options.trials, options.scale, seed).write(&dir)?)
+        }
         None => None,
     };
     let mut finished: Vec<Option<TrialResult>> = plans.iter().map(|p| finished(&dir, p)).collect();
     let skipped = finished.iter().flatten().count();
     let trials_reused = copy_reused(&plans, &mut finished, &options.reuse, &dir, log)?;
-    let (pretrained_run, pretrained_skipped) = run_pretrainings(&plans, &finished, &dir, &workers, log)?;
+    let (pretrained_run, pretrained_skipped) =
+        run_pretrainings(&plans, &finished, &dir, &workers, log)?;
     let (results, trials_run) = run_trials(&plans, finished, &dir, &workers, log)?;
     let outputs = match manifest {
         Some(path) => vec![path],
@@ -147,7 +169,11 @@ fn check_options(spec: &ExperimentSpec, options: &RunOptions) -> Result<()> {
     let mut slugs = BTreeMap::new();
     for arm in &spec.arms {
         if let Some(other) = slugs.insert(slug(&arm.name), &arm.name) {
-            bail!("arms {other:?} and {:?} would share the directory trials/{}", arm.name, slug(&arm.name));
+            bail!(
+                "arms {other:?} and {:?} would share the directory trials/{}",
+                arm.name,
+                slug(&arm.name)
+            );
         }
     }
     Ok(())
@@ -159,7 +185,12 @@ struct Workers(Option<rayon::ThreadPool>);
 impl Workers {
     fn new(threads: Option<usize>) -> Result<Workers> {
         let pool = match threads {
-            Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n).build().context("cannot start worker threads")?),
+            Some(n) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .context("cannot start worker threads")?,
+            ),
             None => None,
         };
         Ok(Workers(pool))
@@ -188,14 +219,21 @@ fn copy_reused(
     }
     let reusable = ReusableTrials::load(reuse)?;
     let mut copied = 0;
-    for (plan, done) in plans.iter().zip(finished.iter_mut()).filter(|(_, f)| f.is_none()) {
+    for (plan, done) in plans
+        .iter()
+        .zip(finished.iter_mut())
+        .filter(|(_, f)| f.is_none())
+    {
         if let Some(result) = reusable.result_for(plan) {
             write_result(&trial_path(dir, plan), &result)?;
             *done = Some(result);
             copied += 1;
         }
     }
-    log(&format!("reuse: {copied} trials copied from {} stored in the --reuse directories", reusable.stored()));
+    log(&format!(
+        "reuse: {copied} trials copied from {} stored in the --reuse directories",
+        reusable.stored()
+    ));
     Ok(copied)
 }
 
@@ -214,8 +252,9 @@ fn run_pretrainings(
             distinct.insert(&p.hash, p);
         }
     }
-    let (done, todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) =
-        distinct.values().partition(|p| pretrained_table(dir, p).is_ok());
+    let (done, todo): (Vec<&PretrainPlan>, Vec<&PretrainPlan>) = distinct
+        .values()
+        .partition(|p| pretrained_table(dir, p).is_ok());
     if !distinct.is_empty() {
         log(&format!(
             "pre-training: {} tables for the trials to run, {} already done (skipped)",
@@ -229,7 +268,12 @@ fn run_pretrainings(
             let t = trial::pretrain(&p.config)?;
             checkpoint::save(&pretrained_path(dir, p), &t.state())?;
             let k = count.fetch_add(1, Ordering::Relaxed) + 1;
-            log(&format!("[{k}/{}] pre-trained {} steps: {} formations", todo.len(), p.config.steps, t.totals().formations));
+            log(&format!(
+                "[{k}/{}] pre-trained {} steps: {} formations",
+                todo.len(),
+                p.config.steps,
+                t.totals().formations
+            ));
             Ok(())
         })
     })?;
@@ -248,7 +292,11 @@ fn run_trials(
 ) -> Result<(Vec<TrialResult>, usize)> {
     let mut results = finished;
     let todo: Vec<usize> = (0..plans.len()).filter(|&i| results[i].is_none()).collect();
-    log(&format!("trials: {}, {} already done (skipped)", plans.len(), plans.len() - todo.len()));
+    log(&format!(
+        "trials: {}, {} already done (skipped)",
+        plans.len(),
+        plans.len() - todo.len()
+    ));
     let count = AtomicUsize::new(0);
     let fresh = std::sync::Mutex::new(Vec::new());
     workers.run(&|| {
@@ -285,7 +333,8 @@ fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
         Some(p) => Some(pretrained_table(dir, p)?),
         None => None,
     };
-    let result = trial::run(plan, seed_table).with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
+    let result = trial::run(plan, seed_table)
+        .with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
     write_result(&trial_path(dir, plan), &result)?;
     Ok(result)
 }
@@ -305,14 +354,19 @@ pub fn pretrained_path(dir: &Path, p: &PretrainPlan) -> PathBuf {
 fn pretrained_table(dir: &Path, p: &PretrainPlan) -> Result<crate::learn::QTable> {
     let state = checkpoint::load(&pretrained_path(dir, p))?;
     if !super::plan::same_run(&state.config, &p.config) {
-        bail!("pre-trained table {} has other settings", pretrained_path(dir, p).display());
+        bail!(
+            "pre-trained table {} has other settings",
+            pretrained_path(dir, p).display()
+        );
     }
     Ok(state.learner.table().clone())
 }
 
 /// Where a trial's result is stored in an output directory.
 pub fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
-    dir.join("trials").join(slug(&plan.arm)).join(format!("trial-{:02}.json", plan.trial))
+    dir.join("trials")
+        .join(slug(&plan.arm))
+        .join(format!("trial-{:02}.json", plan.trial))
 }
 
 /// The stored result of a trial, if it exists and its hash matches.

@@ -29,7 +29,10 @@ impl FromStr for Shard {
     fn from_str(s: &str) -> Result<Shard, String> {
         let bad = || format!("--shard {s:?}: expected K/N with 0 <= K < N, e.g. 0/4");
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
-        let (index, count) = (k.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+        let (index, count) = (
+            k.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
         if index >= count {
             return Err(bad());
         }
@@ -46,7 +49,12 @@ impl fmt::Display for Shard {
 impl Shard {
     /// This shard's plans of the whole run's `plans`.
     pub fn share(self, plans: Vec<TrialPlan>) -> Vec<TrialPlan> {
-        plans.into_iter().enumerate().filter(|(i, _)| i % self.count == self.index).map(|(_, p)| p).collect()
+        plans
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| i % self.count == self.index)
+            .map(|(_, p)| p)
+            .collect()
     }
 
     /// The default output directory's name: `shard-K-of-N`.
@@ -79,34 +87,64 @@ pub const MANIFEST: &str = "shard.json";
 
 impl ShardManifest {
     /// The manifest of shard `shard` of a run of `spec`.
-    pub fn new(spec: &ExperimentSpec, shard: Shard, trials: usize, scale: f64, seed: u64) -> ShardManifest {
-        ShardManifest { experiment: spec.name.clone(), source: spec.source.clone(), shard, trials, scale, seed }
+    pub fn new(
+        spec: &ExperimentSpec,
+        shard: Shard,
+        trials: usize,
+        scale: f64,
+        seed: u64,
+    ) -> ShardManifest {
+        ShardManifest {
+            experiment: spec.name.clone(),
+            source: spec.source.clone(),
+            shard,
+            trials,
+            scale,
+            seed,
+        }
     }
 
     /// Writes it into `dir` atomically; returns its path.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         let path = dir.join(MANIFEST);
-        crate::atomic::write(&path, &serde_json::to_vec_pretty(self).context("cannot encode the shard manifest")?)?;
+        crate::atomic::write(
+            &path,
+            &serde_json::to_vec_pretty(self).context("cannot encode the shard manifest")?,
+        )?;
         Ok(path)
     }
 
     /// Reads the manifest of the shard in `dir`.
     pub fn read(dir: &Path) -> Result<ShardManifest> {
         let path = dir.join(MANIFEST);
-        let bytes = std::fs::read(&path)
-            .with_context(|| format!("{} is not a shard's directory: cannot read {}", dir.display(), path.display()))?;
-        serde_json::from_slice(&bytes).with_context(|| format!("{} is not a valid shard manifest", path.display()))
+        let bytes = std::fs::read(&path).with_context(|| {
+            format!(
+                "{} is not a shard's directory: cannot read {}",
+                dir.display(),
+                path.display()
+            )
+        })?;
+        serde_json::from_slice(&bytes)
+            .with_context(|| format!("{} is not a valid shard manifest", path.display()))
     }
 
     /// The experiment it ran.
     pub fn spec(&self) -> Result<ExperimentSpec> {
-        ExperimentSpec::parse(&self.experiment, &self.source).with_context(|| format!("experiment {}", self.experiment))
+        ExperimentSpec::parse(&self.experiment, &self.source)
+            .with_context(|| format!("experiment {}", self.experiment))
     }
 
     /// Whether another shard's manifest is of the same run.
     pub fn same_run(&self, other: &ShardManifest) -> bool {
         fn run(m: &ShardManifest) -> (&str, &str, usize, usize, u64, u64) {
-            (&m.experiment, &m.source, m.shard.count, m.trials, m.scale.to_bits(), m.seed)
+            (
+                &m.experiment,
+                &m.source,
+                m.shard.count,
+                m.trials,
+                m.scale.to_bits(),
+                m.seed,
+            )
         }
         run(self) == run(other)
     }
@@ -128,8 +166,11 @@ pub fn check_complete(manifests: &[(PathBuf, ShardManifest)]) -> Result<()> {
     }
     let n = first.shard.count;
     for k in 0..n {
-        let dirs: Vec<String> =
-            manifests.iter().filter(|(_, m)| m.shard.index == k).map(|(d, _)| d.display().to_string()).collect();
+        let dirs: Vec<String> = manifests
+            .iter()
+            .filter(|(_, m)| m.shard.index == k)
+            .map(|(d, _)| d.display().to_string())
+            .collect();
         match dirs.len() {
             1 => {}
             0 => bail!("shard {k}/{n} is missing: run `host experiment {} --shard {k}/{n}` and give its directory", first.experiment),

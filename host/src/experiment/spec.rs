@@ -17,16 +17,43 @@ use std::path::{Path, PathBuf};
 /// `host experiment NAME` works from any directory.
 pub const BUILT_IN: [(&str, &str); 11] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
-    ("transfer", include_str!("../../../experiments/transfer.toml")),
+    (
+        "transfer",
+        include_str!("../../../experiments/transfer.toml"),
+    ),
     ("letters", include_str!("../../../experiments/letters.toml")),
-    ("letters-generated", include_str!("../../../experiments/letters-generated.toml")),
-    ("state-bits", include_str!("../../../experiments/state-bits.toml")),
-    ("obstacle", include_str!("../../../experiments/obstacle.toml")),
-    ("collisions", include_str!("../../../experiments/collisions.toml")),
-    ("robot-senses-ablation", include_str!("../../../experiments/robot-senses-ablation.toml")),
-    ("robot-senses-sweep", include_str!("../../../experiments/robot-senses-sweep.toml")),
-    ("robustness", include_str!("../../../experiments/robustness.toml")),
-    ("robot-senses-letter", include_str!("../../../experiments/robot-senses-letter.toml")),
+    (
+        "letters-generated",
+        include_str!("../../../experiments/letters-generated.toml"),
+    ),
+    (
+        "state-bits",
+        include_str!("../../../experiments/state-bits.toml"),
+    ),
+    (
+        "obstacle",
+        include_str!("../../../experiments/obstacle.toml"),
+    ),
+    (
+        "collisions",
+        include_str!("../../../experiments/collisions.toml"),
+    ),
+    (
+        "robot-senses-ablation",
+        include_str!("../../../experiments/robot-senses-ablation.toml"),
+    ),
+    (
+        "robot-senses-sweep",
+        include_str!("../../../experiments/robot-senses-sweep.toml"),
+    ),
+    (
+        "robustness",
+        include_str!("../../../experiments/robustness.toml"),
+    ),
+    (
+        "robot-senses-letter",
+        include_str!("../../../experiments/robot-senses-letter.toml"),
+    ),
 ];
 
 /// A parsed experiment file.
@@ -250,23 +277,39 @@ fn default_controller() -> ArmController {
     ArmController::Learn
 }
 
-const ARM_KEYS: [&str; 7] = ["name", "row", "column", "controller", "pretrain", "policy", "thesis"];
+const ARM_KEYS: [&str; 7] = [
+    "name",
+    "row",
+    "column",
+    "controller",
+    "pretrain",
+    "policy",
+    "thesis",
+];
 
 impl ExperimentSpec {
     /// A built-in experiment by name, or a file by path.
     pub fn load(name_or_path: &str) -> Result<ExperimentSpec> {
         if let Some((name, text)) = BUILT_IN.iter().find(|(n, _)| *n == name_or_path) {
-            return ExperimentSpec::parse(name, text).with_context(|| format!("built-in experiment {name}"));
+            return ExperimentSpec::parse(name, text)
+                .with_context(|| format!("built-in experiment {name}"));
         }
         let path = Path::new(name_or_path);
         if !path.exists() && !name_or_path.contains(['/', '.']) {
             let names: Vec<&str> = BUILT_IN.iter().map(|(n, _)| *n).collect();
-            bail!("unknown experiment {name_or_path:?}: expected one of {} or a path to a TOML file", names.join(", "));
+            bail!(
+                "unknown experiment {name_or_path:?}: expected one of {} or a path to a TOML file",
+                names.join(", ")
+            );
         }
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read experiment file {}", path.display()))?;
-        let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "experiment".into());
-        ExperimentSpec::parse(&stem, &text).with_context(|| format!("experiment file {}", path.display()))
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "experiment".into());
+        ExperimentSpec::parse(&stem, &text)
+            .with_context(|| format!("experiment file {}", path.display()))
     }
 
     /// Parses an experiment's TOML text; errors name the line or the arm.
@@ -284,13 +327,27 @@ impl ExperimentSpec {
             if arms.iter().any(|a| a.name == arm.name) {
                 bail!("two arms are named {:?}", arm.name);
             }
-            if let Some(other) = arms.iter().find(|a| a.row == arm.row && a.column == arm.column) {
-                bail!("arms {:?} and {:?} share the table cell (row {:?}, column {:?})", other.name, arm.name, arm.row, arm.column);
+            if let Some(other) = arms
+                .iter()
+                .find(|a| a.row == arm.row && a.column == arm.column)
+            {
+                bail!(
+                    "arms {:?} and {:?} share the table cell (row {:?}, column {:?})",
+                    other.name,
+                    arm.name,
+                    arm.row,
+                    arm.column
+                );
             }
             arms.push(arm);
         }
         let known = |n: &String| arms.iter().any(|a| &a.name == n);
-        if let Some(r) = file.table.ratio_to.as_ref().filter(|r| !known(r) && !arms.iter().any(|a| &a.row == *r)) {
+        if let Some(r) = file
+            .table
+            .ratio_to
+            .as_ref()
+            .filter(|r| !known(r) && !arms.iter().any(|a| &a.row == *r))
+        {
             bail!("[table] ratio_to = {r:?} is neither a row nor an arm");
         }
         for f in &file.figures {
@@ -301,7 +358,10 @@ impl ExperimentSpec {
                 if f.arms.is_empty() || f.moments.is_empty() {
                     bail!("figure {}: snapshots need arms and moments", f.file);
                 }
-                if let Some(a) = arms.iter().find(|a| f.arms.contains(&a.name) && a.pretrain.is_some()) {
+                if let Some(a) = arms
+                    .iter()
+                    .find(|a| f.arms.contains(&a.name) && a.pretrain.is_some())
+                {
                     bail!("figure {}: arm {:?} is pre-trained; snapshots re-run trials without pre-training", f.file, a.name);
                 }
             }
@@ -315,7 +375,10 @@ impl ExperimentSpec {
             moments: default_moments(),
         };
         let figures = if file.figures.is_empty() {
-            vec![figure("formations.png", FigureKind::Formations), figure("collisions.png", FigureKind::Collisions)]
+            vec![
+                figure("formations.png", FigureKind::Formations),
+                figure("collisions.png", FigureKind::Collisions),
+            ]
         } else {
             file.figures
         };
@@ -341,7 +404,10 @@ impl ExperimentSpec {
     /// the `ratio_to` row in `arm`'s column, else the arm named `ratio_to`.
     pub fn ratio_reference(&self, arm: &ArmSpec) -> Option<&ArmSpec> {
         let r = self.table.ratio_to.as_deref()?;
-        self.arms.iter().find(|a| a.row == r && a.column == arm.column).or_else(|| self.arm(r))
+        self.arms
+            .iter()
+            .find(|a| a.row == r && a.column == arm.column)
+            .or_else(|| self.arm(r))
     }
 }
 
@@ -356,11 +422,16 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     let keys: ArmKeys = toml::Value::Table(own).try_into()?;
     let context = || format!("arm {:?}", keys.name);
     if table.contains_key("output") {
-        bail!("{}: output settings are chosen by the experiment runner", context());
+        bail!(
+            "{}: output settings are chosen by the experiment runner",
+            context()
+        );
     }
     let mut merged = defaults.clone();
     merge(&mut merged, table);
-    let config: TrainConfig = toml::Value::Table(merged).try_into().with_context(context)?;
+    let config: TrainConfig = toml::Value::Table(merged)
+        .try_into()
+        .with_context(context)?;
     config.validate().with_context(context)?;
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
@@ -370,7 +441,10 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     }
     let roles = keys.controller == ArmController::Oc || config.learn.hasher.0.has_role_bit();
     if let Some(n) = config.innies.filter(|_| !roles) {
-        bail!("{}: innies = {n}: only orbital construction and the role hasher have innies", context());
+        bail!(
+            "{}: innies = {n}: only orbital construction and the role hasher have innies",
+            context()
+        );
     }
     Ok(ArmSpec {
         row: keys.row.unwrap_or_else(|| keys.name.clone()),
@@ -427,10 +501,22 @@ alpha = 0.1
     fn arms_merge_over_the_defaults_key_by_key() {
         let spec = ExperimentSpec::parse("x", FILE).unwrap();
         let (a, b) = (&spec.arms[0], &spec.arms[1]);
-        assert_eq!((a.controller, a.config.robots, a.row.as_str()), (ArmController::Oc, Some(4), "A"));
+        assert_eq!(
+            (a.controller, a.config.robots, a.row.as_str()),
+            (ArmController::Oc, Some(4), "A")
+        );
         assert_eq!(a.thesis[&Metric::Formations], 12.5);
-        assert_eq!((b.config.robots, b.config.learn.alpha, b.config.learn.gamma), (Some(2), 0.1, 0.5));
-        assert_eq!(b.pretrain, Some(PretrainSpec { steps: 100, robots: Some(1) }));
+        assert_eq!(
+            (b.config.robots, b.config.learn.alpha, b.config.learn.gamma),
+            (Some(2), 0.1, 0.5)
+        );
+        assert_eq!(
+            b.pretrain,
+            Some(PretrainSpec {
+                steps: 100,
+                robots: Some(1)
+            })
+        );
         assert_eq!(spec.figures.len(), 2, "default figures");
     }
 
@@ -438,11 +524,23 @@ alpha = 0.1
     fn mistakes_are_named() {
         let e = |text: &str| format!("{:#}", ExperimentSpec::parse("x", text).unwrap_err());
         let typo = FILE.replace("robots = 2", "robts = 2");
-        assert!(e(&typo).contains("arm \"B\"") && e(&typo).contains("robts"), "{}", e(&typo));
+        assert!(
+            e(&typo).contains("arm \"B\"") && e(&typo).contains("robts"),
+            "{}",
+            e(&typo)
+        );
         let bad = FILE.replace("ratio_to = \"A\"", "ratio_to = \"Z\"");
-        assert!(e(&bad).contains("\"Z\" is neither a row nor an arm"), "{}", e(&bad));
+        assert!(
+            e(&bad).contains("\"Z\" is neither a row nor an arm"),
+            "{}",
+            e(&bad)
+        );
         let innies = FILE.replace("row = \"b\"", "row = \"b\"\ninnies = 1");
-        assert!(e(&innies).contains("only orbital construction and the role hasher have innies"), "{}", e(&innies));
+        assert!(
+            e(&innies).contains("only orbital construction and the role hasher have innies"),
+            "{}",
+            e(&innies)
+        );
         let syntax = FILE.replace("[table]", "[table");
         assert!(e(&syntax).contains("line 3"), "{}", e(&syntax));
         let metric = FILE.replace("\"formations_ratio\"", "\"speed\"");
@@ -450,9 +548,20 @@ alpha = 0.1
         let range = FILE.replace("alpha = 0.1", "alpha = 3.0");
         assert!(e(&range).contains("learn.alpha = 3"), "{}", e(&range));
         let no_file = FILE.replace("controller = \"oc\"", "controller = \"policy\"");
-        assert!(e(&no_file).contains("names its policy file"), "{}", e(&no_file));
-        let stray = FILE.replace("controller = \"oc\"", "controller = \"oc\"\npolicy = \"p.policy\"");
-        assert!(e(&stray).contains("only a policy arm does"), "{}", e(&stray));
+        assert!(
+            e(&no_file).contains("names its policy file"),
+            "{}",
+            e(&no_file)
+        );
+        let stray = FILE.replace(
+            "controller = \"oc\"",
+            "controller = \"oc\"\npolicy = \"p.policy\"",
+        );
+        assert!(
+            e(&stray).contains("only a policy arm does"),
+            "{}",
+            e(&stray)
+        );
     }
 
     #[test]
@@ -465,7 +574,8 @@ alpha = 0.1
         );
         let spec = ExperimentSpec::parse("x", &text).unwrap();
         assert_eq!(spec.arms[0].policy.as_deref(), Some(path.as_path()));
-        let heuristic = Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/oc-heuristic.policy");
+        let heuristic =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/oc-heuristic.policy");
         std::fs::copy(&heuristic, &path).unwrap();
         let plan = &super::super::plan::plans(&spec, 1, 1.0, 1)[0];
         let result = super::super::trial::run(plan, None).unwrap();
@@ -475,13 +585,17 @@ alpha = 0.1
         let last = bytes.len() - 5;
         bytes[last] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
-        assert_ne!(super::super::plan::plans(&spec, 1, 1.0, 1)[0].hash, plan.hash);
+        assert_ne!(
+            super::super::plan::plans(&spec, 1, 1.0, 1)[0].hash,
+            plan.hash
+        );
     }
 
     #[test]
     fn every_built_in_experiment_parses() {
         for (name, text) in BUILT_IN {
-            let spec = ExperimentSpec::parse(name, text).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+            let spec =
+                ExperimentSpec::parse(name, text).unwrap_or_else(|e| panic!("{name}: {e:#}"));
             assert!(!spec.arms.is_empty());
         }
     }

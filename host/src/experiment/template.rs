@@ -64,9 +64,12 @@ pub fn render(template: &str, sources: &[Source]) -> Result<String> {
         while let Some(open) = rest.find("{{") {
             out.push_str(&rest[..open]);
             let after = &rest[open + 2..];
-            let close = after.find("}}").ok_or_else(|| anyhow!("template line {}: `{{{{` is not closed", n + 1))?;
+            let close = after
+                .find("}}")
+                .ok_or_else(|| anyhow!("template line {}: `{{{{` is not closed", n + 1))?;
             let expr = &after[..close];
-            let value = expression(expr.trim(), sources).with_context(|| format!("template line {}: {{{{{expr}}}}}", n + 1))?;
+            let value = expression(expr.trim(), sources)
+                .with_context(|| format!("template line {}: {{{{{expr}}}}}", n + 1))?;
             out.push_str(&value);
             rest = &after[close + 2..];
         }
@@ -78,14 +81,19 @@ pub fn render(template: &str, sources: &[Source]) -> Result<String> {
 fn expression(expr: &str, sources: &[Source]) -> Result<String> {
     let parts: Vec<&str> = expr.split('|').map(str::trim).collect();
     if parts.len() == 1 {
-        let (names, what) = expr.rsplit_once(' ').ok_or_else(|| anyhow!("expected `EXP table`, `EXP trials`, ... or `EXP | ARM | QUANTITY | STAT`"))?;
+        let (names, what) = expr.rsplit_once(' ').ok_or_else(|| {
+            anyhow!("expected `EXP table`, `EXP trials`, ... or `EXP | ARM | QUANTITY | STAT`")
+        })?;
         let experiments = experiments(names.trim(), sources)?;
         return whole(&experiments, what);
     }
     if !(4..=5).contains(&parts.len()) {
         bail!("expected EXP | ARM | QUANTITY | STAT, and optionally | OP X");
     }
-    let source = experiments(parts[0], sources)?.into_iter().next().ok_or_else(|| anyhow!("no experiment"))?;
+    let source = experiments(parts[0], sources)?
+        .into_iter()
+        .next()
+        .ok_or_else(|| anyhow!("no experiment"))?;
     let stat = statistic(source, parts[1], parts[2], parts[3])?;
     let Some(value) = stat.value else {
         return Ok(stat.text);
@@ -93,7 +101,10 @@ fn expression(expr: &str, sources: &[Source]) -> Result<String> {
     if let Some(check) = parts.get(4) {
         let (op, x) = comparison(check)?;
         if !op.holds(value, x) {
-            bail!("the trials give {}, which is not {check}: the text around it needs rewriting", stat.text);
+            bail!(
+                "the trials give {}, which is not {check}: the text around it needs rewriting",
+                stat.text
+            );
         }
     }
     Ok(stat.text)
@@ -105,17 +116,25 @@ fn experiments<'a>(names: &str, sources: &'a [Source]) -> Result<Vec<&'a Source>
         .split('+')
         .map(|n| {
             let n = n.trim();
-            sources.iter().find(|s| s.spec.name == n).ok_or_else(|| anyhow!("no experiment {n:?}"))
+            sources
+                .iter()
+                .find(|s| s.spec.name == n)
+                .ok_or_else(|| anyhow!("no experiment {n:?}"))
         })
         .collect()
 }
 
 /// A figure of whole experiments.
 fn whole(experiments: &[&Source], what: &str) -> Result<String> {
-    let trials: Vec<&TrialResult> = experiments.iter().flat_map(|s| &s.published.results).collect();
+    let trials: Vec<&TrialResult> = experiments
+        .iter()
+        .flat_map(|s| &s.published.results)
+        .collect();
     match what {
         "table" => match experiments {
-            [s] => Ok(outputs::table(&s.spec, &s.published.results).trim_end().to_string()),
+            [s] => Ok(outputs::table(&s.spec, &s.published.results)
+                .trim_end()
+                .to_string()),
             _ => bail!("`table` takes one experiment"),
         },
         "version" => {
@@ -128,15 +147,29 @@ fn whole(experiments: &[&Source], what: &str) -> Result<String> {
             })
         }
         "trials" => Ok(prose(trials.len() as f64)),
-        "runs" => Ok(prose((trials.len() + pretrainings(experiments).len()) as f64)),
+        "runs" => Ok(prose(
+            (trials.len() + pretrainings(experiments).len()) as f64,
+        )),
         "steps" => {
             let steps = trials.iter().map(|r| r.steps).sum::<u64>()
-                + pretrainings(experiments).iter().map(|(_, steps)| steps).sum::<u64>();
+                + pretrainings(experiments)
+                    .iter()
+                    .map(|(_, steps)| steps)
+                    .sum::<u64>();
             Ok(format!("{} million", prose((steps as f64 / 1e6).round())))
         }
         "wall" => {
             let seconds: Option<u64> = experiments.iter().map(|s| last_sitting(s)).sum();
-            Ok(seconds.map_or_else(|| "(not recorded)".to_string(), |s| format!("{} s ({} min)", prose(s as f64), prose((s as f64 / 60.0).round()))))
+            Ok(seconds.map_or_else(
+                || "(not recorded)".to_string(),
+                |s| {
+                    format!(
+                        "{} s ({} min)",
+                        prose(s as f64),
+                        prose((s as f64 / 60.0).round())
+                    )
+                },
+            ))
         }
         _ => bail!("unknown figure {what:?}: expected table, version, trials, runs, steps or wall"),
     }
@@ -146,9 +179,19 @@ fn whole(experiments: &[&Source], what: &str) -> Result<String> {
 fn pretrainings(experiments: &[&Source]) -> BTreeSet<(String, u64)> {
     let mut out = BTreeSet::new();
     for s in experiments {
-        let trials = s.published.results.iter().map(|r| r.trial + 1).max().unwrap_or(0);
+        let trials = s
+            .published
+            .results
+            .iter()
+            .map(|r| r.trial + 1)
+            .max()
+            .unwrap_or(0);
         for plan in super::plan::plans(&s.spec, trials, 1.0, s.spec.seed) {
-            let published = s.published.results.iter().any(|r| r.arm == plan.arm && r.trial == plan.trial);
+            let published = s
+                .published
+                .results
+                .iter()
+                .any(|r| r.arm == plan.arm && r.trial == plan.trial);
             if let (true, Some(p)) = (published, plan.pretrain) {
                 out.insert((p.hash, p.config.steps));
             }
@@ -162,7 +205,12 @@ fn pretrainings(experiments: &[&Source]) -> BTreeSet<(String, u64)> {
 fn last_sitting(s: &Source) -> Option<u64> {
     let text = std::fs::read_to_string(s.dir.join("wall-time.txt")).ok()?;
     let line = text.lines().rev().find(|l| !l.trim().is_empty())?;
-    line.split_once(": ")?.1.split_whitespace().next()?.parse().ok()
+    line.split_once(": ")?
+        .1
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// A rendered statistic and the number it stands for (none for text).
@@ -173,11 +221,17 @@ struct Stat {
 
 impl Stat {
     fn number(v: f64, text: String) -> Stat {
-        Stat { text, value: Some(v) }
+        Stat {
+            text,
+            value: Some(v),
+        }
     }
 
     fn text(text: &str) -> Stat {
-        Stat { text: text.to_string(), value: None }
+        Stat {
+            text: text.to_string(),
+            value: None,
+        }
     }
 }
 
@@ -226,7 +280,11 @@ impl Quantity {
                 Line::fit(&points).map(|l| l.slope)
             }
             Quantity::EarlyShare => {
-                let early = r.formation_steps.iter().filter(|&&s| s < r.steps / 5).count();
+                let early = r
+                    .formation_steps
+                    .iter()
+                    .filter(|&&s| s < r.steps / 5)
+                    .count();
                 (r.formations > 0).then(|| early as f64 / r.formations as f64)
             }
         }
@@ -249,10 +307,20 @@ impl Quantity {
 /// The thesis' figure of `q` for arm `a`, or for `a / b`: `a`'s
 /// formations ratio if the file gives one, else the ratio of the two arms'.
 fn thesis(spec: &ExperimentSpec, a: &str, b: Option<&str>, q: Quantity) -> Result<f64> {
-    let m = q.metric().ok_or_else(|| anyhow!("the thesis gives no such figure"))?;
+    let m = q
+        .metric()
+        .ok_or_else(|| anyhow!("the thesis gives no such figure"))?;
     let of = |name: &str, m: Metric| -> Result<f64> {
-        let arm = spec.arm(name).ok_or_else(|| anyhow!("{} has no arm {name:?}", spec.name))?;
-        arm.thesis.get(&m).copied().ok_or_else(|| anyhow!("{}: arm {name:?} has no thesis figure for {}", spec.name, m.label()))
+        let arm = spec
+            .arm(name)
+            .ok_or_else(|| anyhow!("{} has no arm {name:?}", spec.name))?;
+        arm.thesis.get(&m).copied().ok_or_else(|| {
+            anyhow!(
+                "{}: arm {name:?} has no thesis figure for {}",
+                spec.name,
+                m.label()
+            )
+        })
     };
     match b {
         None => of(a, m),
@@ -270,11 +338,26 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
         Some((a, b)) => (a.trim(), Some(b.trim())),
         None => (arms, None),
     };
-    spec.arm(a).ok_or_else(|| anyhow!("{} has no arm {a:?}", spec.name))?;
-    let of_arm = |name: &str| -> Vec<&TrialResult> { source.published.results.iter().filter(|r| r.arm == name).collect() };
+    spec.arm(a)
+        .ok_or_else(|| anyhow!("{} has no arm {a:?}", spec.name))?;
+    let of_arm = |name: &str| -> Vec<&TrialResult> {
+        source
+            .published
+            .results
+            .iter()
+            .filter(|r| r.arm == name)
+            .collect()
+    };
     if stat == "thesis" {
         let v = thesis(spec, a, b, q)?;
-        return Ok(Stat::number(v, if b.is_some() { format!("{v:.2}") } else { prose(v) }));
+        return Ok(Stat::number(
+            v,
+            if b.is_some() {
+                format!("{v:.2}")
+            } else {
+                prose(v)
+            },
+        ));
     }
     let trials = of_arm(a);
     if trials.is_empty() {
@@ -283,11 +366,16 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
     if q == Quantity::StepsPerFormation {
         let mean = trials.iter().map(|r| r.formations as f64).sum::<f64>() / trials.len() as f64;
         let v = trials[0].steps as f64 / mean;
-        return Ok(if mean > 0.0 { Stat::number(v, prose(v)) } else { Stat::text("–") });
+        return Ok(if mean > 0.0 {
+            Stat::number(v, prose(v))
+        } else {
+            Stat::text("–")
+        });
     }
     let mut values: Vec<f64> = trials.iter().filter_map(|r| q.of(r)).collect();
     if let Some(b) = b {
-        spec.arm(b).ok_or_else(|| anyhow!("{} has no arm {b:?}", spec.name))?;
+        spec.arm(b)
+            .ok_or_else(|| anyhow!("{} has no arm {b:?}", spec.name))?;
         let reference: Vec<f64> = of_arm(b).iter().filter_map(|r| q.of(r)).collect();
         if reference.is_empty() {
             return Ok(Stat::text(NOT_RUN));
@@ -313,9 +401,18 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
         "min" => number(min),
         "max" => number(max),
         "ci" => number(ci.half_width),
-        "mean±ci" => Ok(Stat::number(ci.mean, format!("{} ± {}", show(ci.mean), show(ci.half_width)))),
-        "n" => Ok(Stat::number(values.len() as f64, prose(values.len() as f64))),
-        "percent" => Ok(Stat::number(ci.mean * 100.0, format!("{:.0} %", ci.mean * 100.0))),
+        "mean±ci" => Ok(Stat::number(
+            ci.mean,
+            format!("{} ± {}", show(ci.mean), show(ci.half_width)),
+        )),
+        "n" => Ok(Stat::number(
+            values.len() as f64,
+            prose(values.len() as f64),
+        )),
+        "percent" => Ok(Stat::number(
+            ci.mean * 100.0,
+            format!("{:.0} %", ci.mean * 100.0),
+        )),
         "times" => Ok(Stat::number(ci.mean, format!("{:.1}x", ci.mean))),
         "over_thesis" => {
             let v = ci.mean / thesis(spec, a, b, q)?;
@@ -330,7 +427,9 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             if let Some(given) = stat.strip_prefix("verdict") {
                 let figure = match given.trim() {
                     "" => thesis(spec, a, b, q)?,
-                    x => x.parse().map_err(|_| anyhow!("verdict {x:?}: expected a number"))?,
+                    x => x
+                        .parse()
+                        .map_err(|_| anyhow!("verdict {x:?}: expected a number"))?,
                 };
                 return Ok(Stat::text(&verdict(&values, figure)));
             }
@@ -346,7 +445,11 @@ pub fn verdict(values: &[f64], thesis: f64) -> String {
     let ci = MeanCi::of(values);
     let min = values.iter().copied().fold(f64::INFINITY, f64::min);
     let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let side = if ci.mean > thesis { "ours higher" } else { "ours lower" };
+    let side = if ci.mean > thesis {
+        "ours higher"
+    } else {
+        "ours lower"
+    };
     if values.len() > 1 && ci.low() <= thesis && thesis <= ci.high() {
         "reproduced".to_string()
     } else if min <= thesis && thesis <= max {
@@ -381,11 +484,21 @@ impl Op {
 /// `OP X`, e.g. `<= 10`.
 fn comparison(s: &str) -> Result<(Op, f64)> {
     let s = s.trim();
-    let (op, rest) = [("<=", Op::Le), (">=", Op::Ge), ("<", Op::Lt), (">", Op::Gt), ("=", Op::Eq)]
-        .into_iter()
-        .find_map(|(token, op)| s.strip_prefix(token).map(|rest| (op, rest)))
-        .ok_or_else(|| anyhow!("{s:?}: expected OP X with OP one of <, <=, >, >=, ="))?;
-    let x = rest.trim().replace(',', "").parse().map_err(|_| anyhow!("{s:?}: {:?} is not a number", rest.trim()))?;
+    let (op, rest) = [
+        ("<=", Op::Le),
+        (">=", Op::Ge),
+        ("<", Op::Lt),
+        (">", Op::Gt),
+        ("=", Op::Eq),
+    ]
+    .into_iter()
+    .find_map(|(token, op)| s.strip_prefix(token).map(|rest| (op, rest)))
+    .ok_or_else(|| anyhow!("{s:?}: expected OP X with OP one of <, <=, >, >=, ="))?;
+    let x = rest
+        .trim()
+        .replace(',', "")
+        .parse()
+        .map_err(|_| anyhow!("{s:?}: {:?} is not a number", rest.trim()))?;
     Ok((op, x))
 }
 
@@ -405,7 +518,10 @@ pub fn prose(v: f64) -> String {
             }
             grouped.push(c);
         }
-        format!("{}{grouped}", if v < 0.0 && v.round() != 0.0 { "-" } else { "" })
+        format!(
+            "{}{grouped}",
+            if v < 0.0 && v.round() != 0.0 { "-" } else { "" }
+        )
     } else if a >= 10.0 {
         format!("{v:.1}")
     } else {
@@ -450,24 +566,57 @@ mod tests {
             steps_per_second: 0.0,
             seconds: 0.0,
         };
-        let mut results: Vec<TrialResult> = a.iter().enumerate().map(|(i, &f)| trial("A", i, f)).collect();
+        let mut results: Vec<TrialResult> = a
+            .iter()
+            .enumerate()
+            .map(|(i, &f)| trial("A", i, f))
+            .collect();
         results.extend(b.iter().enumerate().map(|(i, &f)| trial("B", i, f)));
-        vec![Source { spec, published: Published { results, stale: vec![] }, dir: PathBuf::from("/nonexistent") }]
+        vec![Source {
+            spec,
+            published: Published {
+                results,
+                stale: vec![],
+            },
+            dir: PathBuf::from("/nonexistent"),
+        }]
     }
 
     #[test]
     fn expressions_render_statistics_ratios_counts_and_checks() {
         let s = sources(&[8, 12, 13], &[4, 6]);
         let r = |t: &str| render(t, &s);
-        assert_eq!(r("{{x | A | formations | mean}} of {{x | A | formations | thesis}}").unwrap(), "11 of 10");
-        assert_eq!(r("{{x | A | formations | median}} {{x | A | formations | count > 9}}").unwrap(), "12 2");
-        assert_eq!(r("{{x | A / B | formations | ratio}} {{x | A / B | formations | times}}").unwrap(), "2.20 2.2x");
-        assert_eq!(r("{{x | A | first_formation | max}} {{x trials}} {{x version}}").unwrap(), "10 5 2");
-        assert_eq!(r("{{x | A | formations | over_thesis | > 1}}").unwrap(), "1.10");
+        assert_eq!(
+            r("{{x | A | formations | mean}} of {{x | A | formations | thesis}}").unwrap(),
+            "11 of 10"
+        );
+        assert_eq!(
+            r("{{x | A | formations | median}} {{x | A | formations | count > 9}}").unwrap(),
+            "12 2"
+        );
+        assert_eq!(
+            r("{{x | A / B | formations | ratio}} {{x | A / B | formations | times}}").unwrap(),
+            "2.20 2.2x"
+        );
+        assert_eq!(
+            r("{{x | A | first_formation | max}} {{x trials}} {{x version}}").unwrap(),
+            "10 5 2"
+        );
+        assert_eq!(
+            r("{{x | A | formations | over_thesis | > 1}}").unwrap(),
+            "1.10"
+        );
         let broken = r("line\n{{x | A | formations | mean | < 11}}").unwrap_err();
-        assert!(format!("{broken:#}").contains("line 2") && format!("{broken:#}").contains("not < 11"), "{broken:#}");
+        assert!(
+            format!("{broken:#}").contains("line 2") && format!("{broken:#}").contains("not < 11"),
+            "{broken:#}"
+        );
         let none = sources(&[], &[]);
-        assert_eq!(render("{{x | A | formations | mean | > 5}}", &none).unwrap(), NOT_RUN, "no trials: nothing to check");
+        assert_eq!(
+            render("{{x | A | formations | mean | > 5}}", &none).unwrap(),
+            NOT_RUN,
+            "no trials: nothing to check"
+        );
     }
 
     /// Trials of 1,000 steps with formations every 10 steps: 30 of them
@@ -475,7 +624,10 @@ mod tests {
     #[test]
     fn the_early_share_is_the_part_of_a_trials_formations_in_its_first_fifth() {
         let s = sources(&[30, 8], &[]);
-        assert_eq!(render("{{x | A | early_share | percent}}", &s).unwrap(), "82 %");
+        assert_eq!(
+            render("{{x | A | early_share | percent}}", &s).unwrap(),
+            "82 %"
+        );
         assert_eq!(render("{{x | A | early_share | min}}", &s).unwrap(), "0.63");
         assert!(render("{{x | A | early_share | percent | < 80}}", &s).is_err());
     }

@@ -3,13 +3,13 @@
 
 use super::plan::{TrialPlan, RESULT_FORMAT};
 use super::spec::ArmController;
-use sim::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction};
 use crate::learn::QTable;
-use sim::sensor_setup::SelectedSensors;
-use sim::{EpisodeEnd, Simulation, Totals};
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use sim::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction};
+use sim::sensor_setup::SelectedSensors;
+use sim::{EpisodeEnd, Simulation, Totals};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -70,7 +70,10 @@ pub fn stored_files(dir: &Path) -> Result<Vec<(PathBuf, Vec<PathBuf>)>> {
     let Ok(entries) = std::fs::read_dir(dir.join("trials")) else {
         return Ok(Vec::new());
     };
-    let mut arm_dirs: Vec<_> = entries.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.is_dir()).collect();
+    let mut arm_dirs: Vec<_> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_dir())
+        .collect();
     arm_dirs.sort();
     arm_dirs
         .into_iter()
@@ -100,7 +103,8 @@ impl Recorder {
             self.formation_steps.push(totals.steps);
         }
         if totals.steps % BLOCK_STEPS == 0 {
-            self.collisions_per_block.push(totals.robot_contacts - self.contacts_at_block_start);
+            self.collisions_per_block
+                .push(totals.robot_contacts - self.contacts_at_block_start);
             self.contacts_at_block_start = totals.robot_contacts;
         }
     }
@@ -133,9 +137,14 @@ impl Running {
                 let sim = prepared.simulation(c.seed).context("invalid settings")?;
                 Running::Oc(Box::new(sim), oc)
             }
-            ArmController::Learn => Running::Learn(Box::new(Trainer::start(c.clone(), seed_table)?)),
+            ArmController::Learn => {
+                Running::Learn(Box::new(Trainer::start(c.clone(), seed_table)?))
+            }
             ArmController::Policy => {
-                let path = plan.policy.as_deref().context("a policy arm without its policy file")?;
+                let path = plan
+                    .policy
+                    .as_deref()
+                    .context("a policy arm without its policy file")?;
                 let blob = sim::policy_file::read(path)?;
                 let mut prepared = c.prepare()?;
                 sim::scenario::drive_with(prepared.config_mut(), &blob, &c.field);
@@ -201,7 +210,11 @@ pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> 
         collisions_per_block: recorder.collisions_per_block,
         states_visited: states.map(|s| s.0),
         states_total: states.map(|s| s.1),
-        steps_per_second: if seconds > 0.0 { totals.steps as f64 / seconds } else { f64::INFINITY },
+        steps_per_second: if seconds > 0.0 {
+            totals.steps as f64 / seconds
+        } else {
+            f64::INFINITY
+        },
         seconds,
     })
 }

@@ -1,12 +1,12 @@
 //! The Q-learning controller: one table, every robot's experience.
 
 use super::qtable::{QParams, QTable};
-use sim::reward::Reward;
-use sim::{Controller, Perception};
-use sim::{EpisodeStart, SimRng, StepOutcome};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
+use sim::reward::Reward;
+use sim::{Controller, Perception};
+use sim::{EpisodeStart, SimRng, StepOutcome};
 
 /// What the learner is and how it learns.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -51,9 +51,9 @@ impl std::str::FromStr for StateHasherName {
     type Err = String;
 
     fn from_str(s: &str) -> Result<StateHasherName, String> {
-        StateHasher::from_name(s).map(StateHasherName).ok_or_else(|| {
-            format!("unknown hasher {s:?}: expected {}", StateHasher::NAMES)
-        })
+        StateHasher::from_name(s)
+            .map(StateHasherName)
+            .ok_or_else(|| format!("unknown hasher {s:?}: expected {}", StateHasher::NAMES))
     }
 }
 
@@ -80,20 +80,30 @@ impl LearnConfig {
         if let Err(e) = ActionTable::new(&self.actions, 1.0) {
             bail!("learn.actions = {:?}: {e}", self.actions);
         }
-        for (name, value) in [("learn.alpha", self.alpha), ("learn.gamma", self.gamma), ("learn.epsilon", self.epsilon)] {
+        for (name, value) in [
+            ("learn.alpha", self.alpha),
+            ("learn.gamma", self.gamma),
+            ("learn.epsilon", self.epsilon),
+        ] {
             if !(0.0..=1.0).contains(&value) {
                 bail!("{name} = {value}: must be in [0, 1]");
             }
         }
         if !self.initial_q.is_finite() {
-            bail!("learn.initial_q = {}: must be a finite number", self.initial_q);
+            bail!(
+                "learn.initial_q = {}: must be a finite number",
+                self.initial_q
+            );
         }
         Ok(())
     }
 
     /// The Q-update's parameters.
     pub fn params(&self) -> QParams {
-        QParams { alpha: self.alpha, gamma: self.gamma }
+        QParams {
+            alpha: self.alpha,
+            gamma: self.gamma,
+        }
     }
 }
 
@@ -119,7 +129,12 @@ impl QLearner {
     pub fn new(config: LearnConfig) -> Result<QLearner> {
         config.validate()?;
         let q = QTable::new(config.hasher.0, config.actions.len(), config.initial_q);
-        Ok(QLearner { config, q, chosen: Vec::new(), last_signal: 0.0 })
+        Ok(QLearner {
+            config,
+            q,
+            chosen: Vec::new(),
+            last_signal: 0.0,
+        })
     }
 
     /// A learner that starts from another run's table (the thesis' RL2 and
@@ -161,7 +176,12 @@ impl Controller for QLearner {
     fn decide(&mut self, perception: &Perception<'_>, turns: &mut [f32], rng: &mut SimRng) {
         let hasher = self.q.hasher();
         self.chosen.clear();
-        for ((reading, turn), robot) in perception.readings.iter().zip(turns.iter_mut()).zip(perception.robots) {
+        for ((reading, turn), robot) in perception
+            .readings
+            .iter()
+            .zip(turns.iter_mut())
+            .zip(perception.robots)
+        {
             let state = hasher.hash_as(reading, robot.kind.role());
             let action = self.q.select(state, self.config.epsilon, rng);
             *turn = self.config.actions[action.index()];
@@ -174,17 +194,29 @@ impl Controller for QLearner {
     }
 
     fn episode_start(&mut self, start: &EpisodeStart<'_>) {
-        self.last_signal = self.config.reward.signal(start.world, start.field, start.config, None);
+        self.last_signal = self
+            .config
+            .reward
+            .signal(start.world, start.field, start.config, None);
     }
 
     fn observe(&mut self, outcome: &StepOutcome<'_>) {
-        let signal = self.config.reward.signal(outcome.world, outcome.field, outcome.config, outcome.eval);
+        let signal =
+            self.config
+                .reward
+                .signal(outcome.world, outcome.field, outcome.config, outcome.eval);
         let reward = self.config.reward.reward(self.last_signal, signal);
         let hasher = self.q.hasher();
         let params = self.config.params();
         let robots = outcome.world.robots();
         for ((&(s, a), reading), robot) in self.chosen.iter().zip(outcome.readings).zip(robots) {
-            self.q.update(s, a, reward, hasher.hash_as(reading, robot.kind.role()), params);
+            self.q.update(
+                s,
+                a,
+                reward,
+                hasher.hash_as(reading, robot.kind.role()),
+                params,
+            );
         }
         self.last_signal = signal;
     }
@@ -193,30 +225,45 @@ impl Controller for QLearner {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
     use rand::SeedableRng;
     use shared::{PolicyTable, SensorReading};
+    use sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
 
     /// Two robots in the same state take the same action and reach the
     /// same state: the second update sees the first.
     #[test]
     fn updates_are_applied_in_robot_order_each_seeing_the_last() {
         let config = SimConfig::default();
-        let robots = [(Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie), (Vec2::new(300.0, 300.0), 0.0, RobotKind::Outie)];
+        let robots = [
+            (Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie),
+            (Vec2::new(300.0, 300.0), 0.0, RobotKind::Outie),
+        ];
         let world = World::scene(&config, &robots, &[], 1);
         let field = ScalarField::annulus();
         let mut policy = PolicyTable::new(StateHasher::Original);
-        let reading = SensorReading { puck_left: true, ..SensorReading::default() };
+        let reading = SensorReading {
+            puck_left: true,
+            ..SensorReading::default()
+        };
         let s = StateHasher::Original.hash(&reading);
         policy.set(s, ActionId(0));
         let learn = LearnConfig::default();
-        let mut learner = QLearner::with_table(learn.clone(), QTable::from_policy(&policy, 4, 1.0)).unwrap();
+        let mut learner =
+            QLearner::with_table(learn.clone(), QTable::from_policy(&policy, 4, 1.0)).unwrap();
 
         // no pucks: Eval stays 1, so the reference reward is 0 - 1 = -1
-        learner.episode_start(&EpisodeStart { world: &world, field: &field, config: &config });
+        learner.episode_start(&EpisodeStart {
+            world: &world,
+            field: &field,
+            config: &config,
+        });
         let readings = [reading; 2];
         let mut turns = [0.0; 2];
-        let perception = Perception { readings: &readings, robots: world.robots(), episode_step: 0 };
+        let perception = Perception {
+            readings: &readings,
+            robots: world.robots(),
+            episode_step: 0,
+        };
         learner.decide(&perception, &mut turns, &mut SimRng::seed_from_u64(1));
         assert_eq!(turns, [learn.actions[0]; 2]);
         learner.observe(&StepOutcome {
@@ -232,7 +279,11 @@ mod tests {
         // first: 2 + 0.2 (-1 + 0.9 x 2 - 2) = 1.76; second sees it:
         // 1.76 + 0.2 (-1 + 0.9 x 1.76 - 1.76) = 1.5248
         let q = learner.table();
-        assert!((q.value(s, ActionId(0)) - 1.5248).abs() < 1e-12, "{}", q.value(s, ActionId(0)));
+        assert!(
+            (q.value(s, ActionId(0)) - 1.5248).abs() < 1e-12,
+            "{}",
+            q.value(s, ActionId(0))
+        );
         assert_eq!(q.visits(s, ActionId(0)), 2);
         assert_eq!(learner.signal(), 1.0);
     }
@@ -240,7 +291,9 @@ mod tests {
     #[test]
     fn a_seed_table_of_another_shape_is_refused() {
         let q = QTable::new(StateHasher::Bits9, 4, 1.0);
-        let e = QLearner::with_table(LearnConfig::default(), q).unwrap_err().to_string();
+        let e = QLearner::with_table(LearnConfig::default(), q)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("bits9") && e.contains("original"), "{e}");
     }
 }

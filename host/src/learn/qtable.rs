@@ -32,7 +32,10 @@ pub struct QParams {
 impl Default for QParams {
     /// The thesis' alpha 0.2, gamma 0.9.
     fn default() -> QParams {
-        QParams { alpha: 0.2, gamma: 0.9 }
+        QParams {
+            alpha: 0.2,
+            gamma: 0.9,
+        }
     }
 }
 
@@ -40,7 +43,12 @@ impl QTable {
     /// A table with every value at `initial` (the thesis uses 1.0) and no visits.
     pub fn new(hasher: StateHasher, actions: usize, initial: f64) -> QTable {
         let n = hasher.num_states() * actions;
-        QTable { hasher, actions, values: vec![initial; n], visits: vec![0; n] }
+        QTable {
+            hasher,
+            actions,
+            values: vec![initial; n],
+            visits: vec![0; n],
+        }
     }
 
     /// The hasher whose states index the table.
@@ -72,7 +80,10 @@ impl QTable {
 
     /// Number of states with at least one update.
     pub fn states_visited(&self) -> usize {
-        self.visits.chunks(self.actions).filter(|row| row.iter().any(|&v| v > 0)).count()
+        self.visits
+            .chunks(self.actions)
+            .filter(|row| row.iter().any(|&v| v > 0))
+            .count()
     }
 
     /// An action with the greatest value; among equal maxima, one chosen
@@ -82,8 +93,17 @@ impl QTable {
         let row = self.row(state);
         let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         let ties = row.iter().filter(|&&v| v == best).count();
-        let pick = if ties > 1 { rng.random_range(0..ties) } else { 0 };
-        let index = row.iter().enumerate().filter(|(_, &v)| v == best).nth(pick).map_or(0, |(i, _)| i);
+        let pick = if ties > 1 {
+            rng.random_range(0..ties)
+        } else {
+            0
+        };
+        let index = row
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v == best)
+            .nth(pick)
+            .map_or(0, |(i, _)| i);
         ActionId(index as u8)
     }
 
@@ -102,7 +122,11 @@ impl QTable {
     /// The Q-learning update Q(s,a) += alpha (r + gamma max_a' Q(s',a') - Q(s,a)).
     #[inline]
     pub fn update(&mut self, s: State, a: ActionId, reward: f64, next: State, params: QParams) {
-        let next_best = self.row(next).iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let next_best = self
+            .row(next)
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
         let i = s.index() * self.actions + a.index();
         self.values[i] += params.alpha * (reward + params.gamma * next_best - self.values[i]);
         self.visits[i] += 1;
@@ -154,7 +178,10 @@ mod tests {
     #[test]
     fn update_matches_a_hand_computed_example() {
         let mut q = QTable::new(StateHasher::Original, 4, 1.0);
-        let p = QParams { alpha: 0.2, gamma: 0.9 };
+        let p = QParams {
+            alpha: 0.2,
+            gamma: 0.9,
+        };
         // Q(5,1) = 1 + 0.2 (0.5 + 0.9 x 1 - 1) = 1.08
         q.update(State(5), ActionId(1), 0.5, State(7), p);
         assert!((q.value(State(5), ActionId(1)) - 1.08).abs() < 1e-12);

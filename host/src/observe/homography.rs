@@ -23,7 +23,10 @@ impl Homography {
         let m = [h[0], h[1], h[2], h[3], h[4], h[5], h[6], h[7], 1.0];
         let map = Homography { m };
         // A degenerate quadrilateral solves numerically but maps a corner to infinity.
-        from.iter().zip(to).all(|(p, q)| map.apply(*p).is_some_and(|r| close(r, *q))).then_some(map)
+        from.iter()
+            .zip(to)
+            .all(|(p, q)| map.apply(*p).is_some_and(|r| close(r, *q)))
+            .then_some(map)
     }
 
     /// Where `p` goes, or `None` if it maps to infinity (the horizon).
@@ -33,7 +36,10 @@ impl Homography {
         if w.abs() < 1e-12 {
             return None;
         }
-        Some([(m[0] * x + m[1] * y + m[2]) / w, (m[3] * x + m[4] * y + m[5]) / w])
+        Some([
+            (m[0] * x + m[1] * y + m[2]) / w,
+            (m[3] * x + m[4] * y + m[5]) / w,
+        ])
     }
 }
 
@@ -76,18 +82,32 @@ mod tests {
     #[test]
     fn four_corners_map_exactly_and_lines_stay_lines() {
         let square = [[0.0, 0.0], [254.0, 0.0], [254.0, 142.8], [0.0, 142.8]];
-        let photo = [[210.0, 180.0], [1420.0, 140.0], [1500.0, 1010.0], [120.0, 1060.0]];
+        let photo = [
+            [210.0, 180.0],
+            [1420.0, 140.0],
+            [1500.0, 1010.0],
+            [120.0, 1060.0],
+        ];
         let h = Homography::from_points(&square, &photo).unwrap();
         for (s, p) in square.iter().zip(&photo) {
             let q = h.apply(*s).unwrap();
-            assert!((q[0] - p[0]).abs() < 1e-6 && (q[1] - p[1]).abs() < 1e-6, "{q:?} {p:?}");
+            assert!(
+                (q[0] - p[0]).abs() < 1e-6 && (q[1] - p[1]).abs() < 1e-6,
+                "{q:?} {p:?}"
+            );
         }
         let back = Homography::from_points(&photo, &square).unwrap();
         let mid = back.apply(h.apply([100.0, 50.0]).unwrap()).unwrap();
-        assert!((mid[0] - 100.0).abs() < 1e-6 && (mid[1] - 50.0).abs() < 1e-6, "{mid:?}");
+        assert!(
+            (mid[0] - 100.0).abs() < 1e-6 && (mid[1] - 50.0).abs() < 1e-6,
+            "{mid:?}"
+        );
         // The middle of the top edge lies on the photo's top edge.
         let top = h.apply([127.0, 0.0]).unwrap();
-        let (edge, to_top) = ([photo[1][0] - photo[0][0], photo[1][1] - photo[0][1]], [top[0] - photo[0][0], top[1] - photo[0][1]]);
+        let (edge, to_top) = (
+            [photo[1][0] - photo[0][0], photo[1][1] - photo[0][1]],
+            [top[0] - photo[0][0], top[1] - photo[0][1]],
+        );
         let cross = edge[0] * to_top[1] - edge[1] * to_top[0];
         assert!(cross.abs() < 1e-6, "{cross}");
     }

@@ -94,23 +94,41 @@ pub struct Observation {
 impl fmt::Display for Observation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "photo {}: {} on {}", self.photo, self.field, self.arena)?;
-        writeln!(f, "pucks found: {} (the arena places {})", self.pucks.len(), self.arena_pucks)?;
+        writeln!(
+            f,
+            "pucks found: {} (the arena places {})",
+            self.pucks.len(),
+            self.arena_pucks
+        )?;
         if self.pucks.is_empty() {
             writeln!(f, "  none: check --corners and --puck-colour (the pucks' colour as the camera sees it)")?;
         }
         for (i, p) in self.pucks.iter().enumerate() {
             let (x_mm, y_mm) = (p.x * self.unit_mm, p.y * self.unit_mm);
-            writeln!(f, "  {:>3}: ({:7.1}, {:7.1}) mm, field {:.3}", i + 1, x_mm, y_mm, p.value)?;
+            writeln!(
+                f,
+                "  {:>3}: ({:7.1}, {:7.1}) mm, field {:.3}",
+                i + 1,
+                x_mm,
+                y_mm,
+                p.value
+            )?;
         }
         let verdict = if self.formed { "formed" } else { "not formed" };
-        writeln!(f, "Eval {:.4} (success above {}): {verdict}", self.eval, self.success_eval)
+        writeln!(
+            f,
+            "Eval {:.4} (success above {}): {verdict}",
+            self.eval, self.success_eval
+        )
     }
 }
 
 /// Measures the photo; writes the picture if asked.
 pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
     let arena = &settings.arena;
-    arena.validate().with_context(|| format!("arena {}", arena.name))?;
+    arena
+        .validate()
+        .with_context(|| format!("arena {}", arena.name))?;
     let colour = ColourMatch::of(settings.puck_colour).with_context(|| {
         let [r, g, b] = settings.puck_colour;
         format!(
@@ -152,7 +170,11 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
         pixels_per_unit: scale,
         pucks: centres
             .iter()
-            .map(|p| ObservedPuck { x: p.x, y: p.y, value: f64::from(field.evaluate(*p, &layout)) })
+            .map(|p| ObservedPuck {
+                x: p.x,
+                y: p.y,
+                value: f64::from(field.evaluate(*p, &layout)),
+            })
             .collect(),
         arena_pucks: arena.pucks,
         eval,
@@ -176,10 +198,19 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
 const OUTLINE: Rgb<u8> = Rgb([0, 230, 0]);
 
 /// The map from the arena (units) to the photo (pixels), the corners checked.
-fn screen_map(arena: &ArenaSpec, corners: &[[f64; 2]; 4], (w, h): (u32, u32)) -> Result<Homography> {
+fn screen_map(
+    arena: &ArenaSpec,
+    corners: &[[f64; 2]; 4],
+    (w, h): (u32, u32),
+) -> Result<Homography> {
     for (c, name) in corners.iter().zip(CORNER_NAMES) {
         let inside = (0.0..=f64::from(w)).contains(&c[0]) && (0.0..=f64::from(h)).contains(&c[1]);
-        anyhow::ensure!(inside, "--corners: the {name} corner ({}, {}) lies outside the photo ({w} x {h})", c[0], c[1]);
+        anyhow::ensure!(
+            inside,
+            "--corners: the {name} corner ({}, {}) lies outside the photo ({w} x {h})",
+            c[0],
+            c[1]
+        );
     }
     let turns: Vec<f64> = (0..4)
         .map(|i| {
@@ -195,7 +226,8 @@ fn screen_map(arena: &ArenaSpec, corners: &[[f64; 2]; 4], (w, h): (u32, u32)) ->
     );
     let size = arena.size();
     let screen = [[0.0, 0.0], [size.x, 0.0], [size.x, size.y], [0.0, size.y]];
-    Homography::from_points(&screen, corners).context("--corners: no perspective maps the screen onto them")
+    Homography::from_points(&screen, corners)
+        .context("--corners: no perspective maps the screen onto them")
 }
 
 /// Top-down pixels per unit: as fine as the photo's view of the screen
@@ -210,10 +242,15 @@ fn pixels_per_unit(arena: &ArenaSpec, c: &[[f64; 2]; 4]) -> f64 {
 
 /// The photo resampled over the arena, `scale` pixels per unit (bilinear).
 fn resample(photo: &RgbImage, to_photo: &Homography, size: Vec2, scale: f64) -> RgbImage {
-    let (w, h) = ((size.x * scale).round().max(1.0) as u32, (size.y * scale).round().max(1.0) as u32);
+    let (w, h) = (
+        (size.x * scale).round().max(1.0) as u32,
+        (size.y * scale).round().max(1.0) as u32,
+    );
     RgbImage::from_fn(w, h, |x, y| {
         let p = [(f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale];
-        to_photo.apply(p).map_or(Rgb([0, 0, 0]), |q| sample(photo, q))
+        to_photo
+            .apply(p)
+            .map_or(Rgb([0, 0, 0]), |q| sample(photo, q))
     })
 }
 
@@ -224,7 +261,11 @@ pub fn sample(photo: &RgbImage, [x, y]: [f64; 2]) -> Rgb<u8> {
     let (fx, fy) = (x - 0.5, y - 0.5);
     let (x0, y0) = (fx.floor(), fy.floor());
     let (tx, ty) = (fx - x0, fy - y0);
-    let at = |i: i64, j: i64| photo.get_pixel(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32).0;
+    let at = |i: i64, j: i64| {
+        photo
+            .get_pixel(i.clamp(0, w - 1) as u32, j.clamp(0, h - 1) as u32)
+            .0
+    };
     let (i, j) = (x0 as i64, y0 as i64);
     let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1));
     Rgb(std::array::from_fn(|k| {
@@ -238,7 +279,11 @@ pub fn sample(photo: &RgbImage, [x, y]: [f64; 2]) -> Rgb<u8> {
 fn stack(top: &RgbImage, bottom: &RgbImage) -> RgbImage {
     let width = top.width().max(bottom.width());
     RgbImage::from_fn(width, top.height() + bottom.height(), |x, y| {
-        let (img, y) = if y < top.height() { (top, y) } else { (bottom, y - top.height()) };
+        let (img, y) = if y < top.height() {
+            (top, y)
+        } else {
+            (bottom, y - top.height())
+        };
         if x < img.width() {
             *img.get_pixel(x, y)
         } else {
@@ -249,6 +294,7 @@ fn stack(top: &RgbImage, bottom: &RgbImage) -> RgbImage {
 
 fn write_png(img: &RgbImage, path: &Path) -> Result<()> {
     let mut bytes = Vec::new();
-    img.write_with_encoder(PngEncoder::new(&mut bytes)).context("cannot encode the picture")?;
+    img.write_with_encoder(PngEncoder::new(&mut bytes))
+        .context("cannot encode the picture")?;
     crate::atomic::write(path, &bytes)
 }

@@ -48,7 +48,11 @@ enum Class {
 
 /// Hue (degrees), saturation and value of a colour, HSV.
 fn hsv([r, g, b]: [u8; 3]) -> (f64, f64, f64) {
-    let (r, g, b) = (f64::from(r) / 255.0, f64::from(g) / 255.0, f64::from(b) / 255.0);
+    let (r, g, b) = (
+        f64::from(r) / 255.0,
+        f64::from(g) / 255.0,
+        f64::from(b) / 255.0,
+    );
     let (max, min) = (r.max(g).max(b), r.min(g).min(b));
     let chroma = max - min;
     let hue = if chroma == 0.0 {
@@ -68,8 +72,10 @@ impl ColourMatch {
     /// it is too grey to tell from the field (saturation under 0.3).
     pub fn of(rgb: [u8; 3]) -> Option<ColourMatch> {
         let (hue_deg, saturation, value) = hsv(rgb);
-        (saturation >= 0.3 && value >= MIN_VALUE)
-            .then_some(ColourMatch { hue_deg, min_saturation: (saturation / 2.0).clamp(0.2, 0.45) })
+        (saturation >= 0.3 && value >= MIN_VALUE).then_some(ColourMatch {
+            hue_deg,
+            min_saturation: (saturation / 2.0).clamp(0.2, 0.45),
+        })
     }
 
     /// Whether a pixel is a puck's.
@@ -110,7 +116,12 @@ pub fn find_pucks(image: &RgbImage, colour: &ColourMatch, radius_px: f64) -> Vec
         let k = ((blob.pixels.len() as f64 / area).round() as usize).max(1);
         let rough = split(&blob.pixels, k);
         centres.extend(rough.iter().enumerate().map(|(i, c)| {
-            let own: Vec<[f64; 2]> = blob.edges.iter().copied().filter(|e| nearest(&rough, *e) == i).collect();
+            let own: Vec<[f64; 2]> = blob
+                .edges
+                .iter()
+                .copied()
+                .filter(|e| nearest(&rough, *e) == i)
+                .collect();
             fit_circle(*c, &own, radius_px)
         }));
     }
@@ -130,7 +141,10 @@ fn blobs(image: &RgbImage, colour: &ColourMatch) -> Vec<Blob> {
         }
         todo[start] = false;
         stack.push(start);
-        let mut blob = Blob { pixels: Vec::new(), edges: Vec::new() };
+        let mut blob = Blob {
+            pixels: Vec::new(),
+            edges: Vec::new(),
+        };
         while let Some(k) = stack.pop() {
             let (x, y) = (k % w, k / w);
             let centre = [x as f64 + 0.5, y as f64 + 0.5];
@@ -146,7 +160,8 @@ fn blobs(image: &RgbImage, colour: &ColourMatch) -> Vec<Blob> {
                     todo[n] = false;
                     stack.push(n);
                 } else if class[n] == Class::Plain {
-                    blob.edges.push([centre[0] + towards[0], centre[1] + towards[1]]);
+                    blob.edges
+                        .push([centre[0] + towards[0], centre[1] + towards[1]]);
                 }
             }
         }
@@ -157,7 +172,9 @@ fn blobs(image: &RgbImage, colour: &ColourMatch) -> Vec<Blob> {
 
 /// The index of the centre nearest to `p`.
 fn nearest(centres: &[[f64; 2]], p: [f64; 2]) -> usize {
-    (0..centres.len()).min_by(|&a, &b| distance2(p, centres[a]).total_cmp(&distance2(p, centres[b]))).unwrap_or(0)
+    (0..centres.len())
+        .min_by(|&a, &b| distance2(p, centres[a]).total_cmp(&distance2(p, centres[b])))
+        .unwrap_or(0)
 }
 
 /// The centre of the circle of radius `r` through `edges` (least squares,
@@ -219,7 +236,9 @@ fn mean(points: impl Iterator<Item = [f64; 2]>) -> Option<[f64; 2]> {
 
 /// `k` centres of the blob's pixels: its centroid for one, else k-means.
 fn split(blob: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
-    let Some(centroid) = mean(blob.iter().copied()) else { return Vec::new() };
+    let Some(centroid) = mean(blob.iter().copied()) else {
+        return Vec::new();
+    };
     if k == 1 {
         return vec![centroid];
     }
@@ -228,7 +247,9 @@ fn split(blob: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
     let mut centres: Vec<[f64; 2]> = Vec::with_capacity(k);
     let mut nearest: Vec<f64> = blob.iter().map(|p| distance2(*p, centroid)).collect();
     while centres.len() < k {
-        let far = (0..blob.len()).max_by(|&a, &b| nearest[a].total_cmp(&nearest[b])).unwrap_or(0);
+        let far = (0..blob.len())
+            .max_by(|&a, &b| nearest[a].total_cmp(&nearest[b]))
+            .unwrap_or(0);
         let c = blob[far];
         centres.push(c);
         for (d, p) in nearest.iter_mut().zip(blob) {
@@ -239,12 +260,19 @@ fn split(blob: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
     for _ in 0..KMEANS_ITERATIONS {
         let mut changed = false;
         for (o, p) in owner.iter_mut().zip(blob) {
-            let best = (0..k).min_by(|&a, &b| distance2(*p, centres[a]).total_cmp(&distance2(*p, centres[b]))).unwrap_or(0);
+            let best = (0..k)
+                .min_by(|&a, &b| distance2(*p, centres[a]).total_cmp(&distance2(*p, centres[b])))
+                .unwrap_or(0);
             changed |= best != *o;
             *o = best;
         }
         for (c, centre) in centres.iter_mut().enumerate() {
-            if let Some(m) = mean(blob.iter().zip(&owner).filter(|(_, o)| **o == c).map(|(p, _)| *p)) {
+            if let Some(m) = mean(
+                blob.iter()
+                    .zip(&owner)
+                    .filter(|(_, o)| **o == c)
+                    .map(|(p, _)| *p),
+            ) {
                 *centre = m;
             }
         }
@@ -271,11 +299,17 @@ mod tests {
     #[test]
     fn red_on_any_grey_matches_and_grey_blue_or_dark_red_do_not() {
         let red = ColourMatch::of([200, 44, 44]).unwrap();
-        assert!(red.matches([200, 44, 44]) && red.matches([120, 30, 40]) && red.matches([255, 120, 110]));
+        assert!(
+            red.matches([200, 44, 44])
+                && red.matches([120, 30, 40])
+                && red.matches([255, 120, 110])
+        );
         for grey in [0u8, 60, 128, 200, 255] {
             assert!(!red.matches([grey, grey, grey]), "{grey}");
         }
-        assert!(!red.matches([0, 100, 200]) && !red.matches([20, 5, 5]) && !red.matches([200, 160, 40]));
+        assert!(
+            !red.matches([0, 100, 200]) && !red.matches([20, 5, 5]) && !red.matches([200, 160, 40])
+        );
         assert_eq!(ColourMatch::of([128, 120, 120]), None);
     }
 

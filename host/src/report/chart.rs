@@ -75,7 +75,12 @@ pub enum Spread {
 
 /// Mean over trials with a band (95 % confidence or min to max), one line
 /// per arm (like the thesis' Figure 15).
-pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: Spread) -> Result<()> {
+pub fn mean_with_band(
+    path: &Path,
+    labels: Labels<'_>,
+    bands: &[Band],
+    spread: Spread,
+) -> Result<()> {
     // (x, mean, low, high) per sample point
     let summaries: Vec<Vec<(f64, f64, f64, f64)>> = bands
         .iter()
@@ -83,7 +88,8 @@ pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: S
             b.x.iter()
                 .enumerate()
                 .map(|(i, &x)| {
-                    let column: Vec<f64> = b.trials.iter().filter_map(|t| t.get(i).copied()).collect();
+                    let column: Vec<f64> =
+                        b.trials.iter().filter_map(|t| t.get(i).copied()).collect();
                     let ci = MeanCi::of(&column);
                     match spread {
                         Spread::Ci95 => (x, ci.mean, ci.low().max(0.0), ci.high()),
@@ -97,7 +103,10 @@ pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: S
                 .collect()
         })
         .collect();
-    let x_max = bands.iter().flat_map(|b| b.x.iter().copied()).fold(1.0, f64::max);
+    let x_max = bands
+        .iter()
+        .flat_map(|b| b.x.iter().copied())
+        .fold(1.0, f64::max);
     let y_max = summaries.iter().flatten().map(|p| p.3).fold(1.0, f64::max) * 1.05;
     render(path, WIDTH, HEIGHT, |root| {
         let mut chart = frame(root, labels, x_max, y_max)?;
@@ -105,11 +114,19 @@ pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: S
             let color = PALETTE[k % PALETTE.len()];
             let mut outline: Vec<(f64, f64)> = summary.iter().map(|p| (p.0, p.3)).collect();
             outline.extend(summary.iter().rev().map(|p| (p.0, p.2)));
-            chart.draw_series(std::iter::once(Polygon::new(outline, color.mix(0.2).filled())))?;
+            chart.draw_series(std::iter::once(Polygon::new(
+                outline,
+                color.mix(0.2).filled(),
+            )))?;
             chart
-                .draw_series(LineSeries::new(summary.iter().map(|p| (p.0, p.1)), color.stroke_width(2)))?
+                .draw_series(LineSeries::new(
+                    summary.iter().map(|p| (p.0, p.1)),
+                    color.stroke_width(2),
+                ))?
                 .label(band.name.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
         }
         legend(&mut chart)
     })
@@ -118,27 +135,43 @@ pub fn mean_with_band(path: &Path, labels: Labels<'_>, bands: &[Band], spread: S
 /// Points per arm with each arm's least-squares line (like the thesis'
 /// Figure 24).
 pub fn points_with_trend(path: &Path, labels: Labels<'_>, series: &[Scatter]) -> Result<()> {
-    let x_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold(1.0, f64::max);
-    let y_max = series.iter().flat_map(|s| s.points.iter().map(|p| p.1)).fold(1.0, f64::max) * 1.05;
+    let x_max = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0))
+        .fold(1.0, f64::max);
+    let y_max = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.1))
+        .fold(1.0, f64::max)
+        * 1.05;
     render(path, WIDTH, HEIGHT, |root| {
         let mut chart = frame(root, labels, x_max, y_max)?;
         for (k, s) in series.iter().enumerate() {
             let color = PALETTE[k % PALETTE.len()];
-            chart.draw_series(s.points.iter().map(|&p| Circle::new(p, 2, color.mix(0.35).filled())))?;
+            chart.draw_series(
+                s.points
+                    .iter()
+                    .map(|&p| Circle::new(p, 2, color.mix(0.35).filled())),
+            )?;
             let label = match Line::fit(&s.points) {
                 Some(line) => {
                     chart.draw_series(LineSeries::new(
                         [(0.0, line.at(0.0)), (x_max, line.at(x_max))],
                         color.stroke_width(3),
                     ))?;
-                    format!("{} (fit {:+.3e} x + {:.1})", s.name, line.slope, line.intercept)
+                    format!(
+                        "{} (fit {:+.3e} x + {:.1})",
+                        s.name, line.slope, line.intercept
+                    )
                 }
                 None => s.name.clone(),
             };
             chart
                 .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
                 .label(label)
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                });
         }
         legend(&mut chart)
     })
@@ -158,12 +191,20 @@ pub fn tiles(path: &Path, title: &str, pictures: &[(String, image::RgbImage)]) -
     let width = n * TILE + (n + 1) * TILE_GAP;
     let height = TILE_TITLE + TILE + TILE_CAPTION + TILE_GAP;
     render(path, width, height, |root| {
-        root.draw(&Text::new(title.to_string(), (TILE_GAP as i32, 10), (FONT, 22).into_font()))?;
+        root.draw(&Text::new(
+            title.to_string(),
+            (TILE_GAP as i32, 10),
+            (FONT, 22).into_font(),
+        ))?;
         for (k, (caption, picture)) in pictures.iter().enumerate() {
             let x0 = TILE_GAP + k as u32 * (TILE + TILE_GAP);
-            let scaled = image::imageops::resize(picture, TILE, TILE, image::imageops::FilterType::Triangle);
+            let scaled =
+                image::imageops::resize(picture, TILE, TILE, image::imageops::FilterType::Triangle);
             for (x, y, p) in scaled.enumerate_pixels() {
-                root.draw_pixel(((x0 + x) as i32, (TILE_TITLE + y) as i32), &RGBColor(p[0], p[1], p[2]))?;
+                root.draw_pixel(
+                    ((x0 + x) as i32, (TILE_TITLE + y) as i32),
+                    &RGBColor(p[0], p[1], p[2]),
+                )?;
             }
             let at = (x0 as i32, (TILE_TITLE + TILE + 6) as i32);
             root.draw(&Text::new(caption.clone(), at, (FONT, 16).into_font()))?;
@@ -172,7 +213,11 @@ pub fn tiles(path: &Path, title: &str, pictures: &[(String, image::RgbImage)]) -
     })
 }
 
-type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
+>;
 
 fn frame<'a, 'b>(
     root: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
@@ -236,7 +281,8 @@ fn render(
         draw(&root).with_context(|| format!("cannot draw chart {}", path.display()))?;
         root.present()?;
     }
-    let image = image::RgbImage::from_raw(width, height, buffer).context("chart buffer has the wrong size")?;
+    let image = image::RgbImage::from_raw(width, height, buffer)
+        .context("chart buffer has the wrong size")?;
     let mut png = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
@@ -253,28 +299,49 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let x: Vec<f64> = (0..50).map(|i| i as f64 * 1000.0).collect();
         let bands = vec![
-            Band { name: "OC".into(), x: x.clone(), trials: vec![x.iter().map(|v| v / 1000.0).collect(); 3] },
+            Band {
+                name: "OC".into(),
+                x: x.clone(),
+                trials: vec![x.iter().map(|v| v / 1000.0).collect(); 3],
+            },
             Band {
                 name: "RL".into(),
                 x: x.clone(),
-                trials: (0..3).map(|t| x.iter().map(|v| v / 2000.0 + t as f64).collect()).collect(),
+                trials: (0..3)
+                    .map(|t| x.iter().map(|v| v / 2000.0 + t as f64).collect())
+                    .collect(),
             },
         ];
-        let labels = Labels { title: "Formations", x: "step", y: "formations" };
+        let labels = Labels {
+            title: "Formations",
+            x: "step",
+            y: "formations",
+        };
         let path = dir.path().join("f.png");
         mean_with_band(&path, labels, &bands, Spread::Ci95).unwrap();
         let png = image::open(&path).unwrap();
         assert_eq!((png.width(), png.height()), (WIDTH, HEIGHT));
         mean_with_band(&path, labels, &bands, Spread::MinMax).unwrap();
-        let scatter = vec![Scatter { name: "A".into(), points: x.iter().map(|&v| (v, 100.0 + v / 100.0)).collect() }];
+        let scatter = vec![Scatter {
+            name: "A".into(),
+            points: x.iter().map(|&v| (v, 100.0 + v / 100.0)).collect(),
+        }];
         let path = dir.path().join("c.png");
         points_with_trend(&path, labels, &scatter).unwrap();
         assert!(image::open(&path).is_ok());
         let red = image::RgbImage::from_pixel(60, 60, image::Rgb([255, 0, 0]));
         let path = dir.path().join("t.png");
-        tiles(&path, "Two", &[("a".into(), red.clone()), ("b".into(), red)]).unwrap();
+        tiles(
+            &path,
+            "Two",
+            &[("a".into(), red.clone()), ("b".into(), red)],
+        )
+        .unwrap();
         let png = image::open(&path).unwrap().to_rgb8();
         assert_eq!(png.width(), 2 * TILE + 3 * TILE_GAP);
-        assert_eq!(png.get_pixel(TILE_GAP + TILE / 2, TILE_TITLE + TILE / 2), &image::Rgb([255, 0, 0]));
+        assert_eq!(
+            png.get_pixel(TILE_GAP + TILE / 2, TILE_TITLE + TILE / 2),
+            &image::Rgb([255, 0, 0])
+        );
     }
 }

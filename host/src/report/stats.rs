@@ -2,8 +2,9 @@
 
 /// Two-sided 95 % critical values of Student's t for 1..=30 degrees of freedom.
 const T95: [f64; 30] = [
-    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160, 2.145, 2.131,
-    2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056, 2.052, 2.048, 2.045, 2.042,
+    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+    2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+    2.052, 2.048, 2.045, 2.042,
 ];
 
 /// Mean of a sample with the half-width of its 95 % confidence interval
@@ -21,15 +22,24 @@ impl MeanCi {
     pub fn of(values: &[f64]) -> MeanCi {
         let n = values.len();
         if n == 0 {
-            return MeanCi { mean: 0.0, half_width: 0.0 };
+            return MeanCi {
+                mean: 0.0,
+                half_width: 0.0,
+            };
         }
         let mean = values.iter().sum::<f64>() / n as f64;
         if n < 2 {
-            return MeanCi { mean, half_width: 0.0 };
+            return MeanCi {
+                mean,
+                half_width: 0.0,
+            };
         }
         let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
         let t = T95.get(n - 2).copied().unwrap_or(1.960);
-        MeanCi { mean, half_width: t * (var / n as f64).sqrt() }
+        MeanCi {
+            mean,
+            half_width: t * (var / n as f64).sqrt(),
+        }
     }
 
     /// Lower bound of the interval.
@@ -78,7 +88,10 @@ impl Line {
             return None;
         }
         let slope = sxy / sxx;
-        Some(Line { slope, intercept: my - slope * mx })
+        Some(Line {
+            slope,
+            intercept: my - slope * mx,
+        })
     }
 
     /// The line's value at `x`.

@@ -49,7 +49,13 @@ impl FlashPlan {
     /// Validates the request: the policy decodes (and uses `hasher`, when
     /// one is asked for) and a checkout is found (`repo`, or the nearest
     /// ancestor of `cwd` holding one).
-    pub fn new(policy: &Path, hasher: Option<StateHasher>, port: Option<String>, repo: Option<&Path>, cwd: &Path) -> Result<FlashPlan> {
+    pub fn new(
+        policy: &Path,
+        hasher: Option<StateHasher>,
+        port: Option<String>,
+        repo: Option<&Path>,
+        cwd: &Path,
+    ) -> Result<FlashPlan> {
         let blob = sim::policy_file::read(policy)?;
         if let Some(h) = hasher {
             if h != blob.hasher() {
@@ -70,27 +76,47 @@ impl FlashPlan {
             }
             None => find_checkout(cwd)?,
         };
-        let repo = repo.canonicalize().with_context(|| format!("cannot resolve {}", repo.display()))?;
-        let policy = policy.canonicalize().with_context(|| format!("cannot resolve policy file {}", policy.display()))?;
-        let bytes = std::fs::read(&policy).with_context(|| format!("cannot read policy file {}", policy.display()))?;
+        let repo = repo
+            .canonicalize()
+            .with_context(|| format!("cannot resolve {}", repo.display()))?;
+        let policy = policy
+            .canonicalize()
+            .with_context(|| format!("cannot resolve policy file {}", policy.display()))?;
+        let bytes = std::fs::read(&policy)
+            .with_context(|| format!("cannot read policy file {}", policy.display()))?;
         let policy_crc = FirmwareIdentity::policy_crc_of(&bytes)
             .with_context(|| format!("policy file {} is too short", policy.display()))?;
-        Ok(FlashPlan { repo, policy, hasher: blob.hasher(), port, policy_crc, robot_id: 0 })
+        Ok(FlashPlan {
+            repo,
+            policy,
+            hasher: blob.hasher(),
+            port,
+            policy_crc,
+            robot_id: 0,
+        })
     }
 
     /// The same plan for robot `id`.
     pub fn for_robot(self, id: u8) -> FlashPlan {
-        FlashPlan { robot_id: id, ..self }
+        FlashPlan {
+            robot_id: id,
+            ..self
+        }
     }
 
     /// The identity the hex must embed.
     pub fn identity(&self) -> FirmwareIdentity {
-        FirmwareIdentity { robot_id: self.robot_id, policy_crc: self.policy_crc }
+        FirmwareIdentity {
+            robot_id: self.robot_id,
+            policy_crc: self.policy_crc,
+        }
     }
 
     /// This build's own output directory.
     pub fn out_dir(&self) -> PathBuf {
-        self.repo.join(FLASH_BUILDS).join(format!("{:08x}-robot{}", self.policy_crc, self.robot_id))
+        self.repo
+            .join(FLASH_BUILDS)
+            .join(format!("{:08x}-robot{}", self.policy_crc, self.robot_id))
     }
 
     /// The build script.
@@ -118,13 +144,18 @@ impl FlashPlan {
     /// identity (policy CRC and robot id), and no other.
     pub fn check_hex(&self) -> Result<()> {
         let path = self.hex();
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read the built hex {}", path.display()))?;
-        let image = hex_image(&text).with_context(|| format!("the built hex {} is not Intel HEX", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read the built hex {}", path.display()))?;
+        let image = hex_image(&text)
+            .with_context(|| format!("the built hex {} is not Intel HEX", path.display()))?;
         let found: Vec<FirmwareIdentity> = FirmwareIdentity::find_all(&image).collect();
         if found != [self.identity()] {
             let what = match found.first() {
                 None => "no firmware identity".to_string(),
-                Some(f) => format!("policy CRC {:08x} and robot id {}", f.policy_crc, f.robot_id),
+                Some(f) => format!(
+                    "policy CRC {:08x} and robot id {}",
+                    f.policy_crc, f.robot_id
+                ),
             };
             bail!(
                 "the built hex {} embeds {what}, not policy {} (CRC {:08x}) for robot {}: a stale or foreign build; \
@@ -141,16 +172,31 @@ impl FlashPlan {
     /// avrdude's arguments for `port` (docs/firmware.md: avr109 at 57600,
     /// `-D` keeps the bootloader's erase scheme, EEPROM untouched).
     pub fn avrdude_args(&self, port: &str) -> Vec<String> {
-        ["-p", "atmega32u4", "-c", "avr109", "-P", port, "-b", "57600", "-D", "-U"]
-            .iter()
-            .map(|s| s.to_string())
-            .chain([format!("flash:w:{}:i", self.hex().display())])
-            .collect()
+        [
+            "-p",
+            "atmega32u4",
+            "-c",
+            "avr109",
+            "-P",
+            port,
+            "-b",
+            "57600",
+            "-D",
+            "-U",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([format!("flash:w:{}:i", self.hex().display())])
+        .collect()
     }
 
     /// The exact commands a real run executes, as shell lines.
     pub fn describe(&self) -> String {
-        let env: Vec<String> = self.build_env().iter().map(|(k, v)| format!("{k}={}", quote(v))).collect();
+        let env: Vec<String> = self
+            .build_env()
+            .iter()
+            .map(|(k, v)| format!("{k}={}", quote(v)))
+            .collect();
         let port = self.port.as_deref().unwrap_or("PORT");
         let avrdude: Vec<String> = self.avrdude_args(port).iter().map(|a| quote(a)).collect();
         let mut out = String::new();
@@ -177,9 +223,15 @@ impl FlashPlan {
 pub fn hex_image(text: &str) -> Result<Vec<u8>> {
     let mut image = Vec::new();
     let mut base = 0usize;
-    for (n, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+    for (n, line) in text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+    {
         let line = line.trim();
-        let digits = line.strip_prefix(':').with_context(|| format!("line {}: no ':'", n + 1))?;
+        let digits = line
+            .strip_prefix(':')
+            .with_context(|| format!("line {}: no ':'", n + 1))?;
         let bytes: Vec<u8> = (0..digits.len() / 2)
             .map(|i| u8::from_str_radix(digits.get(2 * i..2 * i + 2).unwrap_or("zz"), 16))
             .collect::<Result<_, _>>()
@@ -190,7 +242,11 @@ pub fn hex_image(text: &str) -> Result<Vec<u8>> {
         if bytes.iter().fold(0u8, |s, b| s.wrapping_add(*b)) != 0 {
             bail!("line {}: bad checksum", n + 1);
         }
-        let (addr, kind, data) = (usize::from(u16::from_be_bytes([bytes[1], bytes[2]])), bytes[3], &bytes[4..bytes.len() - 1]);
+        let (addr, kind, data) = (
+            usize::from(u16::from_be_bytes([bytes[1], bytes[2]])),
+            bytes[3],
+            &bytes[4..bytes.len() - 1],
+        );
         match kind {
             0 => {
                 let at = base + addr;
@@ -201,7 +257,9 @@ pub fn hex_image(text: &str) -> Result<Vec<u8>> {
             }
             1 => break,
             2 if data.len() == 2 => base = usize::from(u16::from_be_bytes([data[0], data[1]])) << 4,
-            4 if data.len() == 2 => base = usize::from(u16::from_be_bytes([data[0], data[1]])) << 16,
+            4 if data.len() == 2 => {
+                base = usize::from(u16::from_be_bytes([data[0], data[1]])) << 16
+            }
             3 | 5 => {}
             _ => bail!("line {}: record type {kind} not understood", n + 1),
         }
@@ -211,7 +269,10 @@ pub fn hex_image(text: &str) -> Result<Vec<u8>> {
 
 /// Quotes a shell word when it needs it.
 fn quote(word: &str) -> String {
-    let plain = !word.is_empty() && word.chars().all(|c| c.is_ascii_alphanumeric() || "_/.:=,+-@%".contains(c));
+    let plain = !word.is_empty()
+        && word
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_/.:=,+-@%".contains(c));
     if plain {
         word.to_string()
     } else {
@@ -238,13 +299,16 @@ pub fn find_checkout(start: &Path) -> Result<PathBuf> {
 /// `name` on a `PATH`-style list of directories.
 pub fn find_program(name: &str, path: Option<&OsStr>) -> Option<PathBuf> {
     let path = path?;
-    std::env::split_paths(path).map(|dir| dir.join(name)).find(|p| is_executable(p))
+    std::env::split_paths(path)
+        .map(|dir| dir.join(name))
+        .find(|p| is_executable(p))
 }
 
 #[cfg(unix)]
 fn is_executable(p: &Path) -> bool {
     use std::os::unix::fs::PermissionsExt;
-    p.metadata().is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+    p.metadata()
+        .is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
 }
 
 #[cfg(not(unix))]
@@ -258,7 +322,12 @@ fn is_executable(p: &Path) -> bool {
 /// appear (one there already must go away first: it is not the bootloader
 /// the user just started), runs avrdude. Progress goes to `out`; the build's and
 /// avrdude's own output to this process's.
-pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out: &mut dyn Write) -> Result<()> {
+pub fn flash(
+    plan: &FlashPlan,
+    avrdude: Option<&Path>,
+    port_wait: Duration,
+    out: &mut dyn Write,
+) -> Result<()> {
     let Some(port) = plan.port.as_deref() else {
         bail!(
             "--port is required to flash: after a double press of reset the bootloader appears as a serial port \
@@ -268,12 +337,20 @@ pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out:
     let Some(avrdude) = avrdude else {
         bail!("avrdude is not installed or not on PATH (Debian/Ubuntu: sudo apt-get install avrdude). Nothing was built or written.");
     };
-    writeln!(out, "flash: building the firmware with {} ({}, robot id {})", plan.policy.display(), plan.hasher, plan.robot_id)?;
+    writeln!(
+        out,
+        "flash: building the firmware with {} ({}, robot id {})",
+        plan.policy.display(),
+        plan.hasher,
+        plan.robot_id
+    )?;
     let out_dir = plan.out_dir();
     for stale in ["firmware.hex", "firmware.elf"] {
         match std::fs::remove_file(out_dir.join(stale)) {
             Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(e).with_context(|| format!("cannot remove the old {}", out_dir.join(stale).display()));
+                return Err(e).with_context(|| {
+                    format!("cannot remove the old {}", out_dir.join(stale).display())
+                });
             }
             _ => {}
         }
@@ -285,15 +362,29 @@ pub fn flash(plan: &FlashPlan, avrdude: Option<&Path>, port_wait: Duration, out:
         .status()
         .with_context(|| format!("cannot run {}", plan.build_script().display()))?;
     if !status.success() {
-        bail!("building the firmware failed ({}: {status}); nothing was written to the robot", plan.build_script().display());
+        bail!(
+            "building the firmware failed ({}: {status}); nothing was written to the robot",
+            plan.build_script().display()
+        );
     }
     if !plan.hex().is_file() {
-        bail!("the build did not produce {}; nothing was written to the robot", plan.hex().display());
+        bail!(
+            "the build did not produce {}; nothing was written to the robot",
+            plan.hex().display()
+        );
     }
     plan.check_hex()?;
     let mut was_there = Path::new(port).exists();
-    writeln!(out, "flash: the hex embeds policy CRC {:08x} and robot id {}", plan.policy_crc, plan.robot_id)?;
-    writeln!(out, "flash: double-press the robot's reset button now; waiting up to {} s for {port} to appear", port_wait.as_secs())?;
+    writeln!(
+        out,
+        "flash: the hex embeds policy CRC {:08x} and robot id {}",
+        plan.policy_crc, plan.robot_id
+    )?;
+    writeln!(
+        out,
+        "flash: double-press the robot's reset button now; waiting up to {} s for {port} to appear",
+        port_wait.as_secs()
+    )?;
     if was_there {
         writeln!(out, "flash: {port} exists already: waiting for it to go away and come back (the bootloader you start now)")?;
     }
@@ -330,7 +421,10 @@ mod tests {
     use super::*;
     use std::os::unix::fs::PermissionsExt;
 
-    const POLICY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../policies/oc-heuristic.policy");
+    const POLICY: &str = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../policies/oc-heuristic.policy"
+    );
 
     fn script(path: &Path, body: &str) {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -379,7 +473,15 @@ mod tests {
     fn the_plan_names_the_exact_commands() {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
-        let plan = FlashPlan::new(Path::new(POLICY), None, Some("/dev/ttyACM0".into()), None, &repo.join("firmware")).unwrap().for_robot(4);
+        let plan = FlashPlan::new(
+            Path::new(POLICY),
+            None,
+            Some("/dev/ttyACM0".into()),
+            None,
+            &repo.join("firmware"),
+        )
+        .unwrap()
+        .for_robot(4);
         let repo = repo.canonicalize().unwrap();
         let policy = Path::new(POLICY).canonicalize().unwrap();
         let crc = FirmwareIdentity::policy_crc_of(&std::fs::read(&policy).unwrap()).unwrap();
@@ -404,7 +506,10 @@ mod tests {
         assert_eq!(hex_image(&to_hex(&image)).unwrap(), image);
         let mut bad = to_hex(&image);
         bad.replace_range(9..10, if &bad[9..10] == "0" { "1" } else { "0" });
-        assert!(hex_image(&bad).unwrap_err().to_string().contains("checksum"));
+        assert!(hex_image(&bad)
+            .unwrap_err()
+            .to_string()
+            .contains("checksum"));
         assert!(hex_image("garbage").is_err());
     }
 
@@ -412,21 +517,47 @@ mod tests {
     fn bad_requests_fail_before_anything_runs() {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
-        let e = format!("{:#}", FlashPlan::new(Path::new(POLICY), Some(StateHasher::Bits9), None, None, &repo).unwrap_err());
-        assert!(e.contains("uses hasher original") && e.contains("bits9"), "{e}");
+        let e = format!(
+            "{:#}",
+            FlashPlan::new(
+                Path::new(POLICY),
+                Some(StateHasher::Bits9),
+                None,
+                None,
+                &repo
+            )
+            .unwrap_err()
+        );
+        assert!(
+            e.contains("uses hasher original") && e.contains("bits9"),
+            "{e}"
+        );
         let bad = dir.path().join("bad.policy");
         std::fs::write(&bad, b"QPOL\x01garbage").unwrap();
-        let e = format!("{:#}", FlashPlan::new(&bad, None, None, None, &repo).unwrap_err());
+        let e = format!(
+            "{:#}",
+            FlashPlan::new(&bad, None, None, None, &repo).unwrap_err()
+        );
         assert!(e.contains("bad.policy"), "{e}");
-        let e = format!("{:#}", FlashPlan::new(Path::new(POLICY), None, None, None, dir.path()).unwrap_err());
+        let e = format!(
+            "{:#}",
+            FlashPlan::new(Path::new(POLICY), None, None, None, dir.path()).unwrap_err()
+        );
         assert!(e.contains("must run inside a zumo-swarm checkout"), "{e}");
 
         let plan = FlashPlan::new(Path::new(POLICY), None, None, Some(&repo), dir.path()).unwrap();
         let avrdude = dir.path().join("avrdude");
-        let e = flash(&plan, Some(&avrdude), Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
+        let e = flash(&plan, Some(&avrdude), Duration::ZERO, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("--port is required"), "{e}");
-        let with_port = FlashPlan { port: Some("/dev/ttyACM0".into()), ..plan };
-        let e = flash(&with_port, None, Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
+        let with_port = FlashPlan {
+            port: Some("/dev/ttyACM0".into()),
+            ..plan
+        };
+        let e = flash(&with_port, None, Duration::ZERO, &mut Vec::new())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("avrdude is not installed"), "{e}");
         assert!(!repo.join("built").exists(), "the build ran");
     }
@@ -436,17 +567,51 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
         let bin = dir.path().join("bin");
-        script(&bin.join("avrdude"), &format!("echo \"$@\" > '{}/avrdude-args'", dir.path().display()));
+        script(
+            &bin.join("avrdude"),
+            &format!("echo \"$@\" > '{}/avrdude-args'", dir.path().display()),
+        );
         let port = dir.path().join("ttyACM9");
-        let plan = FlashPlan::new(Path::new(POLICY), None, Some(port.display().to_string()), Some(&repo), dir.path()).unwrap().for_robot(2);
+        let plan = FlashPlan::new(
+            Path::new(POLICY),
+            None,
+            Some(port.display().to_string()),
+            Some(&repo),
+            dir.path(),
+        )
+        .unwrap()
+        .for_robot(2);
         // A build of robot 3, or of another policy, or no identity at all.
-        for other in [plan.clone().for_robot(3), FlashPlan { policy_crc: 7, ..plan.clone() }] {
+        for other in [
+            plan.clone().for_robot(3),
+            FlashPlan {
+                policy_crc: 7,
+                ..plan.clone()
+            },
+        ] {
             std::fs::write(repo.join("hex"), good_hex(&other)).unwrap();
-            let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
-            assert!(e.contains("stale or foreign build") && e.contains("nothing was written"), "{e}");
+            let e = flash(
+                &plan,
+                Some(&bin.join("avrdude")),
+                Duration::ZERO,
+                &mut Vec::new(),
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(
+                e.contains("stale or foreign build") && e.contains("nothing was written"),
+                "{e}"
+            );
         }
         std::fs::write(repo.join("hex"), to_hex(&[0u8; 64])).unwrap();
-        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut Vec::new()).unwrap_err().to_string();
+        let e = flash(
+            &plan,
+            Some(&bin.join("avrdude")),
+            Duration::ZERO,
+            &mut Vec::new(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("no firmware identity"), "{e}");
         assert!(!dir.path().join("avrdude-args").exists());
     }
@@ -456,22 +621,50 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let repo = fake_checkout(dir.path());
         let bin = dir.path().join("bin");
-        script(&bin.join("avrdude"), &format!("echo \"$@\" > '{}/avrdude-args'", dir.path().display()));
-        assert_eq!(find_program("avrdude", Some(bin.as_os_str())), Some(bin.join("avrdude")));
+        script(
+            &bin.join("avrdude"),
+            &format!("echo \"$@\" > '{}/avrdude-args'", dir.path().display()),
+        );
+        assert_eq!(
+            find_program("avrdude", Some(bin.as_os_str())),
+            Some(bin.join("avrdude"))
+        );
         assert_eq!(find_program("avrdude", Some(dir.path().as_os_str())), None);
 
         let port = dir.path().join("ttyACM9");
-        let plan = FlashPlan::new(Path::new(POLICY), None, Some(port.display().to_string()), Some(&repo), dir.path()).unwrap().for_robot(5);
+        let plan = FlashPlan::new(
+            Path::new(POLICY),
+            None,
+            Some(port.display().to_string()),
+            Some(&repo),
+            dir.path(),
+        )
+        .unwrap()
+        .for_robot(5);
         std::fs::write(repo.join("hex"), good_hex(&plan)).unwrap();
         let mut out = Vec::new();
-        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut out).unwrap_err().to_string();
-        assert!(e.contains("did not appear") && e.contains("Nothing was written"), "{e}");
-        assert!(String::from_utf8(out).unwrap().contains("double-press the robot's reset button now"));
+        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::ZERO, &mut out)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("did not appear") && e.contains("Nothing was written"),
+            "{e}"
+        );
+        assert!(String::from_utf8(out)
+            .unwrap()
+            .contains("double-press the robot's reset button now"));
         assert!(!dir.path().join("avrdude-args").exists());
 
         // A port that is there already does not count: it must go away and come back.
         std::fs::write(&port, b"").unwrap();
-        let e = flash(&plan, Some(&bin.join("avrdude")), Duration::from_millis(200), &mut Vec::new()).unwrap_err().to_string();
+        let e = flash(
+            &plan,
+            Some(&bin.join("avrdude")),
+            Duration::from_millis(200),
+            &mut Vec::new(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("did not appear"), "{e}");
         assert!(!dir.path().join("avrdude-args").exists());
         let replug = {
@@ -486,14 +679,29 @@ mod tests {
         // The environment's target directory and output are not the build's.
         std::env::set_var("CARGO_TARGET_DIR", dir.path().join("elsewhere"));
         let mut out = Vec::new();
-        let result = flash(&plan, Some(&bin.join("avrdude")), Duration::from_secs(20), &mut out);
+        let result = flash(
+            &plan,
+            Some(&bin.join("avrdude")),
+            Duration::from_secs(20),
+            &mut out,
+        );
         std::env::remove_var("CARGO_TARGET_DIR");
         replug.join().unwrap();
         result.unwrap();
         assert!(String::from_utf8(out).unwrap().contains("exists already"));
         let built = std::fs::read_to_string(repo.join("built")).unwrap();
-        assert_eq!(built.trim(), format!("{} original 5 {} unset", plan.policy.display(), plan.out_dir().display()));
+        assert_eq!(
+            built.trim(),
+            format!(
+                "{} original 5 {} unset",
+                plan.policy.display(),
+                plan.out_dir().display()
+            )
+        );
         let args = std::fs::read_to_string(dir.path().join("avrdude-args")).unwrap();
-        assert_eq!(args.trim(), plan.avrdude_args(&port.display().to_string()).join(" "));
+        assert_eq!(
+            args.trim(),
+            plan.avrdude_args(&port.display().to_string()).join(" ")
+        );
     }
 }

@@ -35,7 +35,11 @@ impl FrameSplitter {
 
     /// A splitter whose first byte is at `offset` of the stream.
     pub fn at_offset(offset: u64) -> FrameSplitter {
-        FrameSplitter { pending: Vec::new(), pending_offset: offset, position: offset }
+        FrameSplitter {
+            pending: Vec::new(),
+            pending_offset: offset,
+            position: offset,
+        }
     }
 
     /// Feeds bytes; returns the chunks they complete, in order.
@@ -73,7 +77,11 @@ impl FrameSplitter {
     }
 
     fn take(&mut self, terminated: bool) -> Chunk {
-        Chunk { offset: self.pending_offset, bytes: std::mem::take(&mut self.pending), terminated }
+        Chunk {
+            offset: self.pending_offset,
+            bytes: std::mem::take(&mut self.pending),
+            terminated,
+        }
     }
 }
 
@@ -93,9 +101,21 @@ mod tests {
         assert_eq!(
             whole,
             vec![
-                Chunk { offset: 1, bytes: vec![1, 2], terminated: true },
-                Chunk { offset: 5, bytes: vec![3], terminated: true },
-                Chunk { offset: 7, bytes: vec![4, 5], terminated: false },
+                Chunk {
+                    offset: 1,
+                    bytes: vec![1, 2],
+                    terminated: true
+                },
+                Chunk {
+                    offset: 5,
+                    bytes: vec![3],
+                    terminated: true
+                },
+                Chunk {
+                    offset: 7,
+                    bytes: vec![4, 5],
+                    terminated: false
+                },
             ]
         );
         let mut s = FrameSplitter::new();
@@ -109,9 +129,19 @@ mod tests {
         let mut s = FrameSplitter::at_offset(10);
         let chunks = s.push(&vec![7u8; MAX_CHUNK * 2 + 3]);
         assert_eq!(chunks.len(), 2);
-        assert_eq!((chunks[1].offset, chunks[1].terminated), (10 + MAX_CHUNK as u64, false));
+        assert_eq!(
+            (chunks[1].offset, chunks[1].terminated),
+            (10 + MAX_CHUNK as u64, false)
+        );
         s.discard_partial();
-        assert_eq!(s.push(&[9, 0]), vec![Chunk { offset: 10 + 2 * MAX_CHUNK as u64 + 3, bytes: vec![9], terminated: true }]);
+        assert_eq!(
+            s.push(&[9, 0]),
+            vec![Chunk {
+                offset: 10 + 2 * MAX_CHUNK as u64 + 3,
+                bytes: vec![9],
+                terminated: true
+            }]
+        );
         assert_eq!(s.finish(), None);
     }
 }

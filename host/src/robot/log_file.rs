@@ -43,7 +43,9 @@ const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
 
 /// Microseconds since the Unix epoch, the records' host time.
 pub fn host_time_us() -> u64 {
-    SystemTime::now().duration_since(UNIX_EPOCH).map_or(0, |d| u64::try_from(d.as_micros()).unwrap_or(u64::MAX))
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| u64::try_from(d.as_micros()).unwrap_or(u64::MAX))
 }
 
 /// Encodes one record, its `0x00` terminator included.
@@ -74,21 +76,31 @@ impl LogWriter {
     pub fn create(path: &Path, append: bool) -> Result<LogWriter> {
         let existing = std::fs::metadata(path).ok().map(|m| m.len());
         if existing.is_some() && !append {
-            bail!("log file {} already exists: choose another --out, or pass --append to add to it", path.display());
+            bail!(
+                "log file {} already exists: choose another --out, or pass --append to add to it",
+                path.display()
+            );
         }
         let has_content = existing.is_some_and(|len| len > 0);
         if has_content {
             let mut header = [0u8; HEADER_LEN];
-            let mut f = File::open(path).with_context(|| format!("cannot open log file {}", path.display()))?;
-            let n = read_up_to(&mut f, &mut header).with_context(|| format!("cannot read log file {}", path.display()))?;
-            check_header(&header[..n]).with_context(|| format!("cannot append to {}", path.display()))?;
+            let mut f = File::open(path)
+                .with_context(|| format!("cannot open log file {}", path.display()))?;
+            let n = read_up_to(&mut f, &mut header)
+                .with_context(|| format!("cannot read log file {}", path.display()))?;
+            check_header(&header[..n])
+                .with_context(|| format!("cannot append to {}", path.display()))?;
         }
         let file = OpenOptions::new()
             .create(true)
             .append(true)
             .open(path)
             .with_context(|| format!("cannot open log file {} for writing", path.display()))?;
-        let mut w = LogWriter { file, path: path.to_path_buf(), last_sync: Instant::now() };
+        let mut w = LogWriter {
+            file,
+            path: path.to_path_buf(),
+            last_sync: Instant::now(),
+        };
         if has_content {
             // Ends a record a crash may have cut short, so that it does not
             // swallow the first new one (an empty record is skipped).
@@ -98,7 +110,9 @@ impl LogWriter {
             header.push(VERSION);
             w.write(&header)?;
         }
-        w.file.sync_all().with_context(|| format!("cannot flush log file {}", path.display()))?;
+        w.file
+            .sync_all()
+            .with_context(|| format!("cannot flush log file {}", path.display()))?;
         Ok(w)
     }
 
@@ -115,11 +129,15 @@ impl LogWriter {
     /// Forces everything written so far to the disk.
     pub fn sync(&mut self) -> Result<()> {
         self.last_sync = Instant::now();
-        self.file.sync_data().with_context(|| format!("cannot flush log file {}", self.path.display()))
+        self.file
+            .sync_data()
+            .with_context(|| format!("cannot flush log file {}", self.path.display()))
     }
 
     fn write(&mut self, bytes: &[u8]) -> Result<()> {
-        self.file.write_all(bytes).with_context(|| format!("cannot write log file {}", self.path.display()))
+        self.file
+            .write_all(bytes)
+            .with_context(|| format!("cannot write log file {}", self.path.display()))
     }
 }
 
@@ -174,11 +192,16 @@ pub enum RecordError {
 impl fmt::Display for RecordError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match *self {
-            RecordError::Truncated => f.write_str("record truncated: the file ends before its terminator"),
+            RecordError::Truncated => {
+                f.write_str("record truncated: the file ends before its terminator")
+            }
             RecordError::BadCobs => f.write_str("record is not valid COBS"),
             RecordError::TooShort(n) => write!(f, "record of {n} bytes is too short"),
             RecordError::CrcMismatch { stored, computed } => {
-                write!(f, "record is corrupt: CRC-16 is {computed:#06x}, record says {stored:#06x}")
+                write!(
+                    f,
+                    "record is corrupt: CRC-16 is {computed:#06x}, record says {stored:#06x}"
+                )
             }
         }
     }
@@ -211,7 +234,10 @@ fn check_header(bytes: &[u8]) -> Result<()> {
         bail!("not a recorded log (it does not start with \"ZUMOLOG\\0\")");
     }
     if bytes.len() < HEADER_LEN {
-        bail!("the recorded-log header is truncated ({} of {HEADER_LEN} bytes)", bytes.len());
+        bail!(
+            "the recorded-log header is truncated ({} of {HEADER_LEN} bytes)",
+            bytes.len()
+        );
     }
     let version = bytes[MAGIC.len()];
     if version != VERSION {
@@ -224,22 +250,34 @@ fn check_header(bytes: &[u8]) -> Result<()> {
 /// be read (truncated, another format version); damaged records become
 /// entries with an error.
 pub fn parse(bytes: &[u8]) -> Result<Recording> {
-    let starts_like_header = !bytes.is_empty() && MAGIC.starts_with(&bytes[..bytes.len().min(MAGIC.len())]);
+    let starts_like_header =
+        !bytes.is_empty() && MAGIC.starts_with(&bytes[..bytes.len().min(MAGIC.len())]);
     if !starts_like_header {
         let mut splitter = FrameSplitter::new();
         let mut chunks = splitter.push(bytes);
         chunks.extend(splitter.finish());
         let entries = chunks
             .into_iter()
-            .map(|c| Entry { offset: c.offset, len: c.bytes.len(), host_time_us: None, frame: Ok(c.bytes) })
+            .map(|c| Entry {
+                offset: c.offset,
+                len: c.bytes.len(),
+                host_time_us: None,
+                frame: Ok(c.bytes),
+            })
             .collect();
-        return Ok(Recording { kind: SourceKind::RawCapture, entries });
+        return Ok(Recording {
+            kind: SourceKind::RawCapture,
+            entries,
+        });
     }
     check_header(bytes)?;
     let mut splitter = FrameSplitter::at_offset(HEADER_LEN as u64);
     let mut chunks = splitter.push(&bytes[HEADER_LEN..]);
     chunks.extend(splitter.finish());
-    Ok(Recording { kind: SourceKind::Recorded, entries: chunks.iter().map(decode_record).collect() })
+    Ok(Recording {
+        kind: SourceKind::Recorded,
+        entries: chunks.iter().map(decode_record).collect(),
+    })
 }
 
 fn decode_record(chunk: &Chunk) -> Entry {
@@ -257,12 +295,20 @@ fn decode_record(chunk: &Chunk) -> Entry {
             }
         }
     };
-    let entry = |host_time_us, frame| Entry { offset: chunk.offset, len: chunk.bytes.len(), host_time_us, frame };
+    let entry = |host_time_us, frame| Entry {
+        offset: chunk.offset,
+        len: chunk.bytes.len(),
+        host_time_us,
+        frame,
+    };
     match checked {
         Ok(n) => {
             let mut time = [0u8; 8];
             time.copy_from_slice(&payload[..8]);
-            entry(Some(u64::from_le_bytes(time)), Ok(payload[8..n - 2].to_vec()))
+            entry(
+                Some(u64::from_le_bytes(time)),
+                Ok(payload[8..n - 2].to_vec()),
+            )
         }
         Err(_) if !chunk.terminated => entry(None, Err(RecordError::Truncated)),
         Err(e) => entry(None, Err(e)),
@@ -271,7 +317,8 @@ fn decode_record(chunk: &Chunk) -> Entry {
 
 /// Reads and splits a recorded log or raw capture; errors name the file.
 pub fn read(path: &Path) -> Result<Recording> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read log file {}", path.display()))?;
+    let bytes =
+        std::fs::read(path).with_context(|| format!("cannot read log file {}", path.display()))?;
     parse(&bytes).with_context(|| format!("log file {}", path.display()))
 }
 
@@ -288,7 +335,11 @@ mod tests {
         bytes
     }
 
-    const FRAMES: [(u64, &[u8]); 3] = [(1_000_000, &[3, 1, 2, 9]), (0x0100_0000_0000_0000, &[1]), (7, &[5; 300])];
+    const FRAMES: [(u64, &[u8]); 3] = [
+        (1_000_000, &[3, 1, 2, 9]),
+        (0x0100_0000_0000_0000, &[1]),
+        (7, &[5; 300]),
+    ];
 
     #[test]
     fn records_round_trip_with_offsets() {
@@ -300,7 +351,10 @@ mod tests {
             assert_eq!((e.host_time_us, e.frame.as_deref()), (Some(t), Ok(f)));
         }
         assert_eq!(rec.entries[0].offset, HEADER_LEN as u64);
-        assert_eq!(rec.entries[1].offset, (HEADER_LEN + encode_record(FRAMES[0].0, FRAMES[0].1).len()) as u64);
+        assert_eq!(
+            rec.entries[1].offset,
+            (HEADER_LEN + encode_record(FRAMES[0].0, FRAMES[0].1).len()) as u64
+        );
     }
 
     #[test]
@@ -308,7 +362,10 @@ mod tests {
         let bytes = file_of(&FRAMES);
         for len in 0..bytes.len() {
             match parse(&bytes[..len]) {
-                Err(e) => assert!(len > 0 && len < HEADER_LEN && e.to_string().contains("truncated"), "{len}: {e}"),
+                Err(e) => assert!(
+                    len > 0 && len < HEADER_LEN && e.to_string().contains("truncated"),
+                    "{len}: {e}"
+                ),
                 Ok(rec) if len == 0 => assert!(rec.entries.is_empty()),
                 Ok(rec) => {
                     let good: Vec<_> = rec.entries.iter().filter(|e| e.frame.is_ok()).collect();
@@ -318,7 +375,11 @@ mod tests {
                         assert_eq!(b.frame, Err(RecordError::Truncated), "{len}");
                     }
                     for (e, (t, f)) in good.iter().zip(FRAMES) {
-                        assert_eq!((e.host_time_us, e.frame.as_deref()), (Some(t), Ok(f)), "{len}");
+                        assert_eq!(
+                            (e.host_time_us, e.frame.as_deref()),
+                            (Some(t), Ok(f)),
+                            "{len}"
+                        );
                     }
                 }
             }
@@ -339,7 +400,10 @@ mod tests {
                 // (a zero appears): never more than two lost, never a wrong one kept.
                 assert!(good.len() + 2 >= clean.entries.len(), "byte {i} bit {bit}");
                 for e in good {
-                    assert!(clean.entries.iter().any(|c| c.frame == e.frame && c.host_time_us == e.host_time_us));
+                    assert!(clean
+                        .entries
+                        .iter()
+                        .any(|c| c.frame == e.frame && c.host_time_us == e.host_time_us));
                 }
             }
         }
@@ -353,7 +417,13 @@ mod tests {
         assert!(e.contains("version 2 is not supported"), "{e}");
         let raw = parse(&[0, 4, 5, 0, 6]).unwrap();
         assert_eq!(raw.kind, SourceKind::RawCapture);
-        assert_eq!(raw.entries.iter().map(|e| (e.offset, e.frame.clone().unwrap())).collect::<Vec<_>>(), vec![(1, vec![4, 5]), (4, vec![6])]);
+        assert_eq!(
+            raw.entries
+                .iter()
+                .map(|e| (e.offset, e.frame.clone().unwrap()))
+                .collect::<Vec<_>>(),
+            vec![(1, vec![4, 5]), (4, vec![6])]
+        );
     }
 
     #[test]
@@ -381,6 +451,9 @@ mod tests {
         let other = dir.path().join("other.bin");
         std::fs::write(&other, b"hello").unwrap();
         let e = format!("{:#}", LogWriter::create(&other, true).err().unwrap());
-        assert!(e.contains("other.bin") && e.contains("not a recorded log"), "{e}");
+        assert!(
+            e.contains("other.bin") && e.contains("not a recorded log"),
+            "{e}"
+        );
     }
 }

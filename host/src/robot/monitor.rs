@@ -44,7 +44,12 @@ impl PortOpener for SerialOpener {
             .flow_control(serialport::FlowControl::None)
             .timeout(READ_TIMEOUT)
             .open()
-            .with_context(|| format!("cannot open serial port {} at {} baud", self.port, self.baud))?;
+            .with_context(|| {
+                format!(
+                    "cannot open serial port {} at {} baud",
+                    self.port, self.baud
+                )
+            })?;
         Ok(Box::new(port))
     }
 }
@@ -63,7 +68,9 @@ pub fn list_ports() -> Result<Vec<String>> {
                 u.pid,
                 u.manufacturer.unwrap_or_default(),
                 u.product.unwrap_or_default(),
-                u.serial_number.map(|s| format!("serial {s}")).unwrap_or_default()
+                u.serial_number
+                    .map(|s| format!("serial {s}"))
+                    .unwrap_or_default()
             )
             .trim_end()
             .to_string(),
@@ -85,7 +92,10 @@ pub struct MonitorOptions {
 
 impl Default for MonitorOptions {
     fn default() -> MonitorOptions {
-        MonitorOptions { max_frames: None, reopen_interval: Duration::from_millis(500) }
+        MonitorOptions {
+            max_frames: None,
+            reopen_interval: Duration::from_millis(500),
+        }
     }
 }
 
@@ -131,7 +141,11 @@ impl LiveStatus {
 
 impl fmt::Display for LiveStatus {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "frames {} | decode errors {} | fault frames {}", self.frames, self.decode_errors, self.fault_frames)?;
+        write!(
+            f,
+            "frames {} | decode errors {} | fault frames {}",
+            self.frames, self.decode_errors, self.fault_frames
+        )?;
         if let Some((mode, tick, faults)) = self.last {
             write!(f, " | tick {tick} {mode:?}")?;
             for (flag, name) in Faults::NAMED {
@@ -142,7 +156,11 @@ impl fmt::Display for LiveStatus {
         }
         let driven: u64 = self.actions.iter().sum();
         // None until the policy has driven at least once.
-        let shares: Option<Vec<u64>> = self.actions.iter().map(|n| (n * 100).checked_div(driven)).collect();
+        let shares: Option<Vec<u64>> = self
+            .actions
+            .iter()
+            .map(|n| (n * 100).checked_div(driven))
+            .collect();
         if let Some(shares) = shares {
             f.write_str(" | actions")?;
             for (a, pct) in shares.iter().enumerate() {
@@ -153,7 +171,11 @@ impl fmt::Display for LiveStatus {
             write!(f, " | disconnects {}", self.disconnects)?;
         }
         if self.skipped_bytes > 0 {
-            write!(f, " | skipped {} bytes of partial frames", self.skipped_bytes)?;
+            write!(
+                f,
+                " | skipped {} bytes of partial frames",
+                self.skipped_bytes
+            )?;
         }
         Ok(())
     }
@@ -203,11 +225,22 @@ pub fn run(
         while !stop.load(Ordering::SeqCst) && !done(&status) {
             let n = match port.read(&mut buf) {
                 Ok(0) => {
-                    lost(&mut status, &std::io::Error::from(ErrorKind::UnexpectedEof), observer);
+                    lost(
+                        &mut status,
+                        &std::io::Error::from(ErrorKind::UnexpectedEof),
+                        observer,
+                    );
                     break;
                 }
                 Ok(n) => n,
-                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted) => continue,
+                Err(e)
+                    if matches!(
+                        e.kind(),
+                        ErrorKind::TimedOut | ErrorKind::WouldBlock | ErrorKind::Interrupted
+                    ) =>
+                {
+                    continue
+                }
                 Err(e) => {
                     lost(&mut status, &e, observer);
                     break;
@@ -267,7 +300,13 @@ impl<W: Write + IsTerminal> StatusPrinter<W> {
     /// A printer for the port `port`, writing to `out`.
     pub fn new(out: W, port: &str) -> StatusPrinter<W> {
         let terminal = out.is_terminal();
-        StatusPrinter { out, port: port.to_string(), terminal, last: None, failing: false }
+        StatusPrinter {
+            out,
+            port: port.to_string(),
+            terminal,
+            last: None,
+            failing: false,
+        }
     }
 }
 
@@ -284,14 +323,21 @@ impl<W: Write> StatusPrinter<W> {
             }
             MonitorEvent::OpenFailed(e) if !self.failing => {
                 self.failing = true;
-                writeln!(self.out, "{line_start}monitor: {e:#}; retrying until it appears (Ctrl-C ends)")
+                writeln!(
+                    self.out,
+                    "{line_start}monitor: {e:#}; retrying until it appears (Ctrl-C ends)"
+                )
             }
             MonitorEvent::OpenFailed(_) => Ok(()),
             MonitorEvent::Lost(e) => {
                 writeln!(self.out, "{line_start}monitor: lost {port} ({e}); waiting for it to come back (Ctrl-C ends)")
             }
             MonitorEvent::Frame(status) => {
-                let every = if self.terminal { Duration::from_millis(200) } else { Duration::from_secs(1) };
+                let every = if self.terminal {
+                    Duration::from_millis(200)
+                } else {
+                    Duration::from_secs(1)
+                };
                 if self.last.is_some_and(|t| t.elapsed() < every) {
                     return;
                 }
@@ -322,7 +368,12 @@ mod tests {
     use std::io::Cursor;
 
     fn frame(tick: u32, action: u8) -> Vec<u8> {
-        let f = LogFrame { tick, mode: RunMode::Driving, action: ActionId(action), ..LogFrame::default() };
+        let f = LogFrame {
+            tick,
+            mode: RunMode::Driving,
+            action: ActionId(action),
+            ..LogFrame::default()
+        };
         let mut buf = [0u8; LogFrame::MAX_ENCODED_LEN];
         let n = f.encode(&mut buf);
         buf[..n].to_vec()
@@ -354,20 +405,43 @@ mod tests {
             }
             self.fail_next = true;
             self.opens += 1;
-            let s = self.streams.pop_front().ok_or_else(|| anyhow::anyhow!("no such port"))?;
+            let s = self
+                .streams
+                .pop_front()
+                .ok_or_else(|| anyhow::anyhow!("no such port"))?;
             Ok(Box::new(ThenFail(Cursor::new(s))))
         }
     }
 
     #[test]
     fn records_across_unplugging_and_drops_only_the_partial_first_frame() {
-        let first: Vec<u8> = [&frame(1, 0)[3..], &frame(2, 1), &frame(3, 1), &[0x55, 0x66, 0][..]].concat();
-        let second: Vec<u8> = [&frame(7, 0)[..5], &[0][..], &frame(8, 2), &frame(9, 3), &frame(10, 3)[..4]].concat();
-        let mut opener = Unplugging { streams: VecDeque::from([first, second]), fail_next: false, opens: 0 };
+        let first: Vec<u8> = [
+            &frame(1, 0)[3..],
+            &frame(2, 1),
+            &frame(3, 1),
+            &[0x55, 0x66, 0][..],
+        ]
+        .concat();
+        let second: Vec<u8> = [
+            &frame(7, 0)[..5],
+            &[0][..],
+            &frame(8, 2),
+            &frame(9, 3),
+            &frame(10, 3)[..4],
+        ]
+        .concat();
+        let mut opener = Unplugging {
+            streams: VecDeque::from([first, second]),
+            fail_next: false,
+            opens: 0,
+        };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("run.log");
         let mut log = LogWriter::create(&path, false).unwrap();
-        let options = MonitorOptions { max_frames: Some(5), reopen_interval: Duration::ZERO };
+        let options = MonitorOptions {
+            max_frames: Some(5),
+            reopen_interval: Duration::ZERO,
+        };
         let mut events = Vec::new();
         let stop = AtomicBool::new(false);
         let status = run(&mut opener, &mut log, &options, &stop, &mut |e| {
@@ -382,29 +456,67 @@ mod tests {
         assert_eq!(opener.opens, 2);
         assert_eq!(
             events,
-            ["connected", "frame", "frame", "frame", "lost", "open failed", "connected", "frame", "frame"]
+            [
+                "connected",
+                "frame",
+                "frame",
+                "frame",
+                "lost",
+                "open failed",
+                "connected",
+                "frame",
+                "frame"
+            ]
         );
         // Recorded: ticks 2, 3, the garbage chunk (a decode error), 8, 9; the
         // partial first chunk of each connection is skipped, and the frame
         // cut by the unplugging never completes.
-        assert_eq!((status.frames, status.decode_errors, status.disconnects), (5, 1, 1));
+        assert_eq!(
+            (status.frames, status.decode_errors, status.disconnects),
+            (5, 1, 1)
+        );
         assert_eq!(status.skipped_bytes, (frame(1, 0).len() - 4 + 5) as u64);
         assert_eq!(status.actions, [0, 2, 1, 1]);
         let rec = log_file::read(&path).unwrap();
-        let ticks: Vec<Option<u32>> =
-            rec.entries.iter().map(|e| LogFrame::decode(e.frame.as_ref().unwrap()).ok().map(|f| f.tick)).collect();
+        let ticks: Vec<Option<u32>> = rec
+            .entries
+            .iter()
+            .map(|e| {
+                LogFrame::decode(e.frame.as_ref().unwrap())
+                    .ok()
+                    .map(|f| f.tick)
+            })
+            .collect();
         assert_eq!(ticks, [Some(2), Some(3), None, Some(8), Some(9)]);
-        assert!(rec.entries.iter().all(|e| e.host_time_us.is_some_and(|t| t > 0)));
+        assert!(rec
+            .entries
+            .iter()
+            .all(|e| e.host_time_us.is_some_and(|t| t > 0)));
         let line = status.to_string();
-        assert!(line.contains("frames 5 | decode errors 1") && line.contains("actions 0:0% 1:50% 2:25% 3:25%"), "{line}");
+        assert!(
+            line.contains("frames 5 | decode errors 1")
+                && line.contains("actions 0:0% 1:50% 2:25% 3:25%"),
+            "{line}"
+        );
     }
 
     #[test]
     fn a_set_stop_flag_ends_the_loop_without_opening() {
-        let mut opener = Unplugging { streams: VecDeque::new(), fail_next: false, opens: 0 };
+        let mut opener = Unplugging {
+            streams: VecDeque::new(),
+            fail_next: false,
+            opens: 0,
+        };
         let dir = tempfile::tempdir().unwrap();
         let mut log = LogWriter::create(&dir.path().join("x.log"), false).unwrap();
-        let status = run(&mut opener, &mut log, &MonitorOptions::default(), &AtomicBool::new(true), &mut |_| {}).unwrap();
+        let status = run(
+            &mut opener,
+            &mut log,
+            &MonitorOptions::default(),
+            &AtomicBool::new(true),
+            &mut |_| {},
+        )
+        .unwrap();
         assert_eq!((status.frames, opener.opens), (0, 0));
     }
 }

@@ -81,15 +81,26 @@ impl fmt::Display for CheckpointError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             CheckpointError::Truncated { needed, found } => {
-                write!(f, "checkpoint is truncated: {found} bytes, the checkpoint needs {needed}")
+                write!(
+                    f,
+                    "checkpoint is truncated: {found} bytes, the checkpoint needs {needed}"
+                )
             }
-            CheckpointError::PolicyBlob => f.write_str("this is a policy blob, not a checkpoint (it holds no Q-values)"),
-            CheckpointError::WrongMagic => f.write_str("not a checkpoint: the file does not start with ZSWMCKPT"),
+            CheckpointError::PolicyBlob => {
+                f.write_str("this is a policy blob, not a checkpoint (it holds no Q-values)")
+            }
+            CheckpointError::WrongMagic => {
+                f.write_str("not a checkpoint: the file does not start with ZSWMCKPT")
+            }
             CheckpointError::UnsupportedVersion(v) => {
                 write!(f, "checkpoint format version {v} is not supported (this build reads versions 1 to {VERSION})")
             }
             CheckpointError::TrailingBytes { expected, found } => {
-                write!(f, "checkpoint has {found} bytes, {} more than its header declares", found - expected)
+                write!(
+                    f,
+                    "checkpoint has {found} bytes, {} more than its header declares",
+                    found - expected
+                )
             }
             CheckpointError::CrcMismatch { stored, computed } => {
                 write!(f, "checkpoint is corrupt: CRC-32 is {computed:#010x}, the file says {stored:#010x}")
@@ -133,7 +144,10 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
         if !MAGIC.starts_with(bytes) {
             return Err(CheckpointError::WrongMagic);
         }
-        return Err(CheckpointError::Truncated { needed: HEADER_LEN as u64, found });
+        return Err(CheckpointError::Truncated {
+            needed: HEADER_LEN as u64,
+            found,
+        });
     }
     if bytes[..8] != MAGIC {
         return Err(CheckpointError::WrongMagic);
@@ -149,10 +163,18 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
         return Err(CheckpointError::Truncated { needed, found });
     }
     if found > needed {
-        return Err(CheckpointError::TrailingBytes { expected: needed, found });
+        return Err(CheckpointError::TrailingBytes {
+            expected: needed,
+            found,
+        });
     }
     let crc_at = bytes.len() - CRC_LEN;
-    let stored = u32::from_le_bytes([bytes[crc_at], bytes[crc_at + 1], bytes[crc_at + 2], bytes[crc_at + 3]]);
+    let stored = u32::from_le_bytes([
+        bytes[crc_at],
+        bytes[crc_at + 1],
+        bytes[crc_at + 2],
+        bytes[crc_at + 3],
+    ]);
     let computed = CRC32.checksum(&bytes[..crc_at]);
     if stored != computed {
         return Err(CheckpointError::CrcMismatch { stored, computed });
@@ -160,8 +182,12 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
     let body = &bytes[HEADER_LEN..crc_at];
     let malformed = |e: postcard::Error| CheckpointError::Malformed(e.to_string());
     match version {
-        1 => postcard::from_bytes::<StateV1>(body).map(StateV1::into_state).map_err(malformed),
-        2 => postcard::from_bytes::<StateV2>(body).map(StateV2::into_state).map_err(malformed),
+        1 => postcard::from_bytes::<StateV1>(body)
+            .map(StateV1::into_state)
+            .map_err(malformed),
+        2 => postcard::from_bytes::<StateV2>(body)
+            .map(StateV2::into_state)
+            .map_err(malformed),
         _ => postcard::from_bytes(body).map_err(malformed),
     }
 }
@@ -173,6 +199,7 @@ pub fn save(path: &Path, state: &TrainingState) -> Result<()> {
 
 /// Reads a checkpoint; errors name the file and what is wrong with it.
 pub fn load(path: &Path) -> Result<TrainingState> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read checkpoint {}", path.display()))?;
+    let bytes = std::fs::read(path)
+        .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
     decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))
 }

@@ -6,10 +6,10 @@ use super::checkpoint;
 use super::config::{TrainConfig, TrainOverrides};
 use super::trainer::{Trainer, TrainingState};
 use crate::learn::QTable;
-use sim::sensor_setup::SelectedSensors;
 use anyhow::{bail, Context, Result};
-use shared::PolicyBlob;
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
+use shared::PolicyBlob;
+use sim::sensor_setup::SelectedSensors;
 use std::fmt;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -67,13 +67,24 @@ pub struct TrainReport {
 
 impl fmt::Display for TrainReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "steps                {} (run total {})", self.steps, self.total_steps)?;
+        writeln!(
+            f,
+            "steps                {} (run total {})",
+            self.steps, self.total_steps
+        )?;
         writeln!(f, "formations           {}", self.formations)?;
         writeln!(f, "stuck episodes       {}", self.stuck)?;
         writeln!(f, "steps per second     {:.0}", self.steps_per_second)?;
-        writeln!(f, "states visited       {} of {}", self.states_visited, self.states_total)?;
+        writeln!(
+            f,
+            "states visited       {} of {}",
+            self.states_visited, self.states_total
+        )?;
         if let Some((step, formations)) = self.selected {
-            writeln!(f, "selected policy      of step {step}: {formations} formations in its evaluation")?;
+            writeln!(
+                f,
+                "selected policy      of step {step}: {formations} formations in its evaluation"
+            )?;
         }
         writeln!(f, "policy               {}", self.policy.display())?;
         write!(f, "checkpoint           {}", self.checkpoint.display())
@@ -111,7 +122,11 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
         config.steps = steps;
     }
     config.validate()?;
-    let seed_table = args.init_from.as_deref().map(|path| seed_table(path, &config)).transpose()?;
+    let seed_table = args
+        .init_from
+        .as_deref()
+        .map(|path| seed_table(path, &config))
+        .transpose()?;
     let steps = config.steps;
     Ok((Trainer::start(config, seed_table)?, steps))
 }
@@ -127,7 +142,8 @@ fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>,
     }
     let state = checkpoint::load(path)?;
     let steps = args.steps.unwrap_or(state.config.steps);
-    let trainer = Trainer::restart(state).with_context(|| format!("cannot resume {}", path.display()))?;
+    let trainer =
+        Trainer::restart(state).with_context(|| format!("cannot resume {}", path.display()))?;
     Ok((trainer, steps))
 }
 
@@ -141,8 +157,8 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
         let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
         (q, Some(blob.actions().angular_speeds().to_vec()))
     } else {
-        let state: TrainingState =
-            checkpoint::decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))?;
+        let state: TrainingState = checkpoint::decode(&bytes)
+            .with_context(|| format!("checkpoint file {}", path.display()))?;
         (state.learner.table().clone(), None)
     };
     let (hasher, actions) = (table.hasher(), table.num_actions());
@@ -155,7 +171,11 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
         );
     }
     if let Some(speeds) = speeds.filter(|s| s != &learn.actions) {
-        bail!("policy file {}: its actions {speeds:?} are not this run's {:?}", path.display(), learn.actions);
+        bail!(
+            "policy file {}: its actions {speeds:?} are not this run's {:?}",
+            path.display(),
+            learn.actions
+        );
     }
     Ok(table)
 }
@@ -178,7 +198,10 @@ fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport
         }
         trainer.run(chunk);
         done += chunk;
-        if out.checkpoint_every > 0 && trainer.totals().steps % out.checkpoint_every == 0 && done < steps {
+        if out.checkpoint_every > 0
+            && trainer.totals().steps % out.checkpoint_every == 0
+            && done < steps
+        {
             checkpoint::save(&checkpoint_path, &trainer.state())?;
         }
         let t = trainer.totals();
@@ -201,7 +224,11 @@ fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport
         total_steps: totals.steps,
         formations: totals.formations,
         stuck: totals.stuck,
-        steps_per_second: if seconds > 0.0 { steps as f64 / seconds } else { f64::INFINITY },
+        steps_per_second: if seconds > 0.0 {
+            steps as f64 / seconds
+        } else {
+            f64::INFINITY
+        },
         states_visited: q.states_visited(),
         states_total: q.hasher().num_states(),
         selected: trainer.selected().map(|s| (s.step, s.formations)),
@@ -219,10 +246,15 @@ fn progress_bar(steps: u64) -> ProgressBar {
         ProgressDrawTarget::hidden()
     };
     let bar = ProgressBar::with_draw_target(Some(steps), target);
-    if let Ok(style) = ProgressStyle::with_template("{bar:30} {percent:>3}%  {human_pos}/{human_len} steps  {rate}  {msg}") {
-        bar.set_style(style.with_key("rate", |state: &ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = write!(w, "{} steps/s", HumanCount(state.per_sec().round() as u64));
-        }));
+    if let Ok(style) = ProgressStyle::with_template(
+        "{bar:30} {percent:>3}%  {human_pos}/{human_len} steps  {rate}  {msg}",
+    ) {
+        bar.set_style(style.with_key(
+            "rate",
+            |state: &ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = write!(w, "{} steps/s", HumanCount(state.per_sec().round() as u64));
+            },
+        ));
     }
     bar
 }

@@ -1,15 +1,18 @@
 //! What a training run is: [`TrainConfig`], read from a TOML file and/or
 //! the `host train` flags ([`TrainOverrides`]), flags winning.
 
-use crate::learn::{LearnConfig, StateHasherName};
-use sim::reward::Reward;
-use crate::arena_choice::ArenaChoice;
 use super::selection::SelectConfig;
+use crate::arena_choice::ArenaChoice;
+use crate::learn::{LearnConfig, StateHasherName};
 use crate::sensor_choice::SensorChoice;
-use sim::scenario::orbital_innies;
-use sim::{BroadPhase, ControllerChoice, FieldSource, ObstacleTargets, PreparedScenario, Scenario, SuccessSignal};
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
+use sim::reward::Reward;
+use sim::scenario::orbital_innies;
+use sim::{
+    BroadPhase, ControllerChoice, FieldSource, ObstacleTargets, PreparedScenario, Scenario,
+    SuccessSignal,
+};
 use std::path::{Path, PathBuf};
 
 /// Steps `host train` runs by default: on the annulus with 8 robots and
@@ -93,7 +96,10 @@ pub struct FormationCheck {
 impl Default for FormationCheck {
     /// Every 100 steps, on the current world.
     fn default() -> FormationCheck {
-        FormationCheck { every: 100, stale: false }
+        FormationCheck {
+            every: 100,
+            stale: false,
+        }
     }
 }
 
@@ -124,7 +130,11 @@ pub struct OutputConfig {
 impl Default for OutputConfig {
     /// `out/`, the derived name, a checkpoint every 1,000,000 steps.
     fn default() -> OutputConfig {
-        OutputConfig { dir: PathBuf::from("out"), name: None, checkpoint_every: DEFAULT_CHECKPOINT_EVERY }
+        OutputConfig {
+            dir: PathBuf::from("out"),
+            name: None,
+            checkpoint_every: DEFAULT_CHECKPOINT_EVERY,
+        }
     }
 }
 
@@ -161,14 +171,21 @@ impl TrainConfig {
     /// Reads a TOML file; syntax errors and unknown keys name the file, the
     /// line and the column.
     pub fn from_file(path: &Path) -> Result<TrainConfig> {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("cannot read config file {}", path.display()))?;
-        toml::from_str(&text).with_context(|| format!("config file {} is not a valid training config", path.display()))
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read config file {}", path.display()))?;
+        toml::from_str(&text).with_context(|| {
+            format!(
+                "config file {} is not a valid training config",
+                path.display()
+            )
+        })
     }
 
     /// The arena the run uses.
     pub fn arena_choice(&self) -> ArenaChoice {
-        self.arena.clone().unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
+        self.arena
+            .clone()
+            .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
     }
 
     /// The run as a scenario (arena and sensor files read and checked),
@@ -193,7 +210,10 @@ impl TrainConfig {
     /// every robot an outie. Errors name the offending setting.
     pub fn prepare(&self) -> Result<PreparedScenario> {
         self.validate()?;
-        let mut prepared = self.scenario()?.prepare().context("invalid simulation settings")?;
+        let mut prepared = self
+            .scenario()?
+            .prepare()
+            .context("invalid simulation settings")?;
         let c = prepared.config_mut();
         if let Some(limit) = self.stuck_limit {
             c.episode.stuck_limit = limit;
@@ -219,14 +239,19 @@ impl TrainConfig {
     /// The innies of an orbital-construction run of these settings with
     /// `robots` robots.
     pub fn oc_innies(&self, robots: usize) -> usize {
-        self.innies.unwrap_or_else(|| orbital_innies(&self.field, robots))
+        self.innies
+            .unwrap_or_else(|| orbital_innies(&self.field, robots))
     }
 
     /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
     pub fn name(&self) -> String {
         match &self.output.name {
             Some(name) => name.clone(),
-            None => truncate(&format!("{}-{}", field_label(&self.field).replace(':', "-"), self.learn.hasher.0.name())),
+            None => truncate(&format!(
+                "{}-{}",
+                field_label(&self.field).replace(':', "-"),
+                self.learn.hasher.0.name()
+            )),
         }
     }
 
@@ -235,7 +260,11 @@ impl TrainConfig {
         if self.formation_check.every == 0 {
             bail!("formation_check.every = 0: must be positive");
         }
-        if let Some(r) = self.obstacle_discs.map(|d| d.radius).filter(|r| !(r.is_finite() && *r > 0.0)) {
+        if let Some(r) = self
+            .obstacle_discs
+            .map(|d| d.radius)
+            .filter(|r| !(r.is_finite() && *r > 0.0))
+        {
             bail!("obstacle_discs.radius = {r}: must be positive");
         }
         self.learn.validate()?;
@@ -246,10 +275,17 @@ impl TrainConfig {
             bail!("distil_oc = 0: must be positive (or absent)");
         }
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
-            bail!("obstacle_discs: only the disc sensor model takes them (sensors = {:?})", self.sensors.to_string());
+            bail!(
+                "obstacle_discs: only the disc sensor model takes them (sensors = {:?})",
+                self.sensors.to_string()
+            );
         }
         let name = self.name();
-        if name.is_empty() || name.len() > MAX_NAME_LEN || name.contains(['/', '\\']) || name.starts_with('.') {
+        if name.is_empty()
+            || name.len() > MAX_NAME_LEN
+            || name.contains(['/', '\\'])
+            || name.starts_with('.')
+        {
             bail!(
                 "name {name:?}: must be 1 to {MAX_NAME_LEN} bytes, without path separators, not starting with a dot"
             );
@@ -262,9 +298,12 @@ impl TrainConfig {
 /// and letters, an image's file name; at most 32 bytes.
 pub fn field_label(field: &FieldSource) -> String {
     match field {
-        FieldSource::Image(path) => {
-            truncate(&path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "image".into()))
-        }
+        FieldSource::Image(path) => truncate(
+            &path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "image".into()),
+        ),
         other => truncate(&other.to_string()),
     }
 }
@@ -388,21 +427,37 @@ mod tests {
         let mut c: TrainConfig = toml::from_str(text).unwrap();
         assert_eq!((c.robots, c.pucks, c.learn.alpha), (Some(4), None, 0.5));
         let world = &c.prepare().unwrap().config().clone();
-        assert_eq!((world.episode.stuck_limit, world.world.pucks), (50_000, 250));
-        let flags = TrainOverrides { alpha: Some(0.1), robots: Some(2), ..Default::default() };
+        assert_eq!(
+            (world.episode.stuck_limit, world.world.pucks),
+            (50_000, 250)
+        );
+        let flags = TrainOverrides {
+            alpha: Some(0.1),
+            robots: Some(2),
+            ..Default::default()
+        };
         flags.apply(&mut c);
-        assert_eq!((c.robots, c.learn.alpha, c.learn.hasher.0.bits()), (Some(2), 0.1, 7));
+        assert_eq!(
+            (c.robots, c.learn.alpha, c.learn.hasher.0.bits()),
+            (Some(2), 0.1, 7)
+        );
         assert_eq!(flags.given(), ["--robots", "--alpha"]);
         c.validate().unwrap();
     }
 
     #[test]
     fn malformed_files_give_the_line() {
-        let e = toml::from_str::<TrainConfig>("robots = 4\npucks = = 3\n").unwrap_err().to_string();
+        let e = toml::from_str::<TrainConfig>("robots = 4\npucks = = 3\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 2"), "{e}");
-        let e = toml::from_str::<TrainConfig>("robots = 4\n\nalpah = 0.3\n").unwrap_err().to_string();
+        let e = toml::from_str::<TrainConfig>("robots = 4\n\nalpah = 0.3\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 3") && e.contains("alpah"), "{e}");
-        let e = toml::from_str::<TrainConfig>("[learn]\nhasher = \"bits12\"\n").unwrap_err().to_string();
+        let e = toml::from_str::<TrainConfig>("[learn]\nhasher = \"bits12\"\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("bits12") && e.contains("line 2"), "{e}");
     }
 
@@ -413,7 +468,11 @@ mod tests {
         c.field = FieldSource::Letter(sim::Letter::T);
         assert_eq!(c.name(), "letter-T-original");
         c.output.name = Some("../escape".into());
-        assert!(c.validate().unwrap_err().to_string().contains("path separators"));
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("path separators"));
         c.output.name = Some("x".repeat(33));
         assert!(c.validate().is_err());
     }

@@ -61,12 +61,19 @@ fn most(counts: &[u64]) -> Option<usize> {
 /// Orbital construction as a policy table of the run's hasher and actions.
 pub fn distil_orbital(config: &TrainConfig, steps: u64) -> Result<PolicyTable> {
     let prepared = config.prepare()?;
-    let mut sim = prepared.simulation(config.seed ^ DISTIL_STREAM).context("cannot build the distillation world")?;
+    let mut sim = prepared
+        .simulation(config.seed ^ DISTIL_STREAM)
+        .context("cannot build the distillation world")?;
     let hasher = config.learn.hasher.0;
     let speeds = config.learn.actions.clone();
     let n = speeds.len();
     let orbital = OrbitalConstruction::new(OrbitalConfig::default(), &sim.config().thresholds);
-    let mut counting = Counting { orbital, speeds, hasher, counts: vec![0; hasher.num_states() * n] };
+    let mut counting = Counting {
+        orbital,
+        speeds,
+        hasher,
+        counts: vec![0; hasher.num_states() * n],
+    };
     sim.run(&mut counting, steps);
     let counts = |s: usize| &counting.counts[s * n..(s + 1) * n];
     let mut overall = vec![0u64; n];
@@ -78,8 +85,14 @@ pub fn distil_orbital(config: &TrainConfig, steps: u64) -> Result<PolicyTable> {
     let fallback = most(&overall).unwrap_or(0);
     let mut table = PolicyTable::new(hasher);
     for s in 0..hasher.num_states() {
-        let other_role = if hasher.has_role_bit() { Some(s ^ 256) } else { None };
-        let action = most(counts(s)).or_else(|| other_role.and_then(|o| most(counts(o)))).unwrap_or(fallback);
+        let other_role = if hasher.has_role_bit() {
+            Some(s ^ 256)
+        } else {
+            None
+        };
+        let action = most(counts(s))
+            .or_else(|| other_role.and_then(|o| most(counts(o))))
+            .unwrap_or(fallback);
         table.set(State(s as u16), ActionId(action as u8));
     }
     Ok(table)
@@ -94,7 +107,11 @@ mod tests {
         let speeds = [0.3, 0.15, -0.15, -0.3];
         assert_eq!(nearest(&speeds, 0.09), 1);
         assert_eq!(nearest(&speeds, -0.3), 3);
-        assert_eq!(nearest(&speeds, 0.0), 1, "0 is as near 0.15 as -0.15: the first");
+        assert_eq!(
+            nearest(&speeds, 0.0),
+            1,
+            "0 is as near 0.15 as -0.15: the first"
+        );
         assert_eq!(most(&[0, 3, 3, 1]), Some(1));
         assert_eq!(most(&[0, 0]), None);
     }

@@ -190,7 +190,8 @@ impl StateV1 {
     pub fn of(state: &TrainingState) -> Option<StateV1> {
         let v2 = StateV2::of(state)?;
         let (s, e) = (&v2.sim, &v2.sim.config.episode);
-        let plain_sim = !e.stale_eval && e.success_signal == SuccessSignal::Eval && s.checked_signal.is_none();
+        let plain_sim =
+            !e.stale_eval && e.success_signal == SuccessSignal::Eval && s.checked_signal.is_none();
         plain_sim.then_some(())?;
         let w = &s.world;
         Some(StateV1 {

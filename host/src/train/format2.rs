@@ -20,10 +20,15 @@ use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::actuation::ActuationNoise;
-use sim::config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
+use sim::config::{
+    EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig,
+};
 use sim::field::{FieldFrame, FieldSampling};
 use sim::scenario::{THESIS_PUCKS, THESIS_ROBOTS};
-use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World, WorldState};
+use sim::{
+    Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World,
+    WorldState,
+};
 
 /// A training state in format 2's layout.
 #[derive(Serialize, Deserialize)]
@@ -57,7 +62,10 @@ impl TrainConfigV2 {
     /// The settings in format 2, if they run in the thesis' square
     /// without noise, policy selection or distillation.
     pub fn of(c: &TrainConfig) -> Option<TrainConfigV2> {
-        let plain = c.arena_choice() == ArenaChoice::Thesis && c.noise == 0.0 && c.select.is_none() && c.distil_oc.is_none();
+        let plain = c.arena_choice() == ArenaChoice::Thesis
+            && c.noise == 0.0
+            && c.select.is_none()
+            && c.distil_oc.is_none();
         plain.then(|| TrainConfigV2 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),

@@ -4,11 +4,11 @@
 //! ([`command`]).
 
 pub mod checkpoint;
-pub mod format1;
-pub mod format2;
 pub mod command;
 pub mod config;
 pub mod distil;
+pub mod format1;
+pub mod format2;
 pub mod selection;
 pub mod trainer;
 

@@ -64,10 +64,21 @@ impl Evaluation {
     /// The evaluation of a run of `prepared`'s settings seeded with `seed`.
     pub fn new(select: SelectConfig, prepared: &PreparedScenario, seed: u64) -> Result<Evaluation> {
         if select.every == 0 || select.steps == 0 {
-            anyhow::bail!("select = {{ every = {}, steps = {} }}: both must be positive", select.every, select.steps);
+            anyhow::bail!(
+                "select = {{ every = {}, steps = {} }}: both must be positive",
+                select.every,
+                select.steps
+            );
         }
-        let sim = prepared.simulation(seed ^ EVALUATION_STREAM).context("cannot build the evaluation world")?;
-        Ok(Evaluation { select, start: sim.snapshot(), field: prepared.field().clone(), sensors: prepared.sensors().clone() })
+        let sim = prepared
+            .simulation(seed ^ EVALUATION_STREAM)
+            .context("cannot build the evaluation world")?;
+        Ok(Evaluation {
+            select,
+            start: sim.snapshot(),
+            field: prepared.field().clone(),
+            sensors: prepared.sensors().clone(),
+        })
     }
 
     /// Whether the run evaluates after training step `step`.

@@ -5,11 +5,13 @@ use super::config::{field_label, TrainConfig};
 use super::distil::distil_orbital;
 use super::selection::{Evaluation, Selected};
 use crate::learn::{QLearner, QTable};
-use sim::{EpisodeEnd, ScalarField, SelectedSensors, SensorModel, Simulation, SimulationState, Totals};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
 use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
+use sim::{
+    EpisodeEnd, ScalarField, SelectedSensors, SensorModel, Simulation, SimulationState, Totals,
+};
 use std::sync::Arc;
 
 /// Everything that determines a training run's future: its settings, the
@@ -49,14 +51,23 @@ impl Trainer<SelectedSensors> {
     /// `seed_table` or, with `distil_oc`, from orbital construction.
     pub fn start(config: TrainConfig, seed_table: Option<QTable>) -> Result<Self> {
         let seed_table = match (config.distil_oc, seed_table) {
-            (Some(_), Some(_)) => bail!("distil_oc and --init-from both give the table the run starts from: choose one"),
+            (Some(_), Some(_)) => bail!(
+                "distil_oc and --init-from both give the table the run starts from: choose one"
+            ),
             (Some(steps), None) => {
                 let table = distil_orbital(&config, steps)?;
-                Some(QTable::from_policy(&table, config.learn.actions.len(), config.learn.initial_q))
+                Some(QTable::from_policy(
+                    &table,
+                    config.learn.actions.len(),
+                    config.learn.initial_q,
+                ))
             }
             (None, table) => table,
         };
-        let sim = config.prepare()?.simulation(config.seed).context("invalid simulation settings")?;
+        let sim = config
+            .prepare()?
+            .simulation(config.seed)
+            .context("invalid simulation settings")?;
         Trainer::new(config, sim, seed_table)
     }
 
@@ -73,7 +84,11 @@ impl<S: SensorModel> Trainer<S> {
     /// A new run on `sim` (built from `config`, [`TrainConfig::prepare`]);
     /// `seed_table` (the thesis' RL2) replaces the initial Q-values and
     /// must have the run's hasher and action count.
-    pub fn new(config: TrainConfig, sim: Simulation<S>, seed_table: Option<QTable>) -> Result<Self> {
+    pub fn new(
+        config: TrainConfig,
+        sim: Simulation<S>,
+        seed_table: Option<QTable>,
+    ) -> Result<Self> {
         config.validate()?;
         let learner = match seed_table {
             Some(q) => QLearner::with_table(config.learn.clone(), q)?,
@@ -81,7 +96,14 @@ impl<S: SensorModel> Trainer<S> {
         };
         let field_crc = field_fingerprint(sim.field());
         let evaluation = evaluation_of(&config)?;
-        let mut trainer = Trainer { config, field_crc, sim, learner, evaluation, selected: None };
+        let mut trainer = Trainer {
+            config,
+            field_crc,
+            sim,
+            learner,
+            evaluation,
+            selected: None,
+        };
         trainer.greedy_policy()?;
         // with selection the starting policy is evaluated too (step 0)
         trainer.evaluate_if_due();
@@ -102,8 +124,16 @@ impl<S: SensorModel> Trainer<S> {
         }
         let sim = Simulation::resume(state.sim, field, sensors);
         let evaluation = evaluation_of(&state.config)?;
-        let (config, field_crc, learner, selected) = (state.config, state.field_crc, state.learner, state.selected);
-        let trainer = Trainer { config, field_crc, sim, learner, evaluation, selected };
+        let (config, field_crc, learner, selected) =
+            (state.config, state.field_crc, state.learner, state.selected);
+        let trainer = Trainer {
+            config,
+            field_crc,
+            sim,
+            learner,
+            evaluation,
+            selected,
+        };
         trainer.greedy_policy()?;
         Ok(trainer)
     }
@@ -141,8 +171,16 @@ impl<S: SensorModel> Trainer<S> {
         };
         let packed = policy.table().packed().to_vec();
         let formations = evaluation.formations(policy);
-        if self.selected.as_ref().is_none_or(|best| formations > best.formations) {
-            self.selected = Some(Selected { step, formations, packed });
+        if self
+            .selected
+            .as_ref()
+            .is_none_or(|best| formations > best.formations)
+        {
+            self.selected = Some(Selected {
+                step,
+                formations,
+                packed,
+            });
         }
     }
 
@@ -195,7 +233,9 @@ impl<S: SensorModel> Trainer<S> {
         let hasher = self.learner.table().hasher();
         match self.selected.as_ref().filter(|_| self.evaluation.is_some()) {
             Some(best) => {
-                let table = best.table(hasher).context("the selected policy does not fit the run's hasher")?;
+                let table = best
+                    .table(hasher)
+                    .context("the selected policy does not fit the run's hasher")?;
                 self.blob(table, best.step)
             }
             None => self.greedy_policy(),
@@ -209,17 +249,23 @@ impl<S: SensorModel> Trainer<S> {
 
     fn blob(&self, table: PolicyTable, steps: u64) -> Result<PolicyBlob> {
         let c = &self.config;
-        let actions = ActionTable::new(&c.learn.actions, self.sim.config().world.forward_speed as f32)
+        let actions = ActionTable::new(
+            &c.learn.actions,
+            self.sim.config().world.forward_speed as f32,
+        )
+        .context("cannot export the policy")?;
+        let provenance = Provenance::new(&field_label(&c.field), &c.name(), steps, c.seed)
             .context("cannot export the policy")?;
-        let provenance =
-            Provenance::new(&field_label(&c.field), &c.name(), steps, c.seed).context("cannot export the policy")?;
         PolicyBlob::new(actions, table, provenance).context("cannot export the policy")
     }
 }
 
 /// The evaluation world of a run with selection.
 fn evaluation_of(config: &TrainConfig) -> Result<Option<Evaluation>> {
-    config.select.map(|select| Evaluation::new(select, &config.prepare()?, config.seed)).transpose()
+    config
+        .select
+        .map(|select| Evaluation::new(select, &config.prepare()?, config.seed))
+        .transpose()
 }
 
 /// CRC-32 of a field's size and values.

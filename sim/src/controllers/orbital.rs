@@ -1,8 +1,8 @@
 //! Orbital construction, the thesis' Algorithm 2.
 
-use crate::control::{Controller, Perception};
 use crate::body::RobotKind;
 use crate::config::Thresholds;
+use crate::control::{Controller, Perception};
 use crate::rng::SimRng;
 use serde::{Deserialize, Serialize};
 use shared::{FieldValue, SensorReading};
@@ -20,7 +20,10 @@ pub struct OrbitalConfig {
 impl Default for OrbitalConfig {
     /// The thesis: 0.3 and 0.3.
     fn default() -> OrbitalConfig {
-        OrbitalConfig { max_angular: 0.3, gentle_factor: 0.3 }
+        OrbitalConfig {
+            max_angular: 0.3,
+            gentle_factor: 0.3,
+        }
     }
 }
 

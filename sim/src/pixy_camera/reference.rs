@@ -25,7 +25,9 @@ fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
     let mut in_view = Vec::new();
     world.any_body_near(lens.pos, camera.max_range, |row| {
         for b in row {
-            let Some(c) = camera.candidate(world.robots().len(), robot, &lens, b) else { continue };
+            let Some(c) = camera.candidate(world.robots().len(), robot, &lens, b) else {
+                continue;
+            };
             if let Some(rect) = silhouette(camera, c.ahead, c.side, c.radius, c.height) {
                 in_view.push(c.in_view(rect));
             }
@@ -39,7 +41,10 @@ fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
 /// Sorts bodies in view nearest first, ties by body index.
 fn sort_nearest_first(in_view: &mut [InView]) {
     in_view.sort_unstable_by(|a, b| {
-        a.distance.partial_cmp(&b.distance).unwrap_or(Ordering::Equal).then(a.index.cmp(&b.index))
+        a.distance
+            .partial_cmp(&b.distance)
+            .unwrap_or(Ordering::Equal)
+            .then(a.index.cmp(&b.index))
     });
 }
 
@@ -97,11 +102,17 @@ fn occlude(camera: &mut PixyCamera) {
             }
             pieces = rest;
         }
-        let Some(first) = pieces.first() else { continue };
+        let Some(first) = pieces.first() else {
+            continue;
+        };
         let rect = pieces.iter().fold(*first, |r, p| r.union(p));
         let area = pieces.iter().map(Rect::area).sum();
         if area >= camera.min_area {
-            camera.blobs.push(Blob { signature: body.signature, rect, area });
+            camera.blobs.push(Blob {
+                signature: body.signature,
+                rect,
+                area,
+            });
         }
     }
 }
@@ -117,7 +128,11 @@ fn merge_and_prune(blobs: &mut Vec<Blob>, d: i32) {
                 let (a, b) = (blobs[i], blobs[j]);
                 let (gx, gy) = (a.rect.gap_x(&b.rect), a.rect.gap_y(&b.rect));
                 if a.signature == b.signature && ((gx <= d && gy <= 0) || (gy <= d && gx <= 0)) {
-                    blobs[i] = Blob { signature: a.signature, rect: a.rect.union(&b.rect), area: a.area + b.area };
+                    blobs[i] = Blob {
+                        signature: a.signature,
+                        rect: a.rect.union(&b.rect),
+                        area: a.area + b.area,
+                    };
                     blobs.remove(j);
                     merged = true;
                     break 'outer;
@@ -127,8 +142,11 @@ fn merge_and_prune(blobs: &mut Vec<Blob>, d: i32) {
     }
     let mut k = 0;
     while k < blobs.len() {
-        let enclosed = (0..blobs.len())
-            .any(|o| o != k && blobs[o].rect.contains(&blobs[k].rect) && (blobs[o].rect != blobs[k].rect || o < k));
+        let enclosed = (0..blobs.len()).any(|o| {
+            o != k
+                && blobs[o].rect.contains(&blobs[k].rect)
+                && (blobs[o].rect != blobs[k].rect || o < k)
+        });
         if enclosed {
             blobs.remove(k);
         } else {

@@ -3,8 +3,8 @@
 
 use super::report::{Divergence, Stage, StageCounts, LISTED};
 use shared::{
-    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob, RobotProfile,
-    Role, SensorReading, State,
+    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob,
+    RobotProfile, Role, SensorReading, State,
 };
 
 /// What each stage should have produced from a frame's own inputs.
@@ -74,15 +74,27 @@ impl<'a> DecisionCheck<'a> {
         let values = self.calibration.map(|c| c.scales().values(&f.raw_times));
         // the robot's role is its id's (odd: an innie), as the firmware takes it
         let role = Role::of_robot_id(f.robot_id);
-        let state = self.policy.hasher().hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
+        let state = self
+            .policy
+            .hasher()
+            .hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
         let in_range = f.state.index() < self.policy.hasher().num_states();
-        let action = if in_range { self.policy.table().action(f.state) } else { ActionId(u8::MAX) };
+        let action = if in_range {
+            self.policy.table().action(f.state)
+        } else {
+            ActionId(u8::MAX)
+        };
         let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
             self.motors.command(f.action)
         } else {
             MotorCommand::default()
         };
-        Expected { values, state, action, motors }
+        Expected {
+            values,
+            state,
+            action,
+            motors,
+        }
     }
 
     fn record(&mut self, offset: u64, f: &LogFrame, e: &Expected, stages: Vec<Stage>) {
@@ -100,7 +112,12 @@ impl<'a> DecisionCheck<'a> {
                 raw_times: f.raw_times,
                 values: f.values.map(|v| v.raw()),
                 expected_values: e.values.map(|v| v.map(|x| x.raw())),
-                blobs: [f.blobs.puck_left, f.blobs.puck_right, f.blobs.obstacle_left, f.blobs.obstacle_right],
+                blobs: [
+                    f.blobs.puck_left,
+                    f.blobs.puck_right,
+                    f.blobs.obstacle_left,
+                    f.blobs.obstacle_right,
+                ],
                 state: f.state.0,
                 expected_state: e.state.0,
                 action: f.action.0,

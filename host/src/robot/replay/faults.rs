@@ -20,7 +20,14 @@ impl Default for FaultTracker {
     fn default() -> FaultTracker {
         FaultTracker {
             fault_frames: 0,
-            faults: Faults::NAMED.iter().map(|(_, name)| FaultCount { fault: name, frames: 0, episodes: 0 }).collect(),
+            faults: Faults::NAMED
+                .iter()
+                .map(|(_, name)| FaultCount {
+                    fault: name,
+                    frames: 0,
+                    episodes: 0,
+                })
+                .collect(),
             open: vec![None; Faults::NAMED.len()],
             first_episodes: Vec::new(),
         }
@@ -43,7 +50,12 @@ impl FaultTracker {
                     }
                     open @ None => {
                         self.faults[i].episodes += 1;
-                        *open = Some(FaultEpisode { fault: name, first_tick: f.tick, last_tick: f.tick, frames: 1 });
+                        *open = Some(FaultEpisode {
+                            fault: name,
+                            first_tick: f.tick,
+                            last_tick: f.tick,
+                            frames: 1,
+                        });
                     }
                 }
             } else if let Some(e) = self.open[i].take() {

@@ -30,7 +30,8 @@ pub mod report;
 pub mod timeline;
 
 pub use report::{
-    Coverage, Damaged, Divergence, FaultCount, FaultEpisode, ModeCounts, ReplayReport, Stage, StageCounts, LISTED,
+    Coverage, Damaged, Divergence, FaultCount, FaultEpisode, ModeCounts, ReplayReport, Stage,
+    StageCounts, LISTED,
 };
 
 use super::log_file::{Recording, SourceKind};
@@ -73,7 +74,12 @@ pub fn replay(
 /// Reads the files and replays: the log (recorded or raw), the policy blob
 /// and optional training visits, which must be for the policy's hasher.
 /// Fails, naming the log, when no frame in it decodes.
-pub fn replay_files(log: &Path, policy: &Path, visits: Option<&Path>, odometry: OdometrySettings) -> Result<ReplayReport> {
+pub fn replay_files(
+    log: &Path,
+    policy: &Path,
+    visits: Option<&Path>,
+    odometry: OdometrySettings,
+) -> Result<ReplayReport> {
     let blob = sim::policy_file::read(policy)?;
     let training = match visits {
         Some(path) => {
@@ -95,7 +101,11 @@ pub fn replay_files(log: &Path, policy: &Path, visits: Option<&Path>, odometry: 
     let report = replay(&recording, &blob, training.as_ref(), odometry);
     if report.frames == 0 {
         let versions = if report.other_version > 0 {
-            format!(", {} of them of another log format version (this host reads version {})", report.other_version, LogFrame::VERSION)
+            format!(
+                ", {} of them of another log format version (this host reads version {})",
+                report.other_version,
+                LogFrame::VERSION
+            )
         } else {
             String::new()
         };
@@ -167,10 +177,22 @@ impl<'a> Replayer<'a> {
     /// States met while the policy drove, most frequent first, and those
     /// training never visited.
     fn coverage(&self, visits: Option<&TrainingVisits>) -> Coverage {
-        let mut frames_per_state: Vec<(u16, u64)> = self.states.iter().map(|(s, n)| (*s, *n)).collect();
+        let mut frames_per_state: Vec<(u16, u64)> =
+            self.states.iter().map(|(s, n)| (*s, *n)).collect();
         frames_per_state.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-        let untrained = visits.map(|v| frames_per_state.iter().filter(|(s, _)| v.of(State(*s)) == 0).copied().collect());
-        Coverage { states: frames_per_state.len(), of: self.policy.hasher().num_states(), frames_per_state, untrained }
+        let untrained = visits.map(|v| {
+            frames_per_state
+                .iter()
+                .filter(|(s, _)| v.of(State(*s)) == 0)
+                .copied()
+                .collect()
+        });
+        Coverage {
+            states: frames_per_state.len(),
+            of: self.policy.hasher().num_states(),
+            frames_per_state,
+            untrained,
+        }
     }
 
     fn finish(mut self, recording: &Recording, visits: Option<&TrainingVisits>) -> ReplayReport {
@@ -190,7 +212,9 @@ impl<'a> Replayer<'a> {
             missing_ticks: t.missing_ticks,
             restarts: t.restarts,
             host_seconds: match (recording.kind, t.host_times) {
-                (SourceKind::Recorded, Some((first, last))) => Some(last.saturating_sub(first) as f64 / 1e6),
+                (SourceKind::Recorded, Some((first, last))) => {
+                    Some(last.saturating_sub(first) as f64 / 1e6)
+                }
                 _ => None,
             },
             calibration_checked: d.calibration_checked,
@@ -213,12 +237,18 @@ mod tests {
     use super::*;
     use crate::robot::log_file::{self, encode_record, HEADER_LEN, MAGIC, VERSION};
     use shared::{
-        ActionId, ActionTable, BlobSummary, Faults, FieldCalibration, FieldValue, MotorCommand, PolicyTable, Provenance,
-        RobotProfile, RunMode, SensorRange, SensorReading, State, StateHasher,
+        ActionId, ActionTable, BlobSummary, Faults, FieldCalibration, FieldValue, MotorCommand,
+        PolicyTable, Provenance, RobotProfile, RunMode, SensorRange, SensorReading, State,
+        StateHasher,
     };
     use std::collections::BTreeMap;
 
-    const CAL: FieldCalibration = FieldCalibration { ranges: [SensorRange { bright: 40, dark: 440 }; 3] };
+    const CAL: FieldCalibration = FieldCalibration {
+        ranges: [SensorRange {
+            bright: 40,
+            dark: 440,
+        }; 3],
+    };
 
     fn policy() -> PolicyBlob {
         let mut table = PolicyTable::new(StateHasher::Original);
@@ -226,17 +256,43 @@ mod tests {
             table.set(State(s), ActionId((s % 4) as u8));
         }
         let actions = ActionTable::new(&[0.0, 0.3, -0.3, 0.15], 2.0).unwrap();
-        PolicyBlob::new(actions, table, Provenance::new("annulus", "test", 0, 0).unwrap()).unwrap()
+        PolicyBlob::new(
+            actions,
+            table,
+            Provenance::new("annulus", "test", 0, 0).unwrap(),
+        )
+        .unwrap()
     }
 
     /// A frame as the firmware would log it for these raw times and blobs.
-    fn firmware_frame(p: &PolicyBlob, tick: u32, mode: RunMode, faults: Faults, raw: [u16; 3], puck_left: bool) -> LogFrame {
+    fn firmware_frame(
+        p: &PolicyBlob,
+        tick: u32,
+        mode: RunMode,
+        faults: Faults,
+        raw: [u16; 3],
+        puck_left: bool,
+    ) -> LogFrame {
         let values = CAL.scales().values(&raw);
-        let blobs = BlobSummary { puck_left, ..BlobSummary::default() };
+        let blobs = BlobSummary {
+            puck_left,
+            ..BlobSummary::default()
+        };
         let reading = SensorReading::from_parts(values, blobs);
         let state = p.hasher().hash(&reading);
         let action = p.table().action(state);
-        let mut f = LogFrame { tick, mode, faults, raw_times: raw, values, blobs, blocks: u8::from(puck_left), state, action, ..LogFrame::default() };
+        let mut f = LogFrame {
+            tick,
+            mode,
+            faults,
+            raw_times: raw,
+            values,
+            blobs,
+            blocks: u8::from(puck_left),
+            state,
+            action,
+            ..LogFrame::default()
+        };
         if f.policy_drove() {
             f.motors = RobotProfile::ZUMO.mix(2.0, p.actions().angular_speeds()[action.index()]);
         }
@@ -247,9 +303,21 @@ mod tests {
     fn session(p: &PolicyBlob) -> Vec<LogFrame> {
         let mut frames = Vec::new();
         for tick in 1..=120u32 {
-            let mode = if tick <= 10 { RunMode::Idle } else { RunMode::Driving };
-            let faults = if (60..65).contains(&tick) { Faults::CAMERA_SILENT } else { Faults::NONE };
-            let raw = [40 + (tick * 7 % 400) as u16, 40 + (tick * 13 % 400) as u16, 40 + (tick * 3 % 400) as u16];
+            let mode = if tick <= 10 {
+                RunMode::Idle
+            } else {
+                RunMode::Driving
+            };
+            let faults = if (60..65).contains(&tick) {
+                Faults::CAMERA_SILENT
+            } else {
+                Faults::NONE
+            };
+            let raw = [
+                40 + (tick * 7 % 400) as u16,
+                40 + (tick * 13 % 400) as u16,
+                40 + (tick * 3 % 400) as u16,
+            ];
             frames.push(firmware_frame(p, tick, mode, faults, raw, tick % 3 == 0));
         }
         frames
@@ -271,7 +339,12 @@ mod tests {
     }
 
     fn report_of(bytes: &[u8], p: &PolicyBlob) -> ReplayReport {
-        replay(&log_file::parse(bytes).unwrap(), p, None, Default::default())
+        replay(
+            &log_file::parse(bytes).unwrap(),
+            p,
+            None,
+            Default::default(),
+        )
     }
 
     #[test]
@@ -280,12 +353,26 @@ mod tests {
         let frames = session(&p);
         let r = report_of(&log_of(&frames), &p);
         assert_eq!((r.frames, r.damaged, r.diverged), (120, 0, 0), "{r}");
-        assert_eq!(r.modes, ModeCounts { idle: 10, driving: 110, calibrating: 0 });
+        assert_eq!(
+            r.modes,
+            ModeCounts {
+                idle: 10,
+                driving: 110,
+                calibrating: 0
+            }
+        );
         assert_eq!(r.policy_drove, 105);
         assert_eq!(r.calibration_checked, 120);
         assert_eq!(r.calibrations, vec![CAL]);
-        assert_eq!((r.ticks, r.missing_ticks, r.restarts), (Some((1, 120)), 0, 0));
-        assert!(r.host_seconds.is_some_and(|s| (s - 2.38).abs() < 1e-9), "{:?}", r.host_seconds);
+        assert_eq!(
+            (r.ticks, r.missing_ticks, r.restarts),
+            (Some((1, 120)), 0, 0)
+        );
+        assert!(
+            r.host_seconds.is_some_and(|s| (s - 2.38).abs() < 1e-9),
+            "{:?}",
+            r.host_seconds
+        );
         let mut actions = vec![0u64; 4];
         let mut states = BTreeMap::new();
         for f in frames.iter().filter(|f| f.policy_drove()) {
@@ -294,10 +381,29 @@ mod tests {
         }
         assert_eq!(r.actions, actions);
         assert_eq!(r.coverage.states, states.len());
-        assert_eq!(r.faults[2], FaultCount { fault: "camera silent", frames: 5, episodes: 1 });
-        assert_eq!(r.first_fault_episodes, vec![FaultEpisode { fault: "camera silent", first_tick: 60, last_tick: 64, frames: 5 }]);
+        assert_eq!(
+            r.faults[2],
+            FaultCount {
+                fault: "camera silent",
+                frames: 5,
+                episodes: 1
+            }
+        );
+        assert_eq!(
+            r.first_fault_episodes,
+            vec![FaultEpisode {
+                fault: "camera silent",
+                first_tick: 60,
+                last_tick: 64,
+                frames: 5
+            }]
+        );
         let text = r.to_string();
-        assert!(text.contains("divergences: 0 frames") && text.contains("camera silent: 5 frames in 1 episodes"), "{text}");
+        assert!(
+            text.contains("divergences: 0 frames")
+                && text.contains("camera silent: 5 frames in 1 episodes"),
+            "{text}"
+        );
         let json = serde_json::to_value(&r).unwrap();
         assert_eq!(json["diverged"], 0);
         assert_eq!(json["coverage"]["untrained"], serde_json::Value::Null);
@@ -311,13 +417,25 @@ mod tests {
         frames[30].state = State(frames[30].state.0 ^ 0x10); // hash (and policy: action of another state)
         frames[40].action = ActionId((frames[40].action.0 + 1) % 4); // policy and motors
         frames[50].motors.left += 1; // motors
-        frames[5].motors = MotorCommand { left: 100, right: 100 }; // idle but moving
+        frames[5].motors = MotorCommand {
+            left: 100,
+            right: 100,
+        }; // idle but moving
         let r = report_of(&log_of(&frames), &p);
         assert_eq!(r.diverged, 5, "{r}");
-        let by_tick = |t: u32| r.first_divergences.iter().find(|d| d.tick == t).unwrap().clone();
+        let by_tick = |t: u32| {
+            r.first_divergences
+                .iter()
+                .find(|d| d.tick == t)
+                .unwrap()
+                .clone()
+        };
         assert_eq!(by_tick(21).stages[0], Stage::Calibration);
         assert_eq!(by_tick(21).raw_times, frames[20].raw_times);
-        assert_eq!(by_tick(21).expected_values, Some(CAL.scales().values(&frames[20].raw_times).map(|v| v.raw())));
+        assert_eq!(
+            by_tick(21).expected_values,
+            Some(CAL.scales().values(&frames[20].raw_times).map(|v| v.raw()))
+        );
         assert_eq!(by_tick(31).stages[0], Stage::Hash);
         assert_eq!(by_tick(41).stages, vec![Stage::Policy, Stage::Motors]);
         assert_eq!(by_tick(51).stages, vec![Stage::Motors]);
@@ -337,7 +455,14 @@ mod tests {
         let q = PolicyBlob::new(*p.actions(), other, p.provenance().clone()).unwrap();
         let r = report_of(&log_of(&frames), &q);
         assert_eq!(r.diverged, 120);
-        assert_eq!(r.diverged_by_stage, StageCounts { policy: 120, motors: r.diverged_by_stage.motors, ..StageCounts::default() });
+        assert_eq!(
+            r.diverged_by_stage,
+            StageCounts {
+                policy: 120,
+                motors: r.diverged_by_stage.motors,
+                ..StageCounts::default()
+            }
+        );
     }
 
     #[test]
@@ -348,7 +473,12 @@ mod tests {
         let mut counts = vec![0u64; 256];
         counts[first.index()] = 9;
         let visits = TrainingVisits::new(StateHasher::Original, counts).unwrap();
-        let r = replay(&log_file::parse(&log_of(&frames)).unwrap(), &p, Some(&visits), Default::default());
+        let r = replay(
+            &log_file::parse(&log_of(&frames)).unwrap(),
+            &p,
+            Some(&visits),
+            Default::default(),
+        );
         let untrained = r.coverage.untrained.clone().unwrap();
         assert_eq!(untrained.len(), r.coverage.states - 1);
         assert!(!untrained.iter().any(|(s, _)| *s == first.0));
@@ -364,7 +494,10 @@ mod tests {
             assert!(r.damaged <= 1 && r.diverged == 0, "{len}: {r}");
             assert!(r.frames + r.damaged == r.entries);
             if let Some(d) = r.first_damaged.first() {
-                assert!(d.error.contains("truncated") && d.offset >= HEADER_LEN as u64, "{len}: {d:?}");
+                assert!(
+                    d.error.contains("truncated") && d.offset >= HEADER_LEN as u64,
+                    "{len}: {d:?}"
+                );
             }
         }
         for i in HEADER_LEN..bytes.len() {
@@ -372,12 +505,18 @@ mod tests {
                 let mut bad = bytes.clone();
                 bad[i] ^= 1 << bit;
                 let r = report_of(&bad, &p);
-                assert_eq!(r.diverged, 0, "byte {i} bit {bit}: a damaged frame was taken for a real one");
+                assert_eq!(
+                    r.diverged, 0,
+                    "byte {i} bit {bit}: a damaged frame was taken for a real one"
+                );
                 assert!(r.frames >= 4 && r.damaged >= 1, "byte {i} bit {bit}: {r}");
             }
         }
         // Raw captures: the robot's own CRC finds flipped bits.
-        let raw: Vec<u8> = frames.iter().flat_map(|f| [encoded(f), vec![0]].concat()).collect();
+        let raw: Vec<u8> = frames
+            .iter()
+            .flat_map(|f| [encoded(f), vec![0]].concat())
+            .collect();
         for i in 0..raw.len() {
             let mut bad = raw.clone();
             bad[i] ^= 0x04;
@@ -403,6 +542,12 @@ mod tests {
         let r = report_of(&bytes, &p);
         assert_eq!((r.frames, r.damaged, r.other_version), (3, 1, 1));
         assert_eq!(r.first_damaged[0].offset, offset);
-        assert!(r.first_damaged[0].error.contains("version 1 is not supported"), "{:?}", r.first_damaged);
+        assert!(
+            r.first_damaged[0]
+                .error
+                .contains("version 1 is not supported"),
+            "{:?}",
+            r.first_damaged
+        );
     }
 }

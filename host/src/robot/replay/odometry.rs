@@ -44,7 +44,11 @@ pub struct OdometrySettings {
 
 impl Default for OdometrySettings {
     fn default() -> OdometrySettings {
-        OdometrySettings { mm_per_unit: 6.5, counts_per_mm: 909.7 / 119.0, track_mm: 85.0 }
+        OdometrySettings {
+            mm_per_unit: 6.5,
+            counts_per_mm: 909.7 / 119.0,
+            track_mm: 85.0,
+        }
     }
 }
 
@@ -108,7 +112,11 @@ pub struct OdometryTracker {
 impl OdometryTracker {
     /// A tracker with `settings`.
     pub fn new(settings: OdometrySettings) -> OdometryTracker {
-        OdometryTracker { settings, previous: None, sums: BTreeMap::new() }
+        OdometryTracker {
+            settings,
+            previous: None,
+            sums: BTreeMap::new(),
+        }
     }
 
     /// Adds one decoded frame, in log order.
@@ -158,9 +166,14 @@ impl OdometryTracker {
                 let fit = (intended > 0.0).then(|| RobotFit {
                     id,
                     wheel_speed_factor: measured / intended,
-                    turn_bias: motion.iter().map(|a| a.turn - a.intended_turn).sum::<f64>() / motion.len() as f64,
+                    turn_bias: motion.iter().map(|a| a.turn - a.intended_turn).sum::<f64>()
+                        / motion.len() as f64,
                 });
-                RobotMotion { id, actions: motion, fit }
+                RobotMotion {
+                    id,
+                    actions: motion,
+                    fit,
+                }
             })
             .collect()
     }
@@ -200,8 +213,12 @@ pub fn merge_into_file(path: &Path, robots: &[RobotMotion]) -> Result<FitFile> {
         );
     }
     let mut file = match std::fs::read(path) {
-        Ok(bytes) => serde_json::from_slice::<FitFile>(&bytes)
-            .with_context(|| format!("{} exists but is not a fit file ({{\"robots\": [...]}}); nothing was written", path.display()))?,
+        Ok(bytes) => serde_json::from_slice::<FitFile>(&bytes).with_context(|| {
+            format!(
+                "{} exists but is not a fit file ({{\"robots\": [...]}}); nothing was written",
+                path.display()
+            )
+        })?,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => FitFile::default(),
         Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
     };
@@ -217,16 +234,31 @@ mod tests {
     use shared::{ActionId, MotorCommand, RunMode};
 
     fn frame(tick: u32, action: u8, motors: MotorCommand, counts: [i16; 2]) -> LogFrame {
-        LogFrame { tick, mode: RunMode::Driving, action: ActionId(action), motors, encoder_counts: counts, robot_id: 3, ..LogFrame::default() }
+        LogFrame {
+            tick,
+            mode: RunMode::Driving,
+            action: ActionId(action),
+            motors,
+            encoder_counts: counts,
+            robot_id: 3,
+            ..LogFrame::default()
+        }
     }
 
     #[test]
     fn counts_are_measured_against_the_command_that_drove_them() {
-        let s = OdometrySettings { mm_per_unit: 5.0, counts_per_mm: 2.0, track_mm: 100.0 };
+        let s = OdometrySettings {
+            mm_per_unit: 5.0,
+            counts_per_mm: 2.0,
+            track_mm: 100.0,
+        };
         let mut t = OdometryTracker::new(s);
-        let straight = MotorCommand { left: 150, right: 150 }; // 2 units/step
-        // 2 units x 5 mm x 2 counts/mm = 20 counts per track: as intended; then 10 % slow.
-        // A frame's counts are the period before it: the previous frame's action.
+        let straight = MotorCommand {
+            left: 150,
+            right: 150,
+        }; // 2 units/step
+           // 2 units x 5 mm x 2 counts/mm = 20 counts per track: as intended; then 10 % slow.
+           // A frame's counts are the period before it: the previous frame's action.
         t.frame(&frame(1, 0, straight, [0, 0]));
         t.frame(&frame(2, 0, straight, [20, 20]));
         t.frame(&frame(3, 1, straight, [18, 18]));
@@ -236,7 +268,10 @@ mod tests {
         let robots = t.finish();
         assert_eq!(robots.len(), 1);
         let a = &robots[0].actions;
-        assert_eq!((a[0].action, a[0].periods, a[0].intended_forward), (0, 2, 2.0));
+        assert_eq!(
+            (a[0].action, a[0].periods, a[0].intended_forward),
+            (0, 2, 2.0)
+        );
         assert!((a[0].forward - 1.9).abs() < 1e-9 && a[0].turn == 0.0);
         assert_eq!((a[1].action, a[1].periods, a[1].forward), (1, 1, 2.0));
         let fit = robots[0].fit.unwrap();
@@ -247,33 +282,78 @@ mod tests {
 
     #[test]
     fn a_right_drift_is_a_positive_turn_bias_and_merging_keeps_other_robots() {
-        let s = OdometrySettings { mm_per_unit: 5.0, counts_per_mm: 2.0, track_mm: 100.0 };
+        let s = OdometrySettings {
+            mm_per_unit: 5.0,
+            counts_per_mm: 2.0,
+            track_mm: 100.0,
+        };
         let mut t = OdometryTracker::new(s);
-        let straight = MotorCommand { left: 150, right: 150 };
+        let straight = MotorCommand {
+            left: 150,
+            right: 150,
+        };
         t.frame(&frame(1, 0, straight, [0, 0]));
         // Left 10 mm further than right: 0.1 rad to the right.
         t.frame(&frame(2, 0, straight, [30, 10]));
         let fit = t.finish()[0].fit.unwrap();
         assert!((fit.turn_bias - 0.1).abs() < 1e-9, "{fit:?}");
-        let mut file = FitFile { robots: vec![RobotFit { id: 9, wheel_speed_factor: 1.1, turn_bias: 0.0 }, RobotFit { id: 3, ..fit }] };
-        file.merge([RobotFit { turn_bias: 0.2, ..fit }]);
-        assert_eq!(file.robots.iter().map(|r| (r.id, r.turn_bias)).collect::<Vec<_>>(), [(3, 0.2), (9, 0.0)]);
+        let mut file = FitFile {
+            robots: vec![
+                RobotFit {
+                    id: 9,
+                    wheel_speed_factor: 1.1,
+                    turn_bias: 0.0,
+                },
+                RobotFit { id: 3, ..fit },
+            ],
+        };
+        file.merge([RobotFit {
+            turn_bias: 0.2,
+            ..fit
+        }]);
+        assert_eq!(
+            file.robots
+                .iter()
+                .map(|r| (r.id, r.turn_bias))
+                .collect::<Vec<_>>(),
+            [(3, 0.2), (9, 0.0)]
+        );
         let json = serde_json::to_string(&file).unwrap();
-        assert!(json.starts_with(r#"{"robots":[{"id":3,"wheel_speed_factor":"#), "{json}");
+        assert!(
+            json.starts_with(r#"{"robots":[{"id":3,"wheel_speed_factor":"#),
+            "{json}"
+        );
 
         // Into a file: a new one, then merged, then a foreign file refused by name.
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("fit.json");
-        let motion = |id: u8| RobotMotion { id, actions: Vec::new(), fit: Some(RobotFit { id, ..fit }) };
+        let motion = |id: u8| RobotMotion {
+            id,
+            actions: Vec::new(),
+            fit: Some(RobotFit { id, ..fit }),
+        };
         merge_into_file(&path, &[motion(3)]).unwrap();
         let merged = merge_into_file(&path, &[motion(1)]).unwrap();
-        assert_eq!(merged.robots.iter().map(|r| r.id).collect::<Vec<_>>(), [1, 3]);
+        assert_eq!(
+            merged.robots.iter().map(|r| r.id).collect::<Vec<_>>(),
+            [1, 3]
+        );
         let read: FitFile = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
         assert_eq!(read, merged);
         std::fs::write(&path, "[1, 2]").unwrap();
         let e = format!("{:#}", merge_into_file(&path, &[motion(1)]).unwrap_err());
-        assert!(e.contains("fit.json") && e.contains("not a fit file"), "{e}");
-        let e = merge_into_file(&dir.path().join("new.json"), &[RobotMotion { id: 1, actions: Vec::new(), fit: None }]);
+        assert!(
+            e.contains("fit.json") && e.contains("not a fit file"),
+            "{e}"
+        );
+        let e = merge_into_file(
+            &dir.path().join("new.json"),
+            &[RobotMotion {
+                id: 1,
+                actions: Vec::new(),
+                fit: None,
+            }],
+        );
         assert!(e.unwrap_err().to_string().contains("no fit"));
     }
 }

@@ -37,7 +37,12 @@ impl fmt::Display for Stage {
 
 impl Stage {
     /// Every stage, in pipeline order.
-    pub const ALL: [Stage; 4] = [Stage::Calibration, Stage::Hash, Stage::Policy, Stage::Motors];
+    pub const ALL: [Stage; 4] = [
+        Stage::Calibration,
+        Stage::Hash,
+        Stage::Policy,
+        Stage::Motors,
+    ];
 }
 
 /// Frames per run mode.
@@ -254,9 +259,17 @@ impl fmt::Display for ReplayReport {
 impl ReplayReport {
     /// Source, ticks, modes and damaged entries.
     fn fmt_timeline(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        writeln!(f, "source: {}, {} entries, {} frames decoded", self.source, self.entries, self.frames)?;
+        writeln!(
+            f,
+            "source: {}, {} entries, {} frames decoded",
+            self.source, self.entries, self.frames
+        )?;
         if let Some((first, last)) = self.ticks {
-            write!(f, "ticks: {first}..{last}, {} missing, {} restarts", self.missing_ticks, self.restarts)?;
+            write!(
+                f,
+                "ticks: {first}..{last}, {} missing, {} restarts",
+                self.missing_ticks, self.restarts
+            )?;
             match self.host_seconds {
                 Some(s) => writeln!(f, ", {s:.1} s of host time")?,
                 None => writeln!(f)?,
@@ -268,7 +281,11 @@ impl ReplayReport {
             "modes: idle {}, driving {} (policy drove {}), calibrating {}",
             m.idle, m.driving, self.policy_drove, m.calibrating
         )?;
-        writeln!(f, "damaged: {} (other format version: {})", self.damaged, self.other_version)?;
+        writeln!(
+            f,
+            "damaged: {} (other format version: {})",
+            self.damaged, self.other_version
+        )?;
         for d in &self.first_damaged {
             writeln!(f, "  at byte {} ({} bytes): {}", d.offset, d.len, d.error)?;
         }
@@ -297,9 +314,16 @@ impl ReplayReport {
 
     /// Divergences per stage and the first ones in full.
     fn fmt_divergences(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let by_stage: Vec<String> =
-            Stage::ALL.iter().map(|s| format!("{s} {}", self.diverged_by_stage.of(*s))).collect();
-        writeln!(f, "divergences: {} frames ({})", self.diverged, by_stage.join(", "))?;
+        let by_stage: Vec<String> = Stage::ALL
+            .iter()
+            .map(|s| format!("{s} {}", self.diverged_by_stage.of(*s)))
+            .collect();
+        writeln!(
+            f,
+            "divergences: {} frames ({})",
+            self.diverged,
+            by_stage.join(", ")
+        )?;
         for d in &self.first_divergences {
             let stages: Vec<String> = d.stages.iter().map(|s| s.to_string()).collect();
             writeln!(
@@ -328,20 +352,38 @@ impl ReplayReport {
     /// States met (and untrained ones) and the action histogram.
     fn fmt_coverage(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let c = &self.coverage;
-        write!(f, "coverage: {} of {} states met while the policy drove", c.states, c.of)?;
+        write!(
+            f,
+            "coverage: {} of {} states met while the policy drove",
+            c.states, c.of
+        )?;
         match &c.untrained {
             Some(u) => {
                 let frames: u64 = u.iter().map(|(_, n)| n).sum();
-                writeln!(f, "; {} never visited in training ({} frames)", u.len(), frames)?;
+                writeln!(
+                    f,
+                    "; {} never visited in training ({} frames)",
+                    u.len(),
+                    frames
+                )?;
                 if !u.is_empty() {
-                    let list: Vec<String> = u.iter().take(20).map(|(s, n)| format!("{s} ({n})")).collect();
+                    let list: Vec<String> = u
+                        .iter()
+                        .take(20)
+                        .map(|(s, n)| format!("{s} ({n})"))
+                        .collect();
                     writeln!(f, "  untrained states (frames): {}", list.join(", "))?;
                 }
             }
             None => writeln!(f, " (pass --visits to compare with training)")?,
         }
         if !c.frames_per_state.is_empty() {
-            let list: Vec<String> = c.frames_per_state.iter().take(10).map(|(s, n)| format!("{s} ({n})")).collect();
+            let list: Vec<String> = c
+                .frames_per_state
+                .iter()
+                .take(10)
+                .map(|(s, n)| format!("{s} ({n})"))
+                .collect();
             writeln!(f, "  most met states (frames): {}", list.join(", "))?;
         }
         let actions: Vec<String> = self
@@ -368,7 +410,11 @@ impl ReplayReport {
                 )?;
             }
             match r.fit {
-                Some(fit) => writeln!(f, "  fit: wheel_speed_factor {:.4}, turn_bias {:+.5}", fit.wheel_speed_factor, fit.turn_bias)?,
+                Some(fit) => writeln!(
+                    f,
+                    "  fit: wheel_speed_factor {:.4}, turn_bias {:+.5}",
+                    fit.wheel_speed_factor, fit.turn_bias
+                )?,
                 None => writeln!(f, "  fit: none (no forward motion asked for)")?,
             }
         }
@@ -379,11 +425,19 @@ impl ReplayReport {
     fn fmt_faults(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "faults: {} frames", self.fault_frames)?;
         for c in self.faults.iter().filter(|c| c.frames > 0) {
-            write!(f, "; {}: {} frames in {} episodes", c.fault, c.frames, c.episodes)?;
+            write!(
+                f,
+                "; {}: {} frames in {} episodes",
+                c.fault, c.frames, c.episodes
+            )?;
         }
         writeln!(f)?;
         for e in &self.first_fault_episodes {
-            writeln!(f, "  {} ticks {}..{} ({} frames)", e.fault, e.first_tick, e.last_tick, e.frames)?;
+            writeln!(
+                f,
+                "  {} ticks {}..{} ({} frames)",
+                e.fault, e.first_tick, e.last_tick, e.frames
+            )?;
         }
         Ok(())
     }

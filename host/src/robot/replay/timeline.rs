@@ -29,7 +29,10 @@ impl Timeline {
         if let Some(t) = host_time_us {
             self.host_times = Some(self.host_times.map_or((t, t), |(first, _)| (first, t)));
         }
-        self.ticks = Some(self.ticks.map_or((f.tick, f.tick), |(first, _)| (first, f.tick)));
+        self.ticks = Some(
+            self.ticks
+                .map_or((f.tick, f.tick), |(first, _)| (first, f.tick)),
+        );
         if let Some(last) = self.last_tick {
             if f.tick > last {
                 self.missing_ticks += u64::from(f.tick - last - 1);
