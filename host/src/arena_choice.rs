@@ -1,13 +1,13 @@
 //! `--arena` (and `arena = "..."` in training files): `thesis`, the
 //! reference model's 800 x 800 square; a built-in screen arena by name
-//! (`tv75`, [`sim::arena`]); or the path of a TOML file of a screen arena
+//! (`tv75`, [`sim::scenario::arena`]); or the path of a TOML file of a screen arena
 //! (every field optional, the rest `tv75`'s; `docs/robot-sensors.md`).
 //! Without one, runs with the robot's senses use `tv75` and the others the
 //! thesis' square.
 
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use sim::arena::ArenaSpec;
+use sim::scenario::arena::ArenaSpec;
 use sim::scenario::Arena;
 use std::fmt;
 use std::path::{Path, PathBuf};

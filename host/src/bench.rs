@@ -15,10 +15,10 @@
 //! and 12 pucks on the TV: 250 pucks do not fit on it).
 
 use anyhow::{bail, Result};
-use sim::pixy_camera::PixyCameraConfig;
+use sim::scenario::sensor_setup::SensorSetup;
 use sim::scenario::{Arena, ControllerChoice, Scenario};
-use sim::sensor_setup::SensorSetup;
-use sim::{BroadPhase, World};
+use sim::sensors::pixy_camera::PixyCameraConfig;
+use sim::{config::BroadPhase, world::World};
 use std::fmt;
 use std::time::{Duration, Instant};
 
@@ -182,7 +182,7 @@ impl CameraRange {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sim::Vec2;
+    use sim::math::vec2::Vec2;
 
     #[test]
     fn the_robot_benchmark_counts_the_bodies_a_camera_could_see() {
@@ -205,8 +205,12 @@ mod tests {
 
     #[test]
     fn bodies_in_range_are_counted_by_the_distance_of_their_nearest_point() {
-        let config = sim::SimConfig::default();
-        let robots = [(Vec2::new(100.0, 100.0), 0.0, sim::RobotKind::Outie)];
+        let config = sim::config::SimConfig::default();
+        let robots = [(
+            Vec2::new(100.0, 100.0),
+            0.0,
+            sim::physics::body::RobotKind::Outie,
+        )];
         // Lens at 103 (forward 3); range 250: the puck at 362 reaches to
         // 352 (in), the one at 364 only to 354 (out); one behind is in.
         let world = World::scene(

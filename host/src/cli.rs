@@ -14,9 +14,9 @@ use host::sensor_choice::SensorChoice;
 use host::train::selection::SelectConfig;
 use host::train::{TrainOverrides, TrainRequest};
 use shared::StateHasher;
-use sim::reward::Reward;
+use sim::episodes::reward::Reward;
 use sim::scenario::{ControllerChoice, Scenario};
-use sim::{BroadPhase, FieldError, FieldSource};
+use sim::{config::BroadPhase, fields::source::FieldError, fields::source::FieldSource};
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 

@@ -10,8 +10,8 @@
 use crate::panel_file;
 use anyhow::{Context, Result};
 use serde::Serialize;
-use sim::arena::ArenaSpec;
-use sim::field_source::FieldSource;
+use sim::fields::source::FieldSource;
+use sim::scenario::arena::ArenaSpec;
 use std::net::{SocketAddr, TcpListener};
 use tiny_http::{Header, Method, Request, Response, Server};
 

@@ -90,7 +90,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file }) => {
-            let blob = sim::policy_file::read(&file)?;
+            let blob = sim::control::policy_file::read(&file)?;
             print!("{}", host::inspect::render(&blob));
             Ok(())
         }

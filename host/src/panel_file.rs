@@ -1,21 +1,21 @@
 //! The panel image of a field on a screen arena as a PNG file
 //! (`host field export`) or bytes (`host display` serves them): the
-//! picture [`sim::panel::panel_image`] defines, one 8-bit grey pixel per
+//! picture [`sim::scenario::panel::panel_image`] defines, one 8-bit grey pixel per
 //! panel pixel, with no colour profile or gamma chunk (a browser shows the
 //! levels as they are).
 
 use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::GrayImage;
-use sim::arena::ArenaSpec;
-use sim::field_source::FieldSource;
+use sim::fields::source::FieldSource;
+use sim::scenario::arena::ArenaSpec;
 use std::path::Path;
 
 /// The panel image of `source` on `arena`, the field loaded as the
-/// arena shows it ([`FieldSource::load_for`]).
+/// arena shows it ([`ArenaSpec::load_field`]).
 pub fn panel_image(arena: &ArenaSpec, source: &FieldSource) -> Result<GrayImage> {
-    let field = source.load_for(arena)?;
-    Ok(sim::panel::panel_image(arena, &field))
+    let field = arena.load_field(source)?;
+    Ok(sim::scenario::panel::panel_image(arena, &field))
 }
 
 /// `image` encoded as a PNG.
@@ -49,13 +49,13 @@ mod tests {
             screen_px: [96, 54],
             ..ArenaSpec::tv75()
         };
-        let source = FieldSource::Letter(sim::Letter::T);
+        let source = FieldSource::Letter(sim::fields::letters::Letter::T);
         assert_eq!(export(&arena, &source, &out).unwrap(), (96, 54));
         let back = image::open(&out).unwrap();
         assert_eq!(back.color(), image::ColorType::L8);
         assert_eq!(
             back.into_luma8(),
-            sim::panel::panel_image(&arena, &source.load_for(&arena).unwrap())
+            sim::scenario::panel::panel_image(&arena, &arena.load_field(&source).unwrap())
         );
         let missing = FieldSource::Image("/no/such/field.png".into());
         let e = format!("{:#}", export(&arena, &missing, &out).unwrap_err());

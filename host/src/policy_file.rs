@@ -1,4 +1,4 @@
-//! Writing policy blob files (reading them is `sim::policy_file`'s).
+//! Writing policy blob files (reading them is `sim::control::policy_file`'s).
 
 use anyhow::Result;
 use shared::PolicyBlob;

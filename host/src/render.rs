@@ -6,7 +6,7 @@ use image::codecs::gif::{GifEncoder, Repeat};
 use image::{Delay, Frame, RgbaImage};
 use sim::control::Controller;
 use sim::render::{draw, RenderOptions};
-use sim::sensor_model::SensorModel;
+use sim::sensors::SensorModel;
 use sim::simulation::Simulation;
 use std::path::Path;
 

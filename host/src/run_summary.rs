@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 use sim::control::Controller;
-use sim::sensor_model::SensorModel;
+use sim::sensors::SensorModel;
 use sim::simulation::{Simulation, Totals};
 use std::fmt;
 use std::time::Instant;

@@ -1,6 +1,6 @@
 //! `--sensors` (and `sensors = "..."` in training and experiment files):
 //! a sensor model by name, `disc`, `disc-thesis` or `robot`
-//! ([`sim::sensor_setup`]), or `robot:FILE`, the robot sensor model with
+//! ([`sim::scenario::sensor_setup`]), or `robot:FILE`, the robot sensor model with
 //! the settings of a JSON [`RobotSensorConfig`] file (every field
 //! optional; `docs/robot-sensors.md`), or a mix for ablations:
 //! `mix:FIELD+PUCKS+OBSTACLES`, the field values, puck bits and obstacle
@@ -10,8 +10,8 @@
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use sim::config::SimConfig;
-use sim::robot_sensors::RobotSensorConfig;
-use sim::sensor_setup::{SelectedSensors, SensorSetup};
+use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
+use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;

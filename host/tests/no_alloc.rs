@@ -1,7 +1,7 @@
 //! The steady-state step loop allocates nothing, with or without learning.
 
-use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-use sim::{ScalarField, SimConfig, Simulation};
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::{config::SimConfig, fields::ScalarField, simulation::Simulation};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::sync::Arc;
@@ -69,7 +69,7 @@ fn learning_allocates_nothing() {
 #[test]
 fn stepping_with_the_robots_senses_allocates_nothing_once_warmed_up() {
     let scenario = sim::scenario::Scenario {
-        sensors: sim::sensor_setup::SensorSetup::Robot(Box::default()),
+        sensors: sim::scenario::sensor_setup::SensorSetup::Robot(Box::default()),
         controller: sim::scenario::ControllerChoice::Random,
         ..sim::scenario::Scenario::default()
     };

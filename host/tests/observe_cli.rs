@@ -8,13 +8,13 @@
 use host::observe::homography::Homography;
 use image::{Rgb, RgbImage};
 use rand::{RngExt, SeedableRng};
-use sim::arena::ArenaSpec;
-use sim::field::ScalarField;
-use sim::field_source::FieldSource;
+use sim::fields::source::FieldSource;
+use sim::fields::ScalarField;
+use sim::math::vec2::Vec2;
+use sim::scenario::arena::ArenaSpec;
 use sim::scenario::{Arena, Scenario};
-use sim::vec2::Vec2;
 use sim::world::World;
-use sim::{RobotKind, SimConfig, SimRng};
+use sim::{config::SimConfig, math::rng::SimRng, physics::body::RobotKind};
 use std::path::Path;
 use std::process::Command;
 
@@ -52,7 +52,7 @@ fn tv75_config(field: &ScalarField) -> SimConfig {
 }
 
 fn annulus() -> ScalarField {
-    FieldSource::Annulus.load_for(&ArenaSpec::tv75()).unwrap()
+    ArenaSpec::tv75().load_field(&FieldSource::Annulus).unwrap()
 }
 
 /// The camera: each photo pixel shows the top-down scene where the
@@ -274,7 +274,7 @@ fn check(world: &World, field: &ScalarField, config: &SimConfig, report: &Report
         worst < tolerance,
         "a puck found {worst:.2} units from where it is: {errors:.2?}"
     );
-    let truth = sim::eval::eval(world, field, &config.thresholds);
+    let truth = sim::episodes::eval::eval(world, field, &config.thresholds);
     assert!(
         (report.eval - truth).abs() < 0.005,
         "Eval {} against the world's {truth}",

@@ -6,9 +6,9 @@ use host::sensor_choice::SensorChoice;
 use host::train::checkpoint::{self, CheckpointError};
 use host::train::{TrainConfig, Trainer, TrainingState};
 use shared::SensorReading;
-use sim::Reward;
-use sim::{Controller, Perception};
-use sim::{EpisodeStart, SimRng, StepOutcome};
+use sim::episodes::reward::Reward;
+use sim::{control::Controller, control::Perception};
+use sim::{episodes::EpisodeStart, episodes::StepOutcome, math::rng::SimRng};
 use std::io::Write;
 use std::sync::Arc;
 
@@ -24,7 +24,7 @@ fn small(seed: u64) -> TrainConfig {
     }
 }
 
-fn trainer(config: TrainConfig) -> Trainer<sim::SelectedSensors> {
+fn trainer(config: TrainConfig) -> Trainer<sim::scenario::sensor_setup::SelectedSensors> {
     Trainer::start(config, None).unwrap()
 }
 
@@ -118,10 +118,10 @@ fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkp
             every: 300,
             stale: true,
         },
-        success: sim::SuccessSignal::EvalPrime,
+        success: sim::config::SuccessSignal::EvalPrime,
         obstacle_discs: Some(host::train::config::ObstacleDiscs {
             radius: 2.0,
-            sees: sim::ObstacleTargets::AnyBody,
+            sees: sim::config::disc_sensors::ObstacleTargets::AnyBody,
         }),
         ..small(11)
     };
@@ -189,7 +189,7 @@ fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_b
 #[test]
 fn a_resume_refuses_a_changed_field() {
     let t = trainer(small(1));
-    let letter = Arc::new(sim::Letter::T.field());
+    let letter = Arc::new(sim::fields::letters::Letter::T.field());
     let sensors = SensorChoice::Disc.build(&t.state().sim.config).unwrap();
     let e = Trainer::resume(t.state(), letter, sensors)
         .err()
@@ -329,8 +329,8 @@ impl Controller for Probe {
 #[test]
 fn the_state_reached_is_the_state_decided_on_next() {
     let config = small(6).prepare().unwrap().config().clone();
-    let field = Arc::new(sim::ScalarField::annulus());
-    let mut sim = sim::Simulation::new(config, field, 6).unwrap();
+    let field = Arc::new(sim::fields::ScalarField::annulus());
+    let mut sim = sim::simulation::Simulation::new(config, field, 6).unwrap();
     let mut probe = Probe {
         decided: Vec::new(),
         after: Vec::new(),

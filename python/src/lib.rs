@@ -26,9 +26,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use settings::{ActionKind, Autoreset, EnvArgs, ObservationKind, READING_LEN};
 use shared::{ActionTable, StateHasher};
+use sim::episodes::reward::Reward;
 use sim::render::RenderOptions;
-use sim::reward::Reward;
-use sim::sensor_setup::SensorSetup;
+use sim::scenario::sensor_setup::SensorSetup;
 
 fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -474,7 +474,8 @@ fn encode_policy<'py>(
 /// trainer_steps, seed.
 #[pyfunction]
 fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Bound<'py, PyDict>> {
-    let blob = sim::policy_file::decode(std::path::Path::new(path), data).map_err(value_error)?;
+    let blob =
+        sim::control::policy_file::decode(std::path::Path::new(path), data).map_err(value_error)?;
     let d = PyDict::new(py);
     d.set_item("hasher", blob.hasher().name())?;
     d.set_item("actions", blob.actions().angular_speeds().to_vec())?;

@@ -7,14 +7,14 @@
 //! `thresholds`, `reward`, the observation and action kinds).
 
 use shared::{ActionTable, StateHasher};
-use sim::arena::ArenaSpec;
+use sim::config::validate::ConfigError;
 use sim::config::{SimConfig, Thresholds};
-use sim::field_source::FieldSource;
-use sim::reward::Reward;
-use sim::robot_sensors::RobotSensorConfig;
+use sim::episodes::reward::Reward;
+use sim::fields::source::FieldSource;
+use sim::scenario::arena::ArenaSpec;
+use sim::scenario::sensor_setup::SensorSetup;
 use sim::scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
-use sim::sensor_setup::SensorSetup;
-use sim::validate::ConfigError;
+use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
 
 /// A keyword argument that cannot be used: `name = value: problem`.

@@ -5,9 +5,9 @@
 
 use crate::settings::EnvSettings;
 use shared::{ActionId, SensorReading};
-use sim::episode::EpisodeEnd;
+use sim::episodes::EpisodeEnd;
+use sim::scenario::sensor_setup::SelectedSensors;
 use sim::scenario::ScenarioError;
-use sim::sensor_setup::SelectedSensors;
 use sim::simulation::{Simulation, Totals};
 
 /// What one step of one world produced, besides its observation.

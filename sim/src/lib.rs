@@ -1,84 +1,49 @@
 //! The simulator of policy-guided puck construction by robot swarms.
 //!
-//! One pipeline stage per module, like rapier's, with the data flowing
-//! down: [`world`] (arena, [`body`]s, robots) -> [`physics`] (integration,
-//! the [`broadphase`] over a [`grid`], contacts in one canonical order,
-//! impulses) -> a [`sensor_model`] (the thesis' [`disc_sensors`], or the
-//! robot's [`robot_sensors`]: [`photo_sensors`] and [`pixy_camera`]) ->
-//! a [`control`]ler ([`controllers`]: orbital construction, a greedy
-//! policy table, random turns) -> turns; with the scalar [`field`]s
-//! ([`field_source`], [`letters`]), [`eval`]uation, the learning
-//! [`reward`]s and the step loop and episodes in [`simulation`].
-//! [`scenario`] builds a simulation from a few choices; [`render`] draws
-//! it; [`policy_file`] reads policy blobs.
+//! Rooms by concern, each importing only from the rooms listed before it
+//! (`tests/tests/module_graph.rs` checks the order):
 //!
-//! Arenas: the thesis' square, or a screen lying flat with the field on
-//! it ([`arena`]: the 75" TV of the thesis' hardware; [`panel`]: the image
-//! the screen shows).
+//! 1. [`math`]: vectors, trig, rounding, bit sets, seeded random draws;
+//! 2. [`fields`]: scalar fields, the letter images, where a field comes from;
+//! 3. [`config`]: every setting of a simulation, plain data with defaults
+//!    and validation (world, physics, disc sensors, episodes);
+//! 4. [`physics`]: bodies, the broad phase over a grid, contacts in one
+//!    canonical order, impulses;
+//! 5. [`world`]: the arena's bodies and robots, stepped through physics;
+//! 6. [`sensors`]: sensor models turning the world into readings (the
+//!    thesis' discs, the Zumo's photo-transistors and Pixy camera);
+//! 7. [`episodes`]: Eval, the learning rewards, episode starts and ends;
+//! 8. [`control`]: the controller hook and the controllers (orbital
+//!    construction, a greedy policy table, random turns);
+//! 9. [`simulation`]: the step loop and its episodes;
+//! 10. [`scenario`]: a simulation built from a few choices, screen arenas
+//!     and the image they show, the choice of sensor model;
+//! 11. [`render`]: drawing a world.
 //!
-//! Everything random comes from a seeded [`SimRng`]; the whole state is
-//! serde-serialisable for bit-exact checkpoints. The crate reads field
-//! images and policy files, and writes no files.
+//! A step's data flows world -> physics -> sensors -> controller -> turns.
+//! Every random choice comes from a seeded [`math::rng::SimRng`]; the whole
+//! state is serde-serialisable for bit-exact checkpoints. The crate reads
+//! field images and policy files, and writes no files.
 #![warn(missing_docs)]
 
-pub mod actuation;
-pub mod arena;
-pub mod bitset;
-pub mod body;
-pub mod broadphase;
-pub mod camera_memory;
+pub mod math;
+
+pub mod fields;
+
 pub mod config;
-pub mod control;
-pub mod controllers;
-pub mod disc_sensor_config;
-pub mod disc_sensors;
-pub mod episode;
-pub mod eval;
-pub mod field;
-pub mod field_source;
-pub mod grid;
-pub mod letters;
-pub mod mixed_sensors;
-pub mod noise;
-pub mod panel;
-pub mod photo_sensors;
+
 pub mod physics;
-pub mod pixy_camera;
-pub mod policy_file;
-pub mod render;
-pub mod reward;
-pub mod rng;
-pub mod robot_noise;
-pub mod robot_sensors;
-pub mod rounding;
-pub mod scenario;
-pub mod sensor_model;
-pub mod sensor_setup;
-pub mod simulation;
-pub mod trig;
-pub mod validate;
-pub mod vec2;
+
 pub mod world;
 
-pub use arena::{ArenaSpec, FieldFit};
-pub use body::{Body, Robot, RobotKind};
-pub use broadphase::BroadPhase;
-pub use config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig};
-pub use control::{Controller, Perception};
-pub use disc_sensor_config::{DiscSensorConfig, ObstacleTargets, SensorDisc};
-pub use disc_sensors::DiscSensors;
-pub use episode::{EpisodeEnd, EpisodeStart, StepOutcome};
-pub use eval::{eval, eval_prime, EvalPrime, EvalTracker};
-pub use field::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
-pub use field_source::{FieldError, FieldSource};
-pub use letters::Letter;
-pub use reward::Reward;
-pub use rng::SimRng;
-pub use robot_sensors::{RobotObservation, RobotSensorConfig, RobotSensors};
-pub use scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
-pub use sensor_model::{Footprint, FootprintKind, SensorModel};
-pub use sensor_setup::{SelectedSensors, SensorSetup};
-pub use simulation::{Simulation, SimulationState, StepReport, Totals};
-pub use validate::ConfigError;
-pub use vec2::Vec2;
-pub use world::{World, WorldState};
+pub mod sensors;
+
+pub mod episodes;
+
+pub mod control;
+
+pub mod simulation;
+
+pub mod scenario;
+
+pub mod render;

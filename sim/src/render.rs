@@ -3,10 +3,10 @@
 //! line, optionally each robot's sensor footprints. (Writing them as PNG
 //! or GIF files is the host's.)
 
-use crate::field::ScalarField;
-use crate::sensor_model::{FootprintKind, SensorModel};
+use crate::fields::ScalarField;
+use crate::math::vec2::Vec2;
+use crate::sensors::{FootprintKind, SensorModel};
 use crate::simulation::Simulation;
-use crate::vec2::Vec2;
 use crate::world::World;
 use image::{Rgb, RgbImage};
 

@@ -20,15 +20,15 @@
 //! [`Simulation::reset_episode`] when the [`StepReport`] says the episode
 //! ended. Both give the same trajectory for the same turns.
 
+use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, SuccessSignal};
 use crate::control::{Controller, Perception};
-use crate::disc_sensors::DiscSensors;
-use crate::episode::{EpisodeEnd, EpisodeStart, StepOutcome};
-use crate::eval::{eval, eval_prime, EvalPrime, EvalTracker};
-use crate::field::ScalarField;
-use crate::rng::SimRng;
-use crate::sensor_model::{SensorMemory, SensorModel};
-use crate::validate::ConfigError;
+use crate::episodes::eval::{eval, eval_prime, EvalPrime, EvalTracker};
+use crate::episodes::{EpisodeEnd, EpisodeStart, StepOutcome};
+use crate::fields::ScalarField;
+use crate::math::rng::SimRng;
+use crate::sensors::disc::DiscSensors;
+use crate::sensors::{SensorMemory, SensorModel};
 use crate::world::World;
 use rand::SeedableRng;
 use serde::{Deserialize, Serialize};

@@ -1,9 +1,12 @@
 //! The incrementally tracked Eval the simulation reports equals a fresh
 //! evaluation of the whole world, at every step and across episode resets.
 
-use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-use sim::{eval, ScalarField, SimConfig, SimRng, Simulation, StepOutcome};
-use sim::{Controller, Perception};
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::{
+    config::SimConfig, episodes::eval::eval, episodes::StepOutcome, fields::ScalarField,
+    math::rng::SimRng, simulation::Simulation,
+};
+use sim::{control::Controller, control::Perception};
 use std::sync::Arc;
 
 /// Orbital construction that checks each reported Eval against a recount.
@@ -23,7 +26,7 @@ impl Controller for Checker {
     }
     fn observe(&mut self, o: &StepOutcome<'_>) {
         if let Some(reported) = o.eval {
-            let fresh = eval(o.world, o.field, &sim::Thresholds::default());
+            let fresh = eval(o.world, o.field, &sim::config::Thresholds::default());
             assert_eq!(
                 reported.to_bits(),
                 fresh.to_bits(),

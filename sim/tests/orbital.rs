@@ -3,8 +3,11 @@
 //! >= left), B does not and turns to realign.
 
 use shared::SensorReading;
-use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-use sim::{DiscSensors, RobotKind, ScalarField, SensorModel, SimConfig, Thresholds, Vec2, World};
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::{
+    config::SimConfig, config::Thresholds, fields::ScalarField, math::vec2::Vec2,
+    physics::body::RobotKind, sensors::disc::DiscSensors, sensors::SensorModel, world::World,
+};
 use std::f64::consts::FRAC_PI_2;
 
 fn read(pos: Vec2, heading: f64, kind: RobotKind, pucks: &[Vec2]) -> SensorReading {

@@ -1,9 +1,12 @@
 //! Physics: impulses, walls, sliding pucks, and grid vs all-pairs identity.
 
 use shared::ActionTable;
-use sim::controllers::RandomTurns;
+use sim::control::random::RandomTurns;
 use sim::physics::elastic_impulse;
-use sim::{Body, BroadPhase, RobotKind, SimConfig, Simulation, Vec2, World, WorldState};
+use sim::{
+    config::BroadPhase, config::SimConfig, math::vec2::Vec2, physics::body::Body,
+    physics::body::RobotKind, simulation::Simulation, world::World, world::WorldState,
+};
 use std::sync::Arc;
 
 fn close(a: f64, b: f64) -> bool {
@@ -130,7 +133,7 @@ fn dense_run(broad_phase: BroadPhase, (width, height): (f64, f64), steps: u64) -
     config.world.robots = 24;
     config.world.pucks = 400;
     config.world.broad_phase = broad_phase;
-    let field = Arc::new(sim::ScalarField::annulus());
+    let field = Arc::new(sim::fields::ScalarField::annulus());
     let mut sim = Simulation::new(config, field, 7).unwrap();
     let mut controller = RandomTurns::new(ActionTable::default());
     sim.run(&mut controller, steps);

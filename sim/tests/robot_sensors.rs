@@ -2,10 +2,12 @@
 //! the robot's camera can see.
 
 use shared::{ActionTable, SensorReading};
-use sim::controllers::RandomTurns;
+use sim::control::random::RandomTurns;
 use sim::{
-    DiscSensorConfig, DiscSensors, RobotKind, RobotSensorConfig, RobotSensors, ScalarField,
-    SensorModel, SimConfig, Simulation, Vec2, World,
+    config::disc_sensors::DiscSensorConfig, config::SimConfig, fields::ScalarField,
+    math::vec2::Vec2, physics::body::RobotKind, sensors::disc::DiscSensors,
+    sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors, sensors::SensorModel,
+    simulation::Simulation, world::World,
 };
 use std::sync::Arc;
 
@@ -52,22 +54,22 @@ fn a_puck_in_the_thesis_side_disc_is_sensed_by_the_discs_but_not_the_camera() {
 
 /// A simulation on the TV with the robot's senses and random turns, with
 /// the default noise times `noise`.
-fn noisy(noise: f64, seed: u64) -> Simulation<sim::SelectedSensors> {
-    let tv = sim::ArenaSpec::tv75();
+fn noisy(noise: f64, seed: u64) -> Simulation<sim::scenario::sensor_setup::SelectedSensors> {
+    let tv = sim::scenario::arena::ArenaSpec::tv75();
     let field = ScalarField::annulus_of(64, 36);
     let mut config = SimConfig::default();
     tv.apply(&mut config, &field);
-    config.world.actuation = sim::actuation::ActuationNoise::randomised().scaled(noise);
+    config.world.actuation = sim::config::actuation::ActuationNoise::randomised().scaled(noise);
     let robot = RobotSensorConfig {
-        noise: sim::robot_noise::RobotNoise::randomised().scaled(noise),
+        noise: sim::sensors::robot_noise::RobotNoise::randomised().scaled(noise),
         ..RobotSensorConfig::default()
     };
-    let sensors = sim::SensorSetup::Robot(Box::new(robot)).build(&config);
+    let sensors = sim::scenario::sensor_setup::SensorSetup::Robot(Box::new(robot)).build(&config);
     Simulation::with_sensors(config, Arc::new(field), sensors, seed).unwrap()
 }
 
 fn trajectory(
-    sim: &mut Simulation<sim::SelectedSensors>,
+    sim: &mut Simulation<sim::scenario::sensor_setup::SelectedSensors>,
     steps: u64,
 ) -> (Vec<(f64, f64)>, Vec<SensorReading>) {
     let mut controller = RandomTurns::new(ActionTable::default());
@@ -94,11 +96,11 @@ fn the_same_seed_gives_the_same_noise_and_zero_noise_is_the_noiseless_model() {
     let quiet = trajectory(&mut noisy(0.0, 3), 3000);
     assert_ne!(a, quiet, "the noise changes the run");
     // Zero noise, given explicitly, is the model without noise.
-    let tv = sim::ArenaSpec::tv75();
+    let tv = sim::scenario::arena::ArenaSpec::tv75();
     let field = ScalarField::annulus_of(64, 36);
     let mut config = SimConfig::default();
     tv.apply(&mut config, &field);
-    let sensors = sim::SensorSetup::Robot(Box::default()).build(&config);
+    let sensors = sim::scenario::sensor_setup::SensorSetup::Robot(Box::default()).build(&config);
     let mut plain = Simulation::with_sensors(config, Arc::new(field), sensors, 3).unwrap();
     assert_eq!(quiet, trajectory(&mut plain, 3000));
 }
@@ -110,10 +112,10 @@ fn a_noisy_run_resumed_from_its_snapshot_goes_on_exactly() {
     let mut first = noisy(2.0, 5);
     trajectory(&mut first, 1000);
     let saved = serde_json::to_string(&first.snapshot()).unwrap();
-    let state: sim::SimulationState = serde_json::from_str(&saved).unwrap();
+    let state: sim::simulation::SimulationState = serde_json::from_str(&saved).unwrap();
     let fresh = noisy(2.0, 5);
-    let sensors = sim::SensorSetup::Robot(Box::new(RobotSensorConfig {
-        noise: sim::robot_noise::RobotNoise::randomised().scaled(2.0),
+    let sensors = sim::scenario::sensor_setup::SensorSetup::Robot(Box::new(RobotSensorConfig {
+        noise: sim::sensors::robot_noise::RobotNoise::randomised().scaled(2.0),
         ..RobotSensorConfig::default()
     }))
     .build(fresh.config());

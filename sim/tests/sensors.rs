@@ -3,7 +3,9 @@
 
 use shared::{FieldValue, SensorReading};
 use sim::{
-    DiscSensorConfig, DiscSensors, RobotKind, ScalarField, SensorModel, SimConfig, Vec2, World,
+    config::disc_sensors::DiscSensorConfig, config::SimConfig, fields::ScalarField,
+    math::vec2::Vec2, physics::body::RobotKind, sensors::disc::DiscSensors, sensors::SensorModel,
+    world::World,
 };
 
 const R: f64 = 10.0;
@@ -115,8 +117,8 @@ fn field_sensors_read_the_rounded_cells_and_zero_past_the_edge() {
 /// those of sensors that start afresh every step.
 #[test]
 fn readings_do_not_depend_on_what_the_sensors_saw_before() {
-    use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-    use sim::{Simulation, Thresholds};
+    use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+    use sim::{config::Thresholds, simulation::Simulation};
     use std::sync::Arc;
     let config = SimConfig::default();
     let field = Arc::new(ScalarField::annulus());

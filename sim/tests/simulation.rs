@@ -2,14 +2,16 @@
 //! orbital construction builds the annulus where random turning does not.
 
 use shared::ActionTable;
-use sim::controllers::{OrbitalConfig, OrbitalConstruction, RandomTurns};
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::control::random::RandomTurns;
 use sim::scenario::{ControllerChoice, Scenario};
 use sim::{
-    eval, eval_prime, EvalPrime, ScalarField, SimConfig, SimRng, Simulation, StepOutcome, Vec2,
-    World,
+    config::SimConfig, episodes::eval::eval, episodes::eval::eval_prime, episodes::eval::EvalPrime,
+    episodes::StepOutcome, fields::ScalarField, math::rng::SimRng, math::vec2::Vec2,
+    simulation::Simulation, world::World,
 };
-use sim::{Controller, Perception};
-use sim::{RobotKind, SimulationState};
+use sim::{control::Controller, control::Perception};
+use sim::{physics::body::RobotKind, simulation::SimulationState};
 use std::sync::Arc;
 
 fn standard(seed: u64) -> Simulation {
@@ -94,7 +96,10 @@ fn a_checkpoint_resumes_bit_exactly() {
     first.run(&mut controller, 1500);
     let saved = serde_json::to_string(first.state()).unwrap();
     let state: SimulationState = serde_json::from_str(&saved).unwrap();
-    let sensors = sim::DiscSensors::new(&state.config.sensors, state.config.world.robot_radius);
+    let sensors = sim::sensors::disc::DiscSensors::new(
+        &state.config.sensors,
+        state.config.world.robot_radius,
+    );
     let mut resumed = Simulation::resume(state, Arc::new(ScalarField::annulus()), sensors);
     resumed.run(&mut controller, 2500);
     assert!(final_state(&resumed) == final_state(&straight));
@@ -212,7 +217,7 @@ fn orbital_construction_forms_the_annulus_and_random_does_not() {
 fn checked(
     interval: u64,
     threshold: f64,
-    more: impl FnOnce(&mut sim::EpisodeConfig),
+    more: impl FnOnce(&mut sim::config::EpisodeConfig),
 ) -> Simulation {
     let mut config = SimConfig::default();
     config.world.innies = 4;
@@ -253,7 +258,7 @@ fn first_formation(
     interval: u64,
     threshold: f64,
     stale: bool,
-    signal: sim::SuccessSignal,
+    signal: sim::config::SuccessSignal,
 ) -> Option<u64> {
     let mut sim = checked(interval, threshold, |e| {
         e.stale_eval = stale;
@@ -278,11 +283,11 @@ fn a_stale_check_forms_one_check_after_the_world_formed() {
     // a threshold just below check k's Eval, above every earlier one
     let threshold = evals[k] - 1e-12;
     assert_eq!(
-        first_formation(500, threshold, false, sim::SuccessSignal::Eval),
+        first_formation(500, threshold, false, sim::config::SuccessSignal::Eval),
         Some(500 * k as u64)
     );
     assert_eq!(
-        first_formation(500, threshold, true, sim::SuccessSignal::Eval),
+        first_formation(500, threshold, true, sim::config::SuccessSignal::Eval),
         Some(500 * (k as u64 + 1))
     );
 }
@@ -294,7 +299,7 @@ fn checks_can_test_eval_prime_instead_of_eval() {
     let k = first_record(&primes);
     let threshold = primes[k] - 1e-12;
     assert_eq!(
-        first_formation(500, threshold, false, sim::SuccessSignal::EvalPrime),
+        first_formation(500, threshold, false, sim::config::SuccessSignal::EvalPrime),
         Some(500 * k as u64)
     );
     // Eval crosses that threshold at another check (or never) in this run
@@ -330,7 +335,10 @@ fn a_checkpoint_of_a_stale_checking_run_resumes_bit_exactly() {
     assert!(first.state().checked_signal.is_some());
     let state: SimulationState =
         serde_json::from_str(&serde_json::to_string(first.state()).unwrap()).unwrap();
-    let sensors = sim::DiscSensors::new(&state.config.sensors, state.config.world.robot_radius);
+    let sensors = sim::sensors::disc::DiscSensors::new(
+        &state.config.sensors,
+        state.config.world.robot_radius,
+    );
     let mut resumed = Simulation::resume(state, Arc::new(ScalarField::annulus()), sensors);
     resumed.run(&mut controller, 4500);
     assert!(final_state(&resumed) == final_state(&straight));

@@ -10,9 +10,12 @@ use anyhow::{bail, Context, Result};
 use shared::{
     ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, Role, State,
 };
+use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::scenario::{Arena, ControllerChoice, Scenario};
-use sim::sensor_setup::{SelectedSensors, SensorSetup};
-use sim::{ArenaSpec, FieldSource, RobotObservation, RobotSensors};
+use sim::{
+    fields::source::FieldSource, scenario::arena::ArenaSpec, sensors::robot::RobotObservation,
+    sensors::robot::RobotSensors,
+};
 use std::path::Path;
 
 /// CPU cycles per Timer3 tick (clk/64): the RC time resolution.
@@ -241,7 +244,7 @@ pub fn read_policy(file: &str) -> Result<(std::path::PathBuf, PolicyBlob)> {
             path.display()
         );
     }
-    let blob = sim::policy_file::read(&path)?;
+    let blob = sim::control::policy_file::read(&path)?;
     Ok((path, blob))
 }
 
@@ -262,7 +265,7 @@ pub fn check_elf_embeds(elf: &Path, policy: &PolicyBlob, rebuild: &str) -> Resul
 mod tests {
     use super::*;
     use shared::StateHasher;
-    use sim::RobotSensorConfig;
+    use sim::sensors::robot::RobotSensorConfig;
 
     /// A toy state: the mid time's bin of 10 ticks, and left < right.
     fn toy(t: &[u16; 3]) -> State {

@@ -24,7 +24,10 @@ use shared::{
     ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, RunMode, State,
     StateHasher,
 };
-use sim::{FieldSource, Letter, RobotSensorConfig, RobotSensors, SimRng};
+use sim::{
+    fields::letters::Letter, fields::source::FieldSource, math::rng::SimRng,
+    sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors,
+};
 use std::collections::HashMap;
 use std::time::Instant;
 use tests::equivalence::{

@@ -372,6 +372,46 @@ fn file_circles(root: &Path) -> Vec<String> {
         .collect()
 }
 
+/// The edges of the crate at `root` that point from a room (a module
+/// declared in `lib.rs`) to a room declared after it: `lib.rs` lists its
+/// rooms from the bottom up, and a room may import only from rooms above
+/// it in that list.
+fn room_back_arrows(root: &Path) -> Vec<String> {
+    let files = crate_modules(root);
+    let modules: BTreeSet<Vec<String>> = files.iter().map(|f| f.module.clone()).collect();
+    let lib = files
+        .iter()
+        .find(|f| f.module.is_empty())
+        .expect("the crate root is read");
+    let rank: BTreeMap<&str, usize> = lib
+        .children
+        .iter()
+        .enumerate()
+        .map(|(i, room)| (room.as_str(), i))
+        .collect();
+    let mut found = BTreeSet::new();
+    for f in &files {
+        let Some(from) = f.module.first() else {
+            continue;
+        };
+        for (path, in_use) in named_paths(&f.code) {
+            let Some(target) = resolve(&path, in_use, &f.module, &f.children, &modules) else {
+                continue;
+            };
+            if let Some(to) = target.first() {
+                if rank[to.as_str()] > rank[from.as_str()] {
+                    found.insert(format!(
+                        "{} (room {from}) imports {} (room {to}, declared after it)",
+                        f.path.display(),
+                        target.join("::")
+                    ));
+                }
+            }
+        }
+    }
+    found.into_iter().collect()
+}
+
 fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
@@ -416,4 +456,46 @@ fn the_checker_finds_a_circle_through_a_re_export() {
     )
     .unwrap();
     assert_eq!(file_circles(&src.join("lib.rs")).len(), 1);
+}
+
+#[test]
+fn each_room_of_the_simulator_imports_only_from_the_rooms_below_it() {
+    let root = workspace_root().join("sim").join("src").join("lib.rs");
+    let found = room_back_arrows(&root);
+    assert!(found.is_empty(), "back arrows:\n{}", found.join("\n"));
+}
+
+#[test]
+fn the_simulator_keeps_at_most_twelve_entries_at_its_top_level() {
+    let src = workspace_root().join("sim").join("src");
+    let entries: Vec<String> = std::fs::read_dir(&src)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        entries.len() <= 12,
+        "sim/src has {} entries: {entries:?}",
+        entries.len()
+    );
+}
+
+#[test]
+fn the_room_checker_finds_an_import_from_a_later_room() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path();
+    std::fs::write(src.join("lib.rs"), "pub mod low;\npub mod high;\n").unwrap();
+    std::fs::write(
+        src.join("high.rs"),
+        "use crate::low::L;\npub struct H(L);\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("low.rs"), "pub struct L;\n").unwrap();
+    assert!(room_back_arrows(&src.join("lib.rs")).is_empty());
+    std::fs::write(src.join("low.rs"), "pub struct L(Box<crate::high::H>);\n").unwrap();
+    let found = room_back_arrows(&src.join("lib.rs"));
+    assert_eq!(found.len(), 1, "{found:?}");
+    assert!(
+        found[0].contains("room low") && found[0].contains("room high"),
+        "{found:?}"
+    );
 }

@@ -7,8 +7,8 @@ use super::spec::{ExperimentSpec, FigureSpec, Moment};
 use super::trial::{Running, TrialResult};
 use anyhow::{Context, Result};
 use image::{Rgb, RgbImage};
+use sim::fields::ScalarField;
 use sim::render::{draw, RenderOptions};
-use sim::ScalarField;
 
 /// A field's values as grey pixels, one per cell (0 black, 1 white).
 pub fn field_picture(field: &ScalarField) -> RgbImage {

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 /// Version of `TrialResult`'s layout and meaning, and of the
 /// simulator's results; part of the config hash, so results of another
 /// version are re-run, not mixed in. 2: headings turn through our own
-/// `sin_cos` (`sim::trig`) instead of the platform's. (The settings of the
+/// `sin_cos` (`sim::math::trig`) instead of the platform's. (The settings of the
 /// thesis author's runs, `formation_check` and the others, left it at 2:
 /// at their defaults every trial runs and means what it did, and keeps its
 /// hash: see `hashed`.)
@@ -88,7 +88,7 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 /// ([`TrainConfigV1`], [`TrainConfigV2`]), so that trials run before the
 /// newer settings existed keep their hashes. Settings with the robot's
 /// senses also hash their model's version
-/// ([`sim::robot_sensors::MODEL_VERSION`]): trials of another model are
+/// ([`sim::sensors::robot::MODEL_VERSION`]): trials of another model are
 /// run again.
 #[derive(Serialize)]
 #[serde(untagged)]
@@ -117,7 +117,7 @@ fn hashed(config: &TrainConfig) -> Hashed {
     };
     if robot_senses {
         Hashed::RobotSenses {
-            model: sim::robot_sensors::MODEL_VERSION,
+            model: sim::sensors::robot::MODEL_VERSION,
             settings: Box::new(settings),
         }
     } else {

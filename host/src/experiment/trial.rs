@@ -7,9 +7,10 @@ use crate::learn::QTable;
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use sim::controllers::{GreedyPolicy, OrbitalConfig, OrbitalConstruction};
-use sim::sensor_setup::SelectedSensors;
-use sim::{EpisodeEnd, Simulation, Totals};
+use sim::control::greedy::GreedyPolicy;
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::scenario::sensor_setup::SelectedSensors;
+use sim::{episodes::EpisodeEnd, simulation::Simulation, simulation::Totals};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -145,7 +146,7 @@ impl Running {
                     .policy
                     .as_deref()
                     .context("a policy arm without its policy file")?;
-                let blob = sim::policy_file::read(path)?;
+                let blob = sim::control::policy_file::read(path)?;
                 let mut prepared = c.prepare()?;
                 sim::scenario::drive_with(prepared.config_mut(), &blob, &c.field);
                 let sim = prepared.simulation(c.seed).context("invalid settings")?;
@@ -220,7 +221,9 @@ pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> 
 }
 
 /// Pre-trains a Q-table: a plain training run of `config`.
-pub fn pretrain(config: &TrainConfig) -> Result<Trainer<sim::sensor_setup::SelectedSensors>> {
+pub fn pretrain(
+    config: &TrainConfig,
+) -> Result<Trainer<sim::scenario::sensor_setup::SelectedSensors>> {
     let mut trainer = Trainer::start(config.clone(), None)?;
     trainer.run(config.steps);
     Ok(trainer)

@@ -4,9 +4,9 @@ use super::qtable::{QParams, QTable};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
-use sim::reward::Reward;
-use sim::{Controller, Perception};
-use sim::{EpisodeStart, SimRng, StepOutcome};
+use sim::episodes::reward::Reward;
+use sim::{control::Controller, control::Perception};
+use sim::{episodes::EpisodeStart, episodes::StepOutcome, math::rng::SimRng};
 
 /// What the learner is and how it learns.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -227,7 +227,10 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use shared::{PolicyTable, SensorReading};
-    use sim::{RobotKind, ScalarField, SimConfig, Vec2, World};
+    use sim::{
+        config::SimConfig, fields::ScalarField, math::vec2::Vec2, physics::body::RobotKind,
+        world::World,
+    };
 
     /// Two robots in the same state take the same action and reach the
     /// same state: the second update sees the first.

@@ -1,6 +1,6 @@
 //! Tabular Q-learning with one policy shared by all robots: the table
 //! ([`qtable`]) and the learning controller ([`learner`]), rewarded by
-//! `sim::reward`.
+//! `sim::episodes::reward`.
 
 pub mod learner;
 pub mod qtable;

@@ -6,7 +6,7 @@
 //! ([`homography`]); the photo is resampled top-down over the arena
 //! (`pixels_per_unit` as fine as the photo allows), the pucks are found
 //! there by colour ([`pucks`]), and the simulator evaluates a world of the
-//! detected pucks (`sim::World::scene`, `sim::eval`) against the field's
+//! detected pucks (`sim::world::World::scene`, `sim::episodes::eval`) against the field's
 //! success threshold (`sim::scenario::field_config`). The picture shows
 //! the top-down photo with the detected pucks outlined above the
 //! simulator's drawing of the detected world over the field.
@@ -24,10 +24,10 @@ use image::codecs::png::PngEncoder;
 use image::{Rgb, RgbImage};
 use pucks::ColourMatch;
 use serde::Serialize;
-use sim::arena::ArenaSpec;
-use sim::field_source::FieldSource;
+use sim::fields::source::FieldSource;
+use sim::math::vec2::Vec2;
+use sim::scenario::arena::ArenaSpec;
 use sim::scenario::{Arena, Scenario};
-use sim::vec2::Vec2;
 use sim::world::World;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -152,7 +152,7 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
         .map(|[x, y]| Vec2::new(x / scale, y / scale))
         .collect();
 
-    let field = settings.field.load_for(arena)?;
+    let field = arena.load_field(&settings.field)?;
     let scenario = Scenario {
         field: settings.field.clone(),
         arena: Arena::Screen(Box::new(arena.clone())),
@@ -160,7 +160,7 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
     };
     let config = scenario.config(&field);
     let world = World::scene(&config, &[], &centres, 0);
-    let eval = sim::eval::eval(&world, &field, &config.thresholds);
+    let eval = sim::episodes::eval::eval(&world, &field, &config.thresholds);
     let layout = config.world.field_layout();
     let observation = Observation {
         photo: photo_path.display().to_string(),

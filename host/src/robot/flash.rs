@@ -56,7 +56,7 @@ impl FlashPlan {
         repo: Option<&Path>,
         cwd: &Path,
     ) -> Result<FlashPlan> {
-        let blob = sim::policy_file::read(policy)?;
+        let blob = sim::control::policy_file::read(policy)?;
         if let Some(h) = hasher {
             if h != blob.hasher() {
                 bail!(

@@ -9,7 +9,7 @@ use crate::learn::QTable;
 use anyhow::{bail, Context, Result};
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use shared::PolicyBlob;
-use sim::sensor_setup::SelectedSensors;
+use sim::scenario::sensor_setup::SelectedSensors;
 use std::fmt;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -153,7 +153,7 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     let learn = &config.learn;
     let (table, speeds) = if bytes.starts_with(&PolicyBlob::MAGIC) {
-        let blob = sim::policy_file::decode(path, &bytes)?;
+        let blob = sim::control::policy_file::decode(path, &bytes)?;
         let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
         (q, Some(blob.actions().angular_speeds().to_vec()))
     } else {

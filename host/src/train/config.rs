@@ -7,11 +7,12 @@ use crate::learn::{LearnConfig, StateHasherName};
 use crate::sensor_choice::SensorChoice;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
-use sim::reward::Reward;
+use sim::episodes::reward::Reward;
 use sim::scenario::orbital_innies;
 use sim::{
-    BroadPhase, ControllerChoice, FieldSource, ObstacleTargets, PreparedScenario, Scenario,
-    SuccessSignal,
+    config::disc_sensors::ObstacleTargets, config::BroadPhase, config::SuccessSignal,
+    fields::source::FieldSource, scenario::ControllerChoice, scenario::PreparedScenario,
+    scenario::Scenario,
 };
 use std::path::{Path, PathBuf};
 
@@ -44,7 +45,7 @@ pub struct TrainConfig {
     pub pucks: Option<usize>,
     /// Real-world noise (domain randomisation), in multiples of the
     /// default: the robots' motion and the robot senses' readings
-    /// ([`sim::Scenario::noise`]); 0 for none.
+    /// ([`sim::scenario::Scenario::noise`]); 0 for none.
     pub noise: f64,
     /// Steps to run.
     pub steps: u64,
@@ -465,7 +466,7 @@ mod tests {
     fn names_derive_from_field_and_hasher_and_are_checked() {
         let mut c = TrainConfig::default();
         assert_eq!(c.name(), "annulus-original");
-        c.field = FieldSource::Letter(sim::Letter::T);
+        c.field = FieldSource::Letter(sim::fields::letters::Letter::T);
         assert_eq!(c.name(), "letter-T-original");
         c.output.name = Some("../escape".into());
         assert!(c

@@ -16,8 +16,8 @@
 use super::config::TrainConfig;
 use anyhow::{Context, Result};
 use shared::{ActionId, PolicyTable, State};
-use sim::controllers::{OrbitalConfig, OrbitalConstruction};
-use sim::{Controller, Perception, SimRng};
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::{control::Controller, control::Perception, math::rng::SimRng};
 
 /// Mixed into the run's seed for the distillation world.
 pub const DISTIL_STREAM: u64 = 0xD157_11ED_0000_0001;

@@ -20,8 +20,11 @@ use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::{EpisodeConfig, PhysicsConfig, SuccessSignal, Thresholds, WorldConfig};
-use sim::field::FieldSampling;
-use sim::{Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, Totals};
+use sim::fields::FieldSampling;
+use sim::{
+    config::disc_sensors::DiscSensorConfig, config::BroadPhase, fields::source::FieldSource,
+    math::rng::SimRng, physics::body::Body, physics::body::Robot, simulation::Totals,
+};
 
 /// A training state in format 1's layout.
 #[derive(Serialize, Deserialize)]

@@ -19,15 +19,16 @@ use crate::learn::{LearnConfig, QLearner};
 use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
-use sim::actuation::ActuationNoise;
+use sim::config::actuation::ActuationNoise;
 use sim::config::{
     EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig,
 };
-use sim::field::{FieldFrame, FieldSampling};
+use sim::fields::{FieldFrame, FieldSampling};
 use sim::scenario::{THESIS_PUCKS, THESIS_ROBOTS};
 use sim::{
-    Body, BroadPhase, DiscSensorConfig, FieldSource, Robot, SimRng, SimulationState, Totals, World,
-    WorldState,
+    config::disc_sensors::DiscSensorConfig, config::BroadPhase, fields::source::FieldSource,
+    math::rng::SimRng, physics::body::Body, physics::body::Robot, simulation::SimulationState,
+    simulation::Totals, world::World, world::WorldState,
 };
 
 /// A training state in format 2's layout.

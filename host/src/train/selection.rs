@@ -16,9 +16,12 @@
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use shared::{PolicyBlob, PolicyTable, StateHasher};
-use sim::controllers::GreedyPolicy;
-use sim::sensor_setup::SensorSetup;
-use sim::{PreparedScenario, ScalarField, Simulation, SimulationState};
+use sim::control::greedy::GreedyPolicy;
+use sim::scenario::sensor_setup::SensorSetup;
+use sim::{
+    fields::ScalarField, scenario::PreparedScenario, simulation::Simulation,
+    simulation::SimulationState,
+};
 use std::sync::Arc;
 
 /// Mixed into the run's seed for the evaluation world.

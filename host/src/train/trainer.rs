@@ -10,7 +10,8 @@ use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
 use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
 use sim::{
-    EpisodeEnd, ScalarField, SelectedSensors, SensorModel, Simulation, SimulationState, Totals,
+    episodes::EpisodeEnd, fields::ScalarField, scenario::sensor_setup::SelectedSensors,
+    sensors::SensorModel, simulation::Simulation, simulation::SimulationState, simulation::Totals,
 };
 use std::sync::Arc;
 

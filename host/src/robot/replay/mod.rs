@@ -80,7 +80,7 @@ pub fn replay_files(
     visits: Option<&Path>,
     odometry: OdometrySettings,
 ) -> Result<ReplayReport> {
-    let blob = sim::policy_file::read(policy)?;
+    let blob = sim::control::policy_file::read(policy)?;
     let training = match visits {
         Some(path) => {
             let v = TrainingVisits::read(path)?;

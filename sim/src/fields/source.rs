@@ -1,0 +1,248 @@
+//! Where a field comes from: the annulus, a generated letter, one of the
+//! thesis' own letter images (built in from `experiments/fields/`), or an
+//! image file (one cell per pixel, the mean of R, G and B over 255).
+
+use crate::fields::letters::Letter;
+use crate::fields::ScalarField;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+
+/// Where a field comes from, by name: `annulus`, `letter:T`, or an image
+/// file's path.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum FieldSource {
+    /// The 64 x 64 annulus (`annulus`).
+    Annulus,
+    /// A generated letter (`letter:T`).
+    Letter(Letter),
+    /// The thesis' own image of a letter (`thesis:T`; T, L, V, X and Z, no
+    /// I), built into the binary (`experiments/fields/README.md`: source and
+    /// licence).
+    Thesis(Letter),
+    /// A PNG or JPEG image (any other argument: its path).
+    Image(PathBuf),
+}
+
+/// A field that cannot be loaded, naming the input and the reason.
+#[derive(Debug)]
+pub enum FieldError {
+    /// `letter:` followed by something other than T, I, L, V, X or Z.
+    UnknownLetter(String),
+    /// The image file cannot be read or decoded.
+    Image {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: image::ImageError,
+    },
+    /// The image decodes to no pixels.
+    EmptyImage(PathBuf),
+    /// `thesis:` followed by a letter the thesis has no image of.
+    NoThesisImage(String),
+}
+
+impl fmt::Display for FieldError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FieldError::UnknownLetter(l) => {
+                write!(
+                    f,
+                    "unknown letter {l:?} in the field name: expected one of {}",
+                    Letter::NAMES
+                )
+            }
+            FieldError::Image { path, reason } => {
+                write!(f, "cannot load field image {}: {reason}", path.display())
+            }
+            FieldError::EmptyImage(path) => {
+                write!(f, "field image {} has no pixels", path.display())
+            }
+            FieldError::NoThesisImage(l) => {
+                write!(
+                    f,
+                    "the thesis has no letter image {l:?}: expected one of {}",
+                    THESIS_LETTERS.join(", ")
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for FieldError {}
+
+impl FromStr for FieldSource {
+    type Err = FieldError;
+
+    /// `annulus`, `letter:X`, `thesis:X`, or a path.
+    fn from_str(s: &str) -> Result<FieldSource, FieldError> {
+        if s == "annulus" {
+            Ok(FieldSource::Annulus)
+        } else if let Some(letter) = s.strip_prefix("letter:") {
+            letter
+                .parse()
+                .map(FieldSource::Letter)
+                .map_err(|_| FieldError::UnknownLetter(letter.to_string()))
+        } else if let Some(letter) = s.strip_prefix("thesis:") {
+            match letter.parse::<Letter>() {
+                Ok(l) if thesis_image(l).is_some() => Ok(FieldSource::Thesis(l)),
+                _ => Err(FieldError::NoThesisImage(letter.to_string())),
+            }
+        } else {
+            Ok(FieldSource::Image(PathBuf::from(s)))
+        }
+    }
+}
+
+impl TryFrom<String> for FieldSource {
+    type Error = FieldError;
+    fn try_from(s: String) -> Result<FieldSource, FieldError> {
+        s.parse()
+    }
+}
+
+impl From<FieldSource> for String {
+    fn from(f: FieldSource) -> String {
+        f.to_string()
+    }
+}
+
+impl fmt::Display for FieldSource {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            FieldSource::Annulus => f.write_str("annulus"),
+            FieldSource::Letter(l) => write!(f, "letter:{l}"),
+            FieldSource::Thesis(l) => write!(f, "thesis:{l}"),
+            FieldSource::Image(p) => write!(f, "{}", p.display()),
+        }
+    }
+}
+
+impl FieldSource {
+    /// Builds or loads the field.
+    pub fn load(&self) -> Result<ScalarField, FieldError> {
+        match self {
+            FieldSource::Annulus => Ok(ScalarField::annulus()),
+            FieldSource::Letter(l) => Ok(l.field()),
+            FieldSource::Thesis(l) => {
+                let bytes =
+                    thesis_image(*l).ok_or_else(|| FieldError::NoThesisImage(l.to_string()))?;
+                let name = PathBuf::from(self.to_string());
+                let err = |reason| FieldError::Image {
+                    path: name.clone(),
+                    reason,
+                };
+                field_of(image::load_from_memory(bytes).map_err(err)?, &name)
+            }
+            FieldSource::Image(path) => load_image(path),
+        }
+    }
+
+    /// Whether the target shape has a hole in the middle that innies keep
+    /// free (only the annulus: the thesis removes innies for letters).
+    pub(crate) fn has_cavity(&self) -> bool {
+        matches!(self, FieldSource::Annulus)
+    }
+}
+
+/// The letters the thesis has images of.
+const THESIS_LETTERS: [&str; 5] = ["T", "L", "V", "X", "Z"];
+
+/// The PNG of the thesis' image of `letter`, if it has one.
+fn thesis_image(letter: Letter) -> Option<&'static [u8]> {
+    Some(match letter {
+        Letter::T => include_bytes!("../../../experiments/fields/T.png"),
+        Letter::L => include_bytes!("../../../experiments/fields/L.png"),
+        Letter::V => include_bytes!("../../../experiments/fields/V.png"),
+        Letter::X => include_bytes!("../../../experiments/fields/X.png"),
+        Letter::Z => include_bytes!("../../../experiments/fields/Z.png"),
+        Letter::I => return None,
+    })
+}
+
+/// An image file's field.
+fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
+    let err = |reason| FieldError::Image {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let img = image::ImageReader::open(path)
+        .map_err(|e| err(image::ImageError::IoError(e)))?
+        .with_guessed_format()
+        .map_err(|e| err(image::ImageError::IoError(e)))?
+        .decode()
+        .map_err(err)?;
+    field_of(img, path)
+}
+
+/// An image's field: mean of R, G, B over 255, one cell per pixel.
+fn field_of(img: image::DynamicImage, path: &Path) -> Result<ScalarField, FieldError> {
+    let img = img.to_rgb8();
+    let values = img
+        .pixels()
+        .map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / (3.0 * 255.0))
+        .collect();
+    ScalarField::new(img.width() as usize, img.height() as usize, values)
+        .ok_or_else(|| FieldError::EmptyImage(path.to_path_buf()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sources_parse_and_errors_name_the_input() {
+        assert_eq!(
+            "annulus".parse::<FieldSource>().unwrap(),
+            FieldSource::Annulus
+        );
+        assert_eq!(
+            "letter:T".parse::<FieldSource>().unwrap(),
+            FieldSource::Letter(Letter::T)
+        );
+        let e = "letter:Q".parse::<FieldSource>().unwrap_err().to_string();
+        assert!(e.contains("\"Q\""), "{e}");
+        assert_eq!(
+            "thesis:X".parse::<FieldSource>().unwrap(),
+            FieldSource::Thesis(Letter::X)
+        );
+        let e = "thesis:I".parse::<FieldSource>().unwrap_err().to_string();
+        assert!(e.contains("\"I\"") && e.contains("T, L, V, X, Z"), "{e}");
+        let missing = FieldSource::Image(PathBuf::from("/no/such/field.png"));
+        let e = missing.load().unwrap_err().to_string();
+        assert!(e.contains("/no/such/field.png"), "{e}");
+    }
+
+    #[test]
+    fn the_thesis_images_are_built_in_and_read_like_their_files() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../experiments/fields");
+        for l in THESIS_LETTERS {
+            let built_in = format!("thesis:{l}")
+                .parse::<FieldSource>()
+                .unwrap()
+                .load()
+                .unwrap();
+            let file = FieldSource::Image(dir.join(format!("{l}.png")))
+                .load()
+                .unwrap();
+            assert_eq!((built_in.width(), built_in.height()), (600, 600));
+            assert!(built_in == file, "{l}");
+        }
+    }
+
+    #[test]
+    fn images_read_as_mean_rgb() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("f.png");
+        let mut img = image::RgbImage::new(2, 1);
+        img.put_pixel(0, 0, image::Rgb([255, 255, 255]));
+        img.put_pixel(1, 0, image::Rgb([255, 0, 0]));
+        img.save(&path).unwrap();
+        let f = FieldSource::Image(path).load().unwrap();
+        assert_eq!((f.width(), f.height()), (2, 1));
+        assert_eq!(f.cell(0, 0), 1.0);
+        assert!((f.cell(1, 0) - 1.0 / 3.0).abs() < 1e-6);
+    }
+}

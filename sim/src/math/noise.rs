@@ -1,0 +1,102 @@
+//! Random draws for the noise models, as pure functions of where they are
+//! used: a draw is a function of the world's seed, what it is for, and the
+//! episode, step and robot it belongs to. No generator state is carried,
+//! so a resumed run draws exactly what an uninterrupted one would, and
+//! turning one model's noise on does not change another's draws.
+//!
+//! Normal draws are the sum of 12 uniforms less 6 (mean 0, variance 1,
+//! bounded by +-6), plain arithmetic that rounds the same on every machine.
+
+use crate::math::rng::SimRng;
+use rand::{RngExt, SeedableRng};
+
+/// What a draw is for: each use has its own stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u64)]
+pub enum Purpose {
+    /// A robot's wheel speed factor and turning bias, per episode.
+    RobotMotion = 1,
+    /// A period's length and whether it is dropped, per step and robot.
+    Period = 2,
+    /// The screen's brightness over its regions, per episode.
+    Brightness = 3,
+    /// The discharge times' jitter, per step and robot.
+    Discharge = 4,
+    /// The camera's frame: drops, missed and spurious blocks, jitter.
+    Camera = 5,
+}
+
+/// SplitMix64's finaliser: a well-mixed 64-bit function of its input.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A generator for one use at one place: `seed` (the world's), `purpose`,
+/// and the two coordinates of the place (episode or step, robot).
+pub fn stream(seed: u64, purpose: Purpose, a: u64, b: u64) -> SimRng {
+    SimRng::seed_from_u64(mix(mix(mix(seed ^ purpose as u64) ^ a) ^ b))
+}
+
+/// A standard normal draw (Irwin-Hall: 12 uniforms less 6).
+pub fn normal(rng: &mut SimRng) -> f64 {
+    (0..12).map(|_| rng.random::<f64>()).sum::<f64>() - 6.0
+}
+
+/// A uniform draw in `[-half, half]`.
+pub(crate) fn symmetric(rng: &mut SimRng, half: f64) -> f64 {
+    (rng.random::<f64>() * 2.0 - 1.0) * half
+}
+
+/// Whether an event of probability `p` happens.
+pub(crate) fn chance(rng: &mut SimRng, p: f64) -> bool {
+    p > 0.0 && rng.random::<f64>() < p
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_same_place_draws_the_same_and_other_places_draw_otherwise() {
+        let draw = |seed, purpose, a, b| normal(&mut stream(seed, purpose, a, b));
+        assert_eq!(
+            draw(1, Purpose::Period, 5, 2),
+            draw(1, Purpose::Period, 5, 2)
+        );
+        let here = draw(1, Purpose::Period, 5, 2);
+        for other in [
+            draw(2, Purpose::Period, 5, 2),
+            draw(1, Purpose::Camera, 5, 2),
+            draw(1, Purpose::Period, 6, 2),
+            draw(1, Purpose::Period, 5, 3),
+        ] {
+            assert_ne!(here, other);
+        }
+    }
+
+    #[test]
+    fn normal_draws_have_mean_0_and_variance_1_and_chances_their_rate() {
+        let mut rng = stream(7, Purpose::Discharge, 0, 0);
+        let n = 200_000;
+        let xs: Vec<f64> = (0..n).map(|_| normal(&mut rng)).collect();
+        let mean = xs.iter().sum::<f64>() / n as f64;
+        let var = xs.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n as f64;
+        assert!(
+            mean.abs() < 0.01 && (var - 1.0).abs() < 0.02,
+            "mean {mean}, variance {var}"
+        );
+        assert!(xs.iter().all(|x| x.abs() <= 6.0));
+        let hits = (0..n).filter(|_| chance(&mut rng, 0.1)).count() as f64 / n as f64;
+        assert!((hits - 0.1).abs() < 0.005, "{hits}");
+        assert!(!chance(&mut rng, 0.0));
+        let u: Vec<f64> = (0..1000).map(|_| symmetric(&mut rng, 0.5)).collect();
+        assert!(
+            u.iter().all(|x| x.abs() <= 0.5)
+                && u.iter().any(|x| *x < -0.4)
+                && u.iter().any(|x| *x > 0.4)
+        );
+    }
+}

@@ -1,0 +1,335 @@
+//! Physical arenas: a screen lying flat with the field shown on it, where
+//! the field image lies on the screen, and what drives on it.
+//!
+//! The one definition of the geometry that the simulator, the field export
+//! and the display page share. Units: the simulator's unit is a tenth of the
+//! robot's radius (so every constant of the reference model keeps its
+//! meaning relative to the robot), `unit_mm = robot_radius_mm / 10`
+//! millimetres on the floor; the arena is the screen's visible area, walls
+//! at its edges (the bezel).
+//!
+//! Placing a field image on the screen ([`FieldFit`]): `contain` keeps the
+//! image's aspect ratio, as large as fits and centred, the rest of the
+//! screen black (field 0); `stretch` fills the screen. The annulus is a
+//! generated field and is generated for the screen's shape instead
+//! ([`ArenaSpec::annulus_cells`]: circular contours, 0 in the screen's
+//! corners), filling it.
+//!
+//! The screen shows the image scaled smoothly (bilinear), so the robots
+//! read the field with [`FieldSampling::Bilinear`] ([`ArenaSpec::field_layout`]);
+//! panel pixel `(i, j)` shows the field at its centre
+//! ([`ArenaSpec::panel_pixel_centre`]). Light: the display's light is
+//! `pixel ^ display_gamma`; the pixel a field value is shown with is
+//! pre-compensated so that the light is `v ^ LIGHT_GAMMA`, the curve the
+//! robots' calibration assumes ([`crate::scenario::panel`], `docs/display.md`).
+
+use crate::config::validate::{check, positive, ConfigError};
+use crate::config::SimConfig;
+use crate::fields::source::{FieldError, FieldSource};
+use crate::fields::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
+use crate::math::vec2::Vec2;
+use serde::{Deserialize, Serialize};
+
+/// How a field image lies on the screen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FieldFit {
+    /// Aspect ratio kept, as large as fits, centred; the rest black.
+    #[default]
+    Contain,
+    /// Stretched over the whole screen.
+    Stretch,
+}
+
+/// A screen arena and the bodies on it. Every field is optional in a file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ArenaSpec {
+    /// Name, for messages and provenance.
+    pub name: String,
+    /// Visible screen width and height, mm.
+    pub screen_mm: [f64; 2],
+    /// Panel resolution, width and height, pixels.
+    pub screen_px: [u32; 2],
+    /// How a field image lies on the screen.
+    pub fit: FieldFit,
+    /// The display's gamma: its light is `pixel ^ display_gamma` of full
+    /// white (for measuring it, the display page shows grey patches).
+    pub display_gamma: f64,
+    /// Robot radius, mm: the Zumo in its skirt.
+    pub robot_radius_mm: f64,
+    /// Puck radius, mm.
+    pub puck_radius_mm: f64,
+    /// A puck's mass over a robot's.
+    pub puck_mass_ratio: f64,
+    /// Robots on the screen.
+    pub robots: usize,
+    /// Pucks on the screen.
+    pub pucks: usize,
+    /// Robots' forward speed, units (tenths of their radius) per step.
+    pub forward_speed: f64,
+    /// Steps an episode may last without forming the shape (a lab trial's
+    /// length: one step is one 20 ms control period).
+    pub stuck_limit: u64,
+}
+
+impl Default for ArenaSpec {
+    /// [`ArenaSpec::tv75`].
+    fn default() -> ArenaSpec {
+        ArenaSpec::tv75()
+    }
+}
+
+impl ArenaSpec {
+    /// The built-in arenas' names, as messages list them.
+    pub const NAMES: &'static str = "tv75";
+
+    /// The thesis' hardware (section 1.4): a 75" LG TV (75UK6190PUB) lying
+    /// flat, 1,650 x 928 mm visible, 3840 x 2160 pixels; a Zumo 32U4
+    /// (98 x 86 mm) in a round skirt of 65 mm radius, the least that
+    /// encloses it; 5 robots and 12 pucks as large and heavy as a robot (as
+    /// in the thesis, radius and mass equal); the thesis' forward speed of
+    /// 2 units (0.2 radii) per step; trials of 15,000 steps (5 minutes);
+    /// images kept in their aspect; display gamma 2.2 (a TV's nominal). The
+    /// counts, sizes and trial length are ours, from a sweep with the disc
+    /// sensors (`docs/robot-sensors.md`, which gives the density beside the
+    /// thesis').
+    pub fn tv75() -> ArenaSpec {
+        ArenaSpec {
+            name: "tv75".into(),
+            screen_mm: [1650.0, 928.0],
+            screen_px: [3840, 2160],
+            fit: FieldFit::Contain,
+            display_gamma: 2.2,
+            robot_radius_mm: 65.0,
+            puck_radius_mm: 65.0,
+            puck_mass_ratio: 1.0,
+            robots: 5,
+            pucks: 12,
+            forward_speed: 2.0,
+            stuck_limit: 15_000,
+        }
+    }
+
+    /// A built-in arena by name, or `None`.
+    pub fn by_name(name: &str) -> Option<ArenaSpec> {
+        (name == "tv75").then(ArenaSpec::tv75)
+    }
+
+    /// Millimetres per simulator unit: a tenth of the robot's radius.
+    pub fn unit_mm(&self) -> f64 {
+        self.robot_radius_mm / ROBOT_RADIUS_UNITS
+    }
+
+    /// The screen's width and height in units.
+    pub fn size(&self) -> Vec2 {
+        Vec2::new(self.screen_mm[0], self.screen_mm[1]) * (1.0 / self.unit_mm())
+    }
+
+    /// Checks every setting; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        positive("arena.screen_mm[0]", self.screen_mm[0])?;
+        positive("arena.screen_mm[1]", self.screen_mm[1])?;
+        for (i, px) in self.screen_px.iter().enumerate() {
+            check(
+                &format!("arena.screen_px[{i}]"),
+                f64::from(*px),
+                (1..=16384).contains(px),
+                "must be 1 to 16384",
+            )?;
+        }
+        positive("arena.display_gamma", self.display_gamma)?;
+        positive("arena.robot_radius_mm", self.robot_radius_mm)?;
+        positive("arena.puck_radius_mm", self.puck_radius_mm)?;
+        positive("arena.puck_mass_ratio", self.puck_mass_ratio)?;
+        check(
+            "arena.robots",
+            self.robots as f64,
+            self.robots > 0,
+            "at least one robot is needed",
+        )?;
+        check(
+            "arena.forward_speed",
+            self.forward_speed,
+            self.forward_speed >= 0.0,
+            "must not be negative",
+        )?;
+        check(
+            "arena.stuck_limit",
+            self.stuck_limit as f64,
+            self.stuck_limit > 0,
+            "must be positive",
+        )
+    }
+
+    /// Cells of the annulus generated for this screen: 64 across, as many
+    /// down as keep the cells square.
+    pub(crate) fn annulus_cells(&self) -> (usize, usize) {
+        let rows = (ANNULUS_COLUMNS as f64 * self.screen_mm[1] / self.screen_mm[0])
+            .round()
+            .max(1.0) as usize;
+        (ANNULUS_COLUMNS, rows)
+    }
+
+    /// Where a field image of `cells` (width, height) lies on the screen,
+    /// in units from the screen's top-left corner.
+    pub fn field_frame(&self, cells: (usize, usize)) -> FieldFrame {
+        let size = self.size();
+        match self.fit {
+            FieldFit::Stretch => FieldFrame::whole(size.x, size.y),
+            FieldFit::Contain => {
+                let scale = (size.x / cells.0 as f64).min(size.y / cells.1 as f64);
+                let (width, height) = (cells.0 as f64 * scale, cells.1 as f64 * scale);
+                FieldFrame {
+                    x: (size.x - width) / 2.0,
+                    y: (size.y - height) / 2.0,
+                    width,
+                    height,
+                }
+            }
+        }
+    }
+
+    /// Where `field` lies on this screen and how the robots read it: its
+    /// [`ArenaSpec::field_frame`], bilinear (as the screen scales it).
+    pub fn field_layout(&self, field: &ScalarField) -> FieldLayout {
+        FieldLayout {
+            frame: self.field_frame((field.width(), field.height())),
+            sampling: FieldSampling::Bilinear,
+        }
+    }
+
+    /// The position of panel pixel (`i`, `j`)'s centre, in units from the
+    /// screen's top-left corner (column `i` from the left, row `j` from the
+    /// top): the panel's pixels tile the visible area.
+    pub(crate) fn panel_pixel_centre(&self, i: u32, j: u32) -> Vec2 {
+        let size = self.size();
+        Vec2::new(
+            (f64::from(i) + 0.5) * size.x / f64::from(self.screen_px[0]),
+            (f64::from(j) + 0.5) * size.y / f64::from(self.screen_px[1]),
+        )
+    }
+
+    /// Builds or loads `source`'s field for this screen: the annulus
+    /// generated for the screen's shape, any other field as
+    /// [`FieldSource::load`].
+    pub fn load_field(&self, source: &FieldSource) -> Result<ScalarField, FieldError> {
+        match source {
+            FieldSource::Annulus => {
+                let (width, height) = self.annulus_cells();
+                Ok(ScalarField::annulus_of(width, height))
+            }
+            _ => source.load(),
+        }
+    }
+
+    /// Sets the arena, the bodies, the field's placement of `field` and the
+    /// trial length in `config` (counts as given here; the caller may
+    /// change them after).
+    pub fn apply(&self, config: &mut SimConfig, field: &ScalarField) {
+        config.episode.stuck_limit = self.stuck_limit;
+        let world = &mut config.world;
+        let size = self.size();
+        let unit = self.unit_mm();
+        world.arena_width = size.x;
+        world.arena_height = size.y;
+        world.unit_mm = unit;
+        world.robot_radius = ROBOT_RADIUS_UNITS;
+        world.puck_radius = self.puck_radius_mm / unit;
+        world.puck_mass = Some(
+            self.puck_mass_ratio * crate::physics::body::Body::MASS_PER_RADIUS * ROBOT_RADIUS_UNITS,
+        );
+        world.robots = self.robots;
+        world.pucks = self.pucks;
+        world.forward_speed = self.forward_speed;
+        let layout = self.field_layout(field);
+        world.field_frame = Some(layout.frame);
+        world.field_sampling = layout.sampling;
+    }
+}
+
+/// A robot's radius in units, in every arena.
+pub(crate) const ROBOT_RADIUS_UNITS: f64 = 10.0;
+
+/// Columns of a generated annulus (the reference model's 64).
+const ANNULUS_COLUMNS: usize = 64;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_tv_is_about_25_by_14_robot_radii_and_its_annulus_has_square_cells() {
+        let tv = ArenaSpec::tv75();
+        let size = tv.size();
+        assert!(
+            (size.x / 10.0 - 25.4).abs() < 0.05 && (size.y / 10.0 - 14.3).abs() < 0.05,
+            "{size:?}"
+        );
+        assert_eq!(tv.annulus_cells(), (64, 36));
+        assert_eq!(tv.unit_mm(), 6.5);
+        assert!(tv.validate().is_ok());
+    }
+
+    #[test]
+    fn a_square_image_is_centred_at_full_height_or_stretched() {
+        let tv = ArenaSpec::tv75();
+        let size = tv.size();
+        let f = tv.field_frame((600, 600));
+        assert!((f.height - size.y).abs() < 1e-9 && (f.width - size.y).abs() < 1e-9);
+        assert!((f.x - (size.x - size.y) / 2.0).abs() < 1e-9 && f.y == 0.0);
+        let stretched = ArenaSpec {
+            fit: FieldFit::Stretch,
+            ..tv
+        };
+        assert_eq!(
+            stretched.field_frame((600, 600)),
+            FieldFrame::whole(size.x, size.y)
+        );
+    }
+
+    #[test]
+    fn panel_pixels_tile_the_screen_centre_to_centre() {
+        let tv = ArenaSpec::tv75();
+        let size = tv.size();
+        let pixel = size.x / 3840.0;
+        let first = tv.panel_pixel_centre(0, 0);
+        assert!(
+            (first.x - pixel / 2.0).abs() < 1e-12
+                && (first.y - size.y / 2160.0 / 2.0).abs() < 1e-12
+        );
+        let last = tv.panel_pixel_centre(3839, 2159);
+        assert!(
+            (size.x - last.x - pixel / 2.0).abs() < 1e-9
+                && (size.y - last.y - size.y / 4320.0).abs() < 1e-9
+        );
+    }
+
+    #[test]
+    fn applying_an_arena_sets_a_valid_world_read_bilinear() {
+        let tv = ArenaSpec::tv75();
+        let mut config = crate::config::SimConfig::default();
+        tv.apply(&mut config, &ScalarField::annulus_of(64, 36));
+        assert_eq!((config.world.robots, config.world.pucks), (5, 12));
+        assert_eq!(config.world.field_sampling, FieldSampling::Bilinear);
+        assert_eq!(
+            (config.world.puck_radius, config.world.puck_mass),
+            (10.0, Some(100.0))
+        );
+        assert_eq!(config.episode.stuck_limit, 15_000);
+        assert_eq!(config.validate(), Ok(()));
+        let bad = ArenaSpec {
+            robot_radius_mm: -1.0,
+            ..ArenaSpec::tv75()
+        };
+        assert_eq!(
+            config.world.field_layout(),
+            tv.field_layout(&ScalarField::annulus_of(64, 36))
+        );
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("arena.robot_radius_mm"));
+    }
+}

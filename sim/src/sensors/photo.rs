@@ -1,0 +1,410 @@
+//! The robot's three field sensors as the simulator models them:
+//! photo-transistors under the front of the robot, read by RC discharge
+//! timing exactly as the firmware reads them.
+//!
+//! Chain, per sensor (`docs/robot-sensors.md` gives the physics and how to
+//! measure the parameters):
+//! 1. the field value `v` the screen shows at the sensor's point (as the
+//!    arena reads its field: the nearest cell in the thesis' arena,
+//!    bilinear on a screen);
+//! 2. the screen's light there, `L(v) = v^gamma` of full white (the light
+//!    curve, [`shared::calibration::LIGHT_GAMMA`]);
+//! 3. the discharge time: a photo-transistor's current is proportional to
+//!    the light on it and the capacitor discharges at that current, so the
+//!    time is inversely proportional to the light plus a dark current:
+//!    `1/t = 1/t_dark + L(v) (1/t_bright - 1/t_dark)`, which is `t_bright`
+//!    at `v = 1` and `t_dark` at `v = 0` (brighter is faster);
+//! 4. whole Timer3 ticks, `floor((t + latency) / 4 us)`, capped at the
+//!    2000 us timeout: the firmware polls the pins against the free-running
+//!    timer and keeps the elapsed whole ticks; `latency` is its mean delay
+//!    between a pin going low and the timer read that sees it, net of the
+//!    time between the pins becoming inputs and the start read;
+//! 5. the firmware's own calibration arithmetic ([`shared::FieldScales`])
+//!    with the calibration the robot's procedure stores (its readings on
+//!    the display's full-white and full-black screens, `docs/firmware.md`):
+//!    each sensor's ticks at field 1.0 (bright) and 0.0 (dark).
+//!
+//! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
+//! identical inputs identically.
+
+use crate::config::validate::{check, ConfigError};
+use crate::fields::{FieldLayout, ScalarField};
+use crate::math::rng::SimRng;
+use crate::math::rounding;
+use crate::math::vec2::Vec2;
+use crate::sensors::robot_noise::RobotNoise;
+use serde::{Deserialize, Serialize};
+use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
+use shared::{FieldCalibration, FieldScales, FieldValue, SensorRange};
+
+/// A point on the robot, millimetres from its centre.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MountPoint {
+    /// Ahead of the centre (negative: behind), mm.
+    pub forward_mm: f64,
+    /// To the right of the centre (negative: left), mm.
+    pub right_mm: f64,
+}
+
+/// How one photo-transistor's discharge time depends on the light on it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhotoResponse {
+    /// Discharge time over field value 1.0 (full projector brightness), us.
+    pub bright_us: f64,
+    /// Discharge time over field value 0.0 (projector black: ambient light
+    /// and dark current only), us.
+    pub dark_us: f64,
+}
+
+impl PhotoResponse {
+    /// The discharge time in microseconds over a field value `v` in [0, 1]
+    /// with projector gamma `gamma`.
+    pub fn discharge_us(&self, v: f64, gamma: f64) -> f64 {
+        self.discharge_of_light_us(v.clamp(0.0, 1.0).powf(gamma))
+    }
+
+    /// The discharge time under `light`, relative to full white's.
+    pub(crate) fn discharge_of_light_us(&self, light: f64) -> f64 {
+        let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
+        1.0 / (slow + light.max(0.0) * (fast - slow))
+    }
+}
+
+/// The conditions of one reading with the sensor noise on: the screen's
+/// brightness gains of the episode and the generator of the jitter.
+pub(crate) struct PhotoNoise<'a> {
+    /// The noise's settings.
+    pub noise: &'a RobotNoise,
+    /// The brightness gains ([`RobotNoise::brightness_grid`]).
+    pub grid: &'a [f64],
+    /// The arena's size, over which the gains lie.
+    pub arena: Vec2,
+    /// The generator of this reading's jitter.
+    pub rng: &'a mut SimRng,
+}
+
+/// Geometry and response of the three field sensors (left, mid, right).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PhotoSensorConfig {
+    /// Where the left, mid and right sensors (DN1, DN3, DN5) sit.
+    pub mounts: [MountPoint; 3],
+    /// Each sensor's response.
+    pub response: [PhotoResponse; 3],
+    /// Projector gamma: light = value^gamma of full brightness.
+    pub gamma: f64,
+    /// The firmware's mean timing latency, us (see the module docs).
+    pub poll_latency_us: f64,
+    /// Ideal sensors, for ablations: the calibrated value is the field
+    /// value shown at the point, exactly (no RC timing, no calibration).
+    pub ideal: bool,
+}
+
+impl Default for PhotoSensorConfig {
+    /// Photo-transistors on the skirt's edge (65 mm from the centre), wired
+    /// to the front array's DN1, DN3 and DN5 pins: left and right 45
+    /// degrees off the heading, mid straight ahead (chosen by the
+    /// ablation and sweep in `docs/robot-sensors.md`: the front array's own
+    /// spacing, 37.5 mm to each side, reads too little of the gradient);
+    /// estimates, to be measured: discharge 150 to 170 us under full
+    /// white and 1700 to 1820 us on black (the three sensors differ a
+    /// little, as real ones do); the light curve's gamma,
+    /// [`shared::calibration::LIGHT_GAMMA`]; the firmware's latency as
+    /// measured in simavr, 2.8 us (`docs/robot-sensors.md`).
+    fn default() -> PhotoSensorConfig {
+        let side = 65.0 * std::f64::consts::FRAC_1_SQRT_2;
+        let mount = |forward_mm, right_mm| MountPoint {
+            forward_mm,
+            right_mm,
+        };
+        let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
+        PhotoSensorConfig {
+            mounts: [mount(side, -side), mount(65.0, 0.0), mount(side, side)],
+            response: [
+                response(150.0, 1700.0),
+                response(160.0, 1760.0),
+                response(170.0, 1820.0),
+            ],
+            gamma: f64::from(LIGHT_GAMMA),
+            poll_latency_us: 2.8,
+            ideal: false,
+        }
+    }
+}
+
+/// `floor(us / tick)` capped at the timeout: the firmware's reading of a
+/// discharge that takes `us` microseconds.
+pub(crate) fn quantise_us(us: f64) -> u16 {
+    let ticks = rounding::floor(us / f64::from(RC_TICK_US));
+    if ticks >= f64::from(RC_TIMEOUT_TICKS) {
+        RC_TIMEOUT_TICKS
+    } else if ticks > 0.0 {
+        ticks as u16
+    } else {
+        0
+    }
+}
+
+const NAMES: [&str; 3] = ["left", "mid", "right"];
+
+impl PhotoSensorConfig {
+    /// Checks every position, time and the gamma; each sensor's bright and
+    /// dark times must differ by at least one tick, or no calibration exists.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        check(
+            "field.gamma",
+            self.gamma,
+            self.gamma > 0.0,
+            "must be positive",
+        )?;
+        let latency = self.poll_latency_us;
+        check(
+            "field.poll_latency_us",
+            latency,
+            latency >= 0.0,
+            "must not be negative",
+        )?;
+        for (i, name) in NAMES.iter().enumerate() {
+            let m = self.mounts[i];
+            check(
+                &format!("field.mounts[{i}].forward_mm ({name})"),
+                m.forward_mm,
+                true,
+                "must be a finite number",
+            )?;
+            check(
+                &format!("field.mounts[{i}].right_mm ({name})"),
+                m.right_mm,
+                true,
+                "must be a finite number",
+            )?;
+            let r = self.response[i];
+            check(
+                &format!("field.response[{i}].bright_us ({name})"),
+                r.bright_us,
+                r.bright_us > 0.0,
+                "must be positive",
+            )?;
+            check(
+                &format!("field.response[{i}].dark_us ({name})"),
+                r.dark_us,
+                quantise_us(r.dark_us + latency) > quantise_us(r.bright_us + latency),
+                "must be at least one 4 us tick longer than bright_us",
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The calibration the robot stores from the display's white (1.0) and
+    /// black (0.0) screens: per sensor, the firmware's readings of its
+    /// bright and dark times.
+    pub fn calibration(&self) -> FieldCalibration {
+        let ticks = |us: f64| quantise_us(us + self.poll_latency_us);
+        FieldCalibration {
+            ranges: self.response.map(|r| SensorRange {
+                bright: ticks(r.bright_us),
+                dark: ticks(r.dark_us),
+            }),
+        }
+    }
+}
+
+/// What the three field sensors measure in one control period.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct PhotoReading {
+    /// Discharge times, us (the pins' behaviour, before the firmware's
+    /// latency and quantisation).
+    pub discharge_us: [f64; 3],
+    /// The firmware's raw readings: whole Timer3 ticks, capped at the timeout.
+    pub ticks: [u16; 3],
+    /// The calibrated values: the firmware's arithmetic on `ticks` (or,
+    /// with ideal sensors, the field values shown).
+    pub values: [FieldValue; 3],
+}
+
+/// The three sensors of a robot, ready to read.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct PhotoSensors {
+    /// Left, mid, right points in the robot's frame (x forward, y right), units.
+    points: [Vec2; 3],
+    response: [PhotoResponse; 3],
+    gamma: f64,
+    latency_us: f64,
+    ideal: bool,
+    calibration: FieldCalibration,
+    scales: FieldScales,
+}
+
+impl PhotoSensors {
+    /// The sensors of `config` in a world of `unit_mm` millimetres per unit.
+    pub fn new(config: &PhotoSensorConfig, unit_mm: f64) -> PhotoSensors {
+        let calibration = config.calibration();
+        PhotoSensors {
+            points: config
+                .mounts
+                .map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
+            response: config.response,
+            gamma: config.gamma,
+            latency_us: config.poll_latency_us,
+            ideal: config.ideal,
+            calibration,
+            scales: calibration.scales(),
+        }
+    }
+
+    /// The calibration the robot stores (and the firmware applies).
+    pub fn calibration(&self) -> FieldCalibration {
+        self.calibration
+    }
+
+    /// Calibrated values of raw readings, with the firmware's arithmetic.
+    pub fn values(&self, ticks: &[u16; 3]) -> [FieldValue; 3] {
+        self.scales.values(ticks)
+    }
+
+    /// The sensor points in the robot's frame (x forward, y right), units.
+    pub fn points(&self) -> &[Vec2; 3] {
+        &self.points
+    }
+
+    /// The reading of a robot at `pos` facing `direction` (unit vector),
+    /// with the sensor noise if given.
+    pub fn read(
+        &self,
+        pos: Vec2,
+        direction: Vec2,
+        field: &ScalarField,
+        layout: &FieldLayout,
+        mut noise: Option<PhotoNoise<'_>>,
+    ) -> PhotoReading {
+        let mut r = PhotoReading::default();
+        let mut shown = [0.0; 3];
+        // Sensor `i` of four arrays: an index reads plainer than a zip.
+        #[allow(clippy::needless_range_loop)]
+        for i in 0..3 {
+            let point = pos + self.points[i].rotated(direction);
+            shown[i] = field.shown(point, layout);
+            r.discharge_us[i] = match noise.as_mut() {
+                None => self.response[i].discharge_us(shown[i], self.gamma),
+                Some(n) => {
+                    let light = shown[i].clamp(0.0, 1.0).powf(self.gamma)
+                        * RobotNoise::gain_at(n.grid, point, n.arena);
+                    n.noise
+                        .jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
+                }
+            };
+            r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
+        }
+        r.values = if self.ideal {
+            shown.map(|v| FieldValue::from_f32(v as f32))
+        } else {
+            self.scales.values(&r.ticks)
+        };
+        r
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fields::{FieldFrame, FieldSampling};
+
+    /// A 100 x 100 arena, nearest cell.
+    const SQUARE_100: FieldLayout = FieldLayout {
+        frame: FieldFrame::whole(100.0, 100.0),
+        sampling: FieldSampling::Nearest,
+    };
+
+    #[test]
+    fn brighter_discharges_faster_between_the_calibrated_ends() {
+        let c = PhotoSensorConfig::default();
+        let r = c.response[1];
+        assert!((r.discharge_us(1.0, c.gamma) - 160.0).abs() < 1e-9);
+        assert!((r.discharge_us(0.0, c.gamma) - 1760.0).abs() < 1e-9);
+        let mut last = f64::INFINITY;
+        for k in 0..=100 {
+            let t = r.discharge_us(f64::from(k) / 100.0, c.gamma);
+            assert!(t < last, "not faster at {k}%");
+            last = t;
+        }
+        // Inverse in the light: half the light of full brightness (above the
+        // dark current) is less than twice the bright time.
+        let half_light = 0.5f64.powf(1.0 / c.gamma);
+        assert!(r.discharge_us(half_light, c.gamma) < 2.0 * 160.0 + 1.0);
+    }
+
+    #[test]
+    fn quantisation_floors_to_ticks_and_caps_at_the_timeout() {
+        assert_eq!(quantise_us(0.0), 0);
+        assert_eq!(quantise_us(3.99), 0);
+        assert_eq!(quantise_us(4.0), 1);
+        assert_eq!(quantise_us(1759.9), 439);
+        assert_eq!(quantise_us(1999.0), 499);
+        assert_eq!(quantise_us(2000.0), RC_TIMEOUT_TICKS);
+        assert_eq!(quantise_us(1e9), RC_TIMEOUT_TICKS);
+        assert_eq!(quantise_us(-5.0), 0);
+    }
+
+    #[test]
+    fn full_and_no_light_read_one_and_zero_through_the_calibration() {
+        let config = PhotoSensorConfig::default();
+        let cal = config.calibration();
+        // (150 + 2.8) / 4 and (1700 + 2.8) / 4, floored.
+        assert_eq!(
+            cal.ranges[0],
+            SensorRange {
+                bright: 38,
+                dark: 425
+            }
+        );
+        let sensors = PhotoSensors::new(&config, 5.0);
+        let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
+        let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
+        // One cell over the whole arena: every point inside reads it.
+        let at = Vec2::new(20.0, 20.0);
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &bright, &SQUARE_100, None);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ONE; 3]);
+        assert_eq!(r.ticks, cal.ranges.map(|c| c.bright));
+        let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100, None);
+        assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
+        assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
+    }
+
+    #[test]
+    fn sensors_sit_where_configured_and_turn_with_the_robot() {
+        // A field bright in its left column only (2 x 1 cells over 100 units).
+        let field = ScalarField::new(2, 1, vec![1.0, 0.0]).unwrap();
+        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 5.0);
+        // Facing down the screen (+y): the robot's right is -x, so its right
+        // sensor is over the bright column at x < 25 (cell 0 by rounding).
+        let r = sensors.read(
+            Vec2::new(24.0, 20.0),
+            Vec2::new(0.0, 1.0),
+            &field,
+            &SQUARE_100,
+            None,
+        );
+        let values = sensors.values(&r.ticks);
+        assert_eq!((values[0], values[2]), (FieldValue::ZERO, FieldValue::ONE));
+    }
+
+    #[test]
+    fn bad_settings_are_named() {
+        let mut c = PhotoSensorConfig::default();
+        c.response[2].dark_us = c.response[2].bright_us + 1.0;
+        let e = c.validate().unwrap_err().to_string();
+        assert!(e.contains("field.response[2].dark_us (right)"), "{e}");
+        let c = PhotoSensorConfig {
+            gamma: 0.0,
+            ..PhotoSensorConfig::default()
+        };
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("field.gamma"));
+        assert!(PhotoSensorConfig::default().validate().is_ok());
+    }
+}
