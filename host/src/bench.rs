@@ -182,7 +182,7 @@ impl CameraRange {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sim::math::vec2::Vec2;
+    use sim::base::vec2::Vec2;
 
     #[test]
     fn the_robot_benchmark_counts_the_bodies_a_camera_could_see() {

@@ -3,7 +3,6 @@
 //! for the field on their TV, and the tools around policy blobs.
 #![warn(missing_docs)]
 
-pub mod arena_choice;
 pub mod atomic;
 pub mod bench;
 pub mod display;
@@ -17,5 +16,4 @@ pub mod render;
 pub mod report;
 pub mod robot;
 pub mod run_summary;
-pub mod sensor_choice;
 pub mod train;

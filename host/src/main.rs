@@ -1,15 +1,19 @@
-//! `host`: parses the command line ([`cli`]) and runs the command.
+//! `host`: parses the command line ([`cli`]) and runs each command in its
+//! own function.
 
 mod cli;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use cli::{
-    Cli, Command, ExperimentAction, ExperimentArgs, FieldCommand, MonitorArgs, PolicyCommand,
-};
+use cli::learn::{ExperimentAction, ExperimentArgs, TrainArgs};
+use cli::robot::{FlashArgs, MonitorArgs, ReplayArgs};
+use cli::screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
+use cli::simulate::{BenchArgs, RenderArgs, RunArgs};
+use cli::{Cli, Command, FieldCommand, PolicyCommand};
 use host::run_summary::run_timed;
 use sim::render::RenderOptions;
 use std::io::Write;
+use std::path::Path;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -40,147 +44,165 @@ fn end_quietly_on_a_closed_pipe() {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
-        Command::Run {
-            scenario,
-            steps,
-            json,
-        } => {
-            let (mut sim, mut controller) = scenario.scenario()?.build()?;
-            let summary = run_timed(&mut sim, &mut controller, steps);
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string(&summary).context("cannot encode the summary")?
-                );
-            } else {
-                println!("{summary}");
-            }
-            Ok(())
-        }
-        Command::Render {
-            scenario,
-            steps,
-            out,
-            gif,
-            every,
-            size,
-            footprints,
-        } => {
-            let (mut sim, mut controller) = scenario.scenario()?.build()?;
-            let options = RenderOptions { size, footprints };
-            if let Some(path) = gif {
-                host::render::animate(&mut sim, &mut controller, steps, every, options, &path)?;
-            }
-            if let Some(path) = out {
-                if sim.totals().steps < steps {
-                    sim.run(&mut controller, steps);
-                }
-                host::render::write_png(&sim, options, &path)?;
-            }
-            Ok(())
-        }
-        Command::Bench(args) => {
-            println!("{}", host::bench::run(&args.variant()?, args.steps())?);
-            Ok(())
-        }
-        Command::Train(args) => {
-            let report = host::train::train(&args.request())?;
-            println!("{report}");
-            Ok(())
-        }
+        Command::Run(args) => simulate(args),
+        Command::Render(args) => render(args),
+        Command::Bench(args) => bench(args),
+        Command::Train(args) => train(args),
         Command::Experiment(args) => experiment(args),
-        Command::Policy(PolicyCommand::Inspect { file }) => {
-            let blob = sim::control::policy_file::read(&file)?;
-            print!("{}", host::inspect::render(&blob));
-            Ok(())
-        }
+        Command::Policy(PolicyCommand::Inspect { file }) => inspect_policy(&file),
         Command::Monitor(args) => monitor(args),
-        Command::Replay(args) => {
-            use host::robot::replay::{odometry, replay_files};
-            let settings = odometry::OdometrySettings {
-                mm_per_unit: args.mm_per_unit,
-                counts_per_mm: args.counts_per_mm,
-                track_mm: args.track_mm,
-            };
-            let report = replay_files(&args.log, &args.policy, args.visits.as_deref(), settings)?;
-            if let Some(path) = &args.fit_profile {
-                let file = odometry::merge_into_file(path, &report.motion)?;
-                eprintln!(
-                    "replay: wrote {} ({} robots)",
-                    path.display(),
-                    file.robots.len()
-                );
-            }
-            let text = if args.json {
-                serde_json::to_string(&report).context("cannot encode the report")? + "\n"
-            } else {
-                report.to_string()
-            };
-            std::io::stdout()
-                .write_all(text.as_bytes())
-                .context("cannot write the report")
-        }
-        Command::Flash(args) => {
-            use host::robot::flash;
-            let cwd = std::env::current_dir().context("cannot read the current directory")?;
-            let plan = flash::FlashPlan::new(
-                &args.policy,
-                args.hasher,
-                args.port,
-                args.repo.as_deref(),
-                &cwd,
-            )?
-            .for_robot(args.robot_id);
-            if args.dry_run {
-                return std::io::stdout()
-                    .write_all(plan.describe().as_bytes())
-                    .context("cannot write the commands");
-            }
-            let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
-            flash::flash(
-                &plan,
-                avrdude.as_deref(),
-                flash::PORT_WAIT,
-                &mut std::io::stdout(),
-            )
-        }
-        Command::Field(FieldCommand::Export(args)) => {
-            let arena = args.screen.arena.screen()?;
-            let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
-            println!(
-                "wrote {} ({w} x {h}: {} on {})",
-                args.out.display(),
-                args.screen.field,
-                arena.name
-            );
-            Ok(())
-        }
-        Command::Display(args) => {
-            let display = host::display::Display::start(&args.settings()?)?;
-            let url = display.url();
-            // The first line names the address (scripts and tests read it).
-            println!("display: serving {url}");
-            println!("  field: {url}   calibration: {url}?mode=calibrate   grey patches: {url}?mode=grey");
-            println!("  keys: c calibration, f field, g grey patches, Enter or click full-screen, h help; Ctrl-C stops");
-            std::io::stdout()
-                .flush()
-                .context("cannot write to stdout")?;
-            display.serve();
-            Ok(())
-        }
-        Command::Observe(args) => {
-            let json = args.json;
-            let observation = host::observe::observe(&args.settings()?)?;
-            let text = if json {
-                serde_json::to_string(&observation).context("cannot encode the observation")? + "\n"
-            } else {
-                observation.to_string()
-            };
-            std::io::stdout()
-                .write_all(text.as_bytes())
-                .context("cannot write the observation")
-        }
+        Command::Replay(args) => replay(args),
+        Command::Flash(args) => flash(args),
+        Command::Field(FieldCommand::Export(args)) => export_field(args),
+        Command::Display(args) => display(args),
+        Command::Observe(args) => observe(args),
     }
+}
+
+fn simulate(args: RunArgs) -> Result<()> {
+    let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
+    let summary = run_timed(&mut sim, &mut controller, args.steps);
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&summary).context("cannot encode the summary")?
+        );
+    } else {
+        println!("{summary}");
+    }
+    Ok(())
+}
+
+fn render(args: RenderArgs) -> Result<()> {
+    let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
+    let options = RenderOptions {
+        size: args.size,
+        footprints: args.footprints,
+    };
+    if let Some(path) = &args.gif {
+        host::render::animate(
+            &mut sim,
+            &mut controller,
+            args.steps,
+            args.every,
+            options,
+            path,
+        )?;
+    }
+    if let Some(path) = &args.out {
+        if sim.totals().steps < args.steps {
+            sim.run(&mut controller, args.steps);
+        }
+        host::render::write_png(&sim, options, path)?;
+    }
+    Ok(())
+}
+
+fn bench(args: BenchArgs) -> Result<()> {
+    println!("{}", host::bench::run(&args.variant()?, args.steps())?);
+    Ok(())
+}
+
+fn train(args: TrainArgs) -> Result<()> {
+    let report = host::train::train(&args.request())?;
+    println!("{report}");
+    Ok(())
+}
+
+fn inspect_policy(file: &Path) -> Result<()> {
+    let blob = sim::control::policy_file::read(file)?;
+    print!("{}", host::inspect::render(&blob));
+    Ok(())
+}
+
+fn replay(args: ReplayArgs) -> Result<()> {
+    use host::robot::replay::{odometry, replay_files};
+    let settings = odometry::OdometrySettings {
+        mm_per_unit: args.mm_per_unit,
+        counts_per_mm: args.counts_per_mm,
+        track_mm: args.track_mm,
+    };
+    let report = replay_files(&args.log, &args.policy, args.visits.as_deref(), settings)?;
+    if let Some(path) = &args.fit_profile {
+        let file = odometry::merge_into_file(path, &report.motion)?;
+        eprintln!(
+            "replay: wrote {} ({} robots)",
+            path.display(),
+            file.robots.len()
+        );
+    }
+    let text = if args.json {
+        serde_json::to_string(&report).context("cannot encode the report")? + "\n"
+    } else {
+        report.to_string()
+    };
+    std::io::stdout()
+        .write_all(text.as_bytes())
+        .context("cannot write the report")
+}
+
+fn flash(args: FlashArgs) -> Result<()> {
+    use host::robot::flash;
+    let cwd = std::env::current_dir().context("cannot read the current directory")?;
+    let plan = flash::FlashPlan::new(
+        &args.policy,
+        args.hasher,
+        args.port,
+        args.repo.as_deref(),
+        &cwd,
+    )?
+    .for_robot(args.robot_id);
+    if args.dry_run {
+        return std::io::stdout()
+            .write_all(plan.describe().as_bytes())
+            .context("cannot write the commands");
+    }
+    let avrdude = flash::find_program("avrdude", std::env::var_os("PATH").as_deref());
+    flash::flash(
+        &plan,
+        avrdude.as_deref(),
+        flash::PORT_WAIT,
+        &mut std::io::stdout(),
+    )
+}
+
+fn export_field(args: FieldExportArgs) -> Result<()> {
+    let arena = args.screen.arena.screen()?;
+    let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
+    println!(
+        "wrote {} ({w} x {h}: {} on {})",
+        args.out.display(),
+        args.screen.field,
+        arena.name
+    );
+    Ok(())
+}
+
+fn display(args: DisplayArgs) -> Result<()> {
+    let display = host::display::Display::start(&args.settings()?)?;
+    let url = display.url();
+    // The first line names the address (scripts and tests read it).
+    println!("display: serving {url}");
+    println!("  field: {url}   calibration: {url}?mode=calibrate   grey patches: {url}?mode=grey");
+    println!("  keys: c calibration, f field, g grey patches, Enter or click full-screen, h help; Ctrl-C stops");
+    std::io::stdout()
+        .flush()
+        .context("cannot write to stdout")?;
+    display.serve();
+    Ok(())
+}
+
+fn observe(args: ObserveArgs) -> Result<()> {
+    let json = args.json;
+    let observation = host::observe::observe(&args.settings()?)?;
+    let text = if json {
+        serde_json::to_string(&observation).context("cannot encode the observation")? + "\n"
+    } else {
+        observation.to_string()
+    };
+    std::io::stdout()
+        .write_all(text.as_bytes())
+        .context("cannot write the observation")
 }
 
 fn experiment(args: ExperimentArgs) -> Result<()> {

@@ -8,13 +8,13 @@
 use host::observe::homography::Homography;
 use image::{Rgb, RgbImage};
 use rand::{RngExt, SeedableRng};
+use sim::base::vec2::Vec2;
 use sim::fields::source::FieldSource;
 use sim::fields::ScalarField;
-use sim::math::vec2::Vec2;
 use sim::scenario::arena::ArenaSpec;
 use sim::scenario::{Arena, Scenario};
 use sim::world::World;
-use sim::{config::SimConfig, math::rng::SimRng, physics::body::RobotKind};
+use sim::{base::rng::SimRng, config::SimConfig, physics::body::RobotKind};
 use std::path::Path;
 use std::process::Command;
 

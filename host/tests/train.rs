@@ -2,13 +2,13 @@
 //! the one-sensing-per-step contract a learner relies on.
 
 use host::learn::QLearner;
-use host::sensor_choice::SensorChoice;
 use host::train::checkpoint::{self, CheckpointError};
 use host::train::{TrainConfig, Trainer, TrainingState};
 use shared::SensorReading;
 use sim::episodes::reward::Reward;
+use sim::scenario::sensor_choice::SensorChoice;
+use sim::{base::rng::SimRng, episodes::EpisodeStart, episodes::StepOutcome};
 use sim::{control::Controller, control::Perception};
-use sim::{episodes::EpisodeStart, episodes::StepOutcome, math::rng::SimRng};
 use std::io::Write;
 use std::sync::Arc;
 

@@ -28,7 +28,7 @@ use settings::{ActionKind, Autoreset, EnvArgs, ObservationKind, READING_LEN};
 use shared::{ActionTable, StateHasher};
 use sim::episodes::reward::Reward;
 use sim::render::RenderOptions;
-use sim::scenario::sensor_setup::SensorSetup;
+use sim::scenario::sensor_choice::SensorChoice;
 
 fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
@@ -510,7 +510,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "REWARDS",
         Reward::ALL.iter().map(|r| r.name()).collect::<Vec<_>>(),
     )?;
-    m.add("SENSORS", SensorSetup::NAMES)?;
+    m.add("SENSORS", SensorChoice::NAMES)?;
     m.add("DEFAULT_ANGULAR", ActionTable::DEFAULT_ANGULAR.to_vec())?;
     m.add("DEFAULT_FORWARD_SPEED", ActionTable::DEFAULT_FORWARD_SPEED)?;
     m.add(

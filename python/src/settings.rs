@@ -12,6 +12,7 @@ use sim::config::{SimConfig, Thresholds};
 use sim::episodes::reward::Reward;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
+use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::sensor_setup::SensorSetup;
 use sim::scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
 use sim::sensors::robot::RobotSensorConfig;
@@ -180,17 +181,24 @@ fn count(name: &str, value: i64, min: i64) -> Result<usize, ArgumentError> {
 }
 
 fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, ArgumentError> {
-    let setup = SensorSetup::from_name(name).ok_or_else(|| {
-        ArgumentError::new(
-            "sensors",
-            format!("{name:?}"),
-            format!("unknown sensor model; expected {}", SensorSetup::NAMES),
-        )
-    })?;
-    let Some(json) = robot_config else {
-        return Ok(setup);
+    let choice = match name.parse::<SensorChoice>() {
+        Ok(
+            choice @ (SensorChoice::Disc | SensorChoice::DiscThesis | SensorChoice::Robot(None)),
+        ) => choice,
+        _ => {
+            return Err(ArgumentError::new(
+                "sensors",
+                format!("{name:?}"),
+                format!("unknown sensor model; expected {}", SensorChoice::NAMES),
+            ))
+        }
     };
-    if !matches!(setup, SensorSetup::Robot(_)) {
+    let Some(json) = robot_config else {
+        return choice
+            .setup()
+            .map_err(|e| ArgumentError::new("sensors", format!("{name:?}"), e.to_string()));
+    };
+    if !choice.is_robot() {
         return Err(ArgumentError::new(
             "robot_config",
             json,

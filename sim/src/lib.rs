@@ -3,7 +3,8 @@
 //! Rooms by concern, each importing only from the rooms listed before it
 //! (`tests/tests/module_graph.rs` checks the order):
 //!
-//! 1. [`math`]: vectors, trig, rounding, bit sets, seeded random draws;
+//! 1. [`base`]: vectors, trig, rounding, bit sets, seeded random draws,
+//!    the text form of named choices;
 //! 2. [`fields`]: scalar fields, the letter images, where a field comes from;
 //! 3. [`config`]: every setting of a simulation, plain data with defaults
 //!    and validation (world, physics, disc sensors, episodes);
@@ -21,12 +22,12 @@
 //! 11. [`render`]: drawing a world.
 //!
 //! A step's data flows world -> physics -> sensors -> controller -> turns.
-//! Every random choice comes from a seeded [`math::rng::SimRng`]; the whole
+//! Every random choice comes from a seeded [`base::rng::SimRng`]; the whole
 //! state is serde-serialisable for bit-exact checkpoints. The crate reads
 //! field images and policy files, and writes no files.
 #![warn(missing_docs)]
 
-pub mod math;
+pub mod base;
 
 pub mod fields;
 

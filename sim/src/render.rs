@@ -3,8 +3,8 @@
 //! line, optionally each robot's sensor footprints. (Writing them as PNG
 //! or GIF files is the host's.)
 
+use crate::base::vec2::Vec2;
 use crate::fields::ScalarField;
-use crate::math::vec2::Vec2;
 use crate::sensors::{FootprintKind, SensorModel};
 use crate::simulation::Simulation;
 use crate::world::World;

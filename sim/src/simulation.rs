@@ -20,13 +20,13 @@
 //! [`Simulation::reset_episode`] when the [`StepReport`] says the episode
 //! ended. Both give the same trajectory for the same turns.
 
+use crate::base::rng::SimRng;
 use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, SuccessSignal};
 use crate::control::{Controller, Perception};
 use crate::episodes::eval::{eval, eval_prime, EvalPrime, EvalTracker};
 use crate::episodes::{EpisodeEnd, EpisodeStart, StepOutcome};
 use crate::fields::ScalarField;
-use crate::math::rng::SimRng;
 use crate::sensors::disc::DiscSensors;
 use crate::sensors::{SensorMemory, SensorModel};
 use crate::world::World;

@@ -3,8 +3,8 @@
 
 use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
 use sim::{
-    config::SimConfig, episodes::eval::eval, episodes::StepOutcome, fields::ScalarField,
-    math::rng::SimRng, simulation::Simulation,
+    base::rng::SimRng, config::SimConfig, episodes::eval::eval, episodes::StepOutcome,
+    fields::ScalarField, simulation::Simulation,
 };
 use sim::{control::Controller, control::Perception};
 use std::sync::Arc;

@@ -5,7 +5,7 @@
 use shared::SensorReading;
 use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
 use sim::{
-    config::SimConfig, config::Thresholds, fields::ScalarField, math::vec2::Vec2,
+    base::vec2::Vec2, config::SimConfig, config::Thresholds, fields::ScalarField,
     physics::body::RobotKind, sensors::disc::DiscSensors, sensors::SensorModel, world::World,
 };
 use std::f64::consts::FRAC_PI_2;

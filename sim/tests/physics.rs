@@ -4,7 +4,7 @@ use shared::ActionTable;
 use sim::control::random::RandomTurns;
 use sim::physics::elastic_impulse;
 use sim::{
-    config::BroadPhase, config::SimConfig, math::vec2::Vec2, physics::body::Body,
+    base::vec2::Vec2, config::BroadPhase, config::SimConfig, physics::body::Body,
     physics::body::RobotKind, simulation::Simulation, world::World, world::WorldState,
 };
 use std::sync::Arc;

@@ -4,8 +4,8 @@
 use shared::{ActionTable, SensorReading};
 use sim::control::random::RandomTurns;
 use sim::{
-    config::disc_sensors::DiscSensorConfig, config::SimConfig, fields::ScalarField,
-    math::vec2::Vec2, physics::body::RobotKind, sensors::disc::DiscSensors,
+    base::vec2::Vec2, config::disc_sensors::DiscSensorConfig, config::SimConfig,
+    fields::ScalarField, physics::body::RobotKind, sensors::disc::DiscSensors,
     sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors, sensors::SensorModel,
     simulation::Simulation, world::World,
 };

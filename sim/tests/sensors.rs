@@ -3,9 +3,9 @@
 
 use shared::{FieldValue, SensorReading};
 use sim::{
-    config::disc_sensors::DiscSensorConfig, config::SimConfig, fields::ScalarField,
-    math::vec2::Vec2, physics::body::RobotKind, sensors::disc::DiscSensors, sensors::SensorModel,
-    world::World,
+    base::vec2::Vec2, config::disc_sensors::DiscSensorConfig, config::SimConfig,
+    fields::ScalarField, physics::body::RobotKind, sensors::disc::DiscSensors,
+    sensors::SensorModel, world::World,
 };
 
 const R: f64 = 10.0;

@@ -6,9 +6,9 @@ use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
 use sim::control::random::RandomTurns;
 use sim::scenario::{ControllerChoice, Scenario};
 use sim::{
-    config::SimConfig, episodes::eval::eval, episodes::eval::eval_prime, episodes::eval::EvalPrime,
-    episodes::StepOutcome, fields::ScalarField, math::rng::SimRng, math::vec2::Vec2,
-    simulation::Simulation, world::World,
+    base::rng::SimRng, base::vec2::Vec2, config::SimConfig, episodes::eval::eval,
+    episodes::eval::eval_prime, episodes::eval::EvalPrime, episodes::StepOutcome,
+    fields::ScalarField, simulation::Simulation, world::World,
 };
 use sim::{control::Controller, control::Perception};
 use sim::{physics::body::RobotKind, simulation::SimulationState};

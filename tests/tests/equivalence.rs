@@ -25,7 +25,7 @@ use shared::{
     StateHasher,
 };
 use sim::{
-    fields::letters::Letter, fields::source::FieldSource, math::rng::SimRng,
+    base::rng::SimRng, fields::letters::Letter, fields::source::FieldSource,
     sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors,
 };
 use std::collections::HashMap;

@@ -19,7 +19,7 @@ use std::path::PathBuf;
 /// Version of `TrialResult`'s layout and meaning, and of the
 /// simulator's results; part of the config hash, so results of another
 /// version are re-run, not mixed in. 2: headings turn through our own
-/// `sin_cos` (`sim::math::trig`) instead of the platform's. (The settings of the
+/// `sin_cos` (`sim::base::trig`) instead of the platform's. (The settings of the
 /// thesis author's runs, `formation_check` and the others, left it at 2:
 /// at their defaults every trial runs and means what it did, and keeps its
 /// hash: see `hashed`.)

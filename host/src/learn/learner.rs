@@ -5,26 +5,35 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
 use sim::episodes::reward::Reward;
+use sim::{base::rng::SimRng, episodes::EpisodeStart, episodes::StepOutcome};
 use sim::{control::Controller, control::Perception};
-use sim::{episodes::EpisodeStart, episodes::StepOutcome, math::rng::SimRng};
 
 /// What the learner is and how it learns.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct LearnConfig {
-    /// State representation (`original`, `original-obstacle`, `bits7`, `bits9`).
+    /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
+    /// 7, 9), original-role (innies and outies apart) [default: original].
+    #[arg(long, required = false)]
     pub hasher: StateHasherName,
     /// Angular speeds of the actions, radians per step (2 to 4).
+    #[arg(skip)]
     pub actions: Vec<f32>,
-    /// Learning rate.
+    /// Learning rate [default: 0.2].
+    #[arg(long, required = false)]
     pub alpha: f64,
-    /// Discount.
+    /// Discount [default: 0.9].
+    #[arg(long, required = false)]
     pub gamma: f64,
-    /// Exploration probability.
+    /// Exploration probability [default: 0].
+    #[arg(long, required = false)]
     pub epsilon: f64,
-    /// Initial Q-value of every (state, action).
+    /// Initial Q-value of every (state, action) [default: 1].
+    #[arg(long, required = false)]
     pub initial_q: f64,
-    /// The reward signal.
+    /// Reward: reference, thesis, collision, collision-spread [default:
+    /// reference].
+    #[arg(long, required = false)]
     pub reward: Reward,
 }
 
@@ -33,19 +42,13 @@ pub struct LearnConfig {
 #[serde(try_from = "String", into = "String")]
 pub struct StateHasherName(pub StateHasher);
 
-impl TryFrom<String> for StateHasherName {
-    type Error = String;
-
-    fn try_from(s: String) -> Result<StateHasherName, String> {
-        s.parse()
+impl std::fmt::Display for StateHasherName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0.name())
     }
 }
 
-impl From<StateHasherName> for String {
-    fn from(h: StateHasherName) -> String {
-        h.0.name().to_string()
-    }
-}
+sim::text_form!(StateHasherName);
 
 impl std::str::FromStr for StateHasherName {
     type Err = String;
@@ -228,7 +231,7 @@ mod tests {
     use rand::SeedableRng;
     use shared::{PolicyTable, SensorReading};
     use sim::{
-        config::SimConfig, fields::ScalarField, math::vec2::Vec2, physics::body::RobotKind,
+        base::vec2::Vec2, config::SimConfig, fields::ScalarField, physics::body::RobotKind,
         world::World,
     };
 

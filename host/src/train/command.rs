@@ -3,7 +3,7 @@
 //! summary.
 
 use super::checkpoint;
-use super::config::{TrainConfig, TrainOverrides};
+use super::config::{TrainConfig, TrainFlags};
 use super::trainer::{Trainer, TrainingState};
 use crate::learn::QTable;
 use anyhow::{bail, Context, Result};
@@ -21,18 +21,12 @@ const PROGRESS_CHUNK: u64 = 20_000;
 /// What `host train` is asked to do (the CLI's flags, as plain settings).
 #[derive(Clone, Debug, Default)]
 pub struct TrainRequest {
-    /// TOML file with any of the settings; the overrides win over it.
+    /// TOML file with any of the settings; the flags win over it.
     pub config: Option<PathBuf>,
     /// Settings given one by one.
-    pub overrides: TrainOverrides,
-    /// Steps to run (default: the config's; when resuming, the checkpoint's run length).
-    pub steps: Option<u64>,
-    /// Directory for <name>.policy and <name>.ckpt.
-    pub out: Option<PathBuf>,
-    /// Name of the output files and of the policy.
-    pub name: Option<String>,
-    /// Steps between checkpoints, 0 for only at the end.
-    pub checkpoint_every: Option<u64>,
+    pub flags: TrainFlags,
+    /// The default real-world noise (`--randomise`, the same as `--noise 1`).
+    pub randomise: bool,
     /// Continue a run from its checkpoint, with its settings.
     pub resume: Option<PathBuf>,
     /// Start from the Q-table of a checkpoint, or from a policy blob.
@@ -97,15 +91,11 @@ pub fn train(args: &TrainRequest) -> Result<TrainReport> {
         Some(path) => resume(args, path)?,
         None => start(args)?,
     };
-    let out = trainer.output_mut();
-    if let Some(dir) = &args.out {
-        out.dir = dir.clone();
-    }
-    if let Some(name) = &args.name {
-        out.name = Some(name.clone());
-    }
-    if let Some(every) = args.checkpoint_every {
-        out.checkpoint_every = every;
+    if args.resume.is_some() {
+        // The output flags apply to a resumed run too.
+        let mut config = trainer.config().clone();
+        args.flags.apply(&mut config)?;
+        *trainer.output_mut() = config.output;
     }
     trainer.config().validate()?;
     run(&mut trainer, steps)
@@ -117,9 +107,9 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
         Some(path) => TrainConfig::from_file(path)?,
         None => TrainConfig::default(),
     };
-    args.overrides.apply(&mut config);
-    if let Some(steps) = args.steps {
-        config.steps = steps;
+    args.flags.apply(&mut config)?;
+    if args.randomise {
+        config.noise = 1.0;
     }
     config.validate()?;
     let seed_table = args
@@ -133,7 +123,10 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
 
 /// A run continued from its checkpoint, with its own settings.
 fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>, u64)> {
-    let given = args.overrides.given();
+    let mut given = args.flags.given_settings();
+    if args.randomise {
+        given.push("--randomise".into());
+    }
     if !given.is_empty() {
         bail!(
             "--resume continues a run with the settings in its checkpoint; {} cannot change them",
@@ -141,7 +134,7 @@ fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>,
         );
     }
     let state = checkpoint::load(path)?;
-    let steps = args.steps.unwrap_or(state.config.steps);
+    let steps = args.flags.steps().unwrap_or(state.config.steps);
     let trainer =
         Trainer::restart(state).with_context(|| format!("cannot resume {}", path.display()))?;
     Ok((trainer, steps))

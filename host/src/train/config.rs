@@ -1,14 +1,17 @@
 //! What a training run is: [`TrainConfig`], read from a TOML file and/or
-//! the `host train` flags ([`TrainOverrides`]), flags winning.
+//! the `host train` flags ([`TrainFlags`]), flags winning. Each setting is
+//! declared once, as a field of [`TrainConfig`]: its doc comment is both
+//! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::arena_choice::ArenaChoice;
-use crate::learn::{LearnConfig, StateHasherName};
-use crate::sensor_choice::SensorChoice;
+use crate::learn::LearnConfig;
 use anyhow::{bail, Context, Result};
+use clap::parser::ValueSource;
+use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
 use serde::{Deserialize, Serialize};
-use sim::episodes::reward::Reward;
+use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::orbital_innies;
+use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
     config::disc_sensors::ObstacleTargets, config::BroadPhase, config::SuccessSignal,
     fields::source::FieldSource, scenario::ControllerChoice, scenario::PreparedScenario,
@@ -26,71 +29,100 @@ pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
 
 /// A training run: world, learner and outputs. Every key of a config file
 /// is optional; missing ones keep the defaults (the thesis' Table 1 run).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrainConfig {
-    /// The field: `annulus`, `letter:T` or an image path.
+    /// The field: annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the
+    /// thesis' T, L, V, X, Z) or an image file (PNG, JPEG) [default: annulus].
+    #[arg(long, required = false)]
     pub field: FieldSource,
-    /// The robots' sensor model.
+    /// Sensor model: disc (the reference model's discs), disc-thesis (with
+    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
+    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
+    /// or robot:CONFIG.json (docs/robot-sensors.md) [default: disc].
+    #[arg(long, required = false)]
     pub sensors: SensorChoice,
-    /// The arena: `thesis`, `tv75` or a screen arena file; `None` for
-    /// `tv75` with the robot's senses and the thesis' square otherwise
-    /// ([`ArenaChoice::default_for`]).
+    /// The arena: thesis (the reference model's 800 x 800 square), tv75
+    /// (the thesis' 75" TV lying flat) or a FILE.toml of a screen arena
+    /// [default: tv75 with the robot's senses, else thesis].
+    #[arg(long)]
     pub arena: Option<ArenaChoice>,
-    /// Number of robots; `None` for the arena's (8 in the thesis' square,
-    /// 5 on `tv75`).
+    /// Number of robots [default: the arena's: 8 in the thesis' square, 5
+    /// on tv75].
+    #[arg(long)]
     pub robots: Option<usize>,
-    /// Number of pucks; `None` for the arena's (250 in the thesis' square,
-    /// 12 on `tv75`).
+    /// Number of pucks [default: the arena's: 250 in the thesis' square, 12
+    /// on tv75].
+    #[arg(long)]
     pub pucks: Option<usize>,
-    /// Real-world noise (domain randomisation), in multiples of the
-    /// default: the robots' motion and the robot senses' readings
-    /// ([`sim::scenario::Scenario::noise`]); 0 for none.
+    /// Real-world noise (domain randomisation) in multiples of the default
+    /// (0 none, 1 the default, 2 twice as much): the robots' motion and the
+    /// robot senses' readings [default: 0].
+    #[arg(long, required = false)]
     pub noise: f64,
-    /// Steps to run.
+    /// Steps to run [default: 2000000; when resuming, the checkpoint's run
+    /// length].
+    #[arg(long, required = false)]
     pub steps: u64,
-    /// Seed of every random choice.
+    /// Seed of every random choice [default: 1].
+    #[arg(long, required = false)]
     pub seed: u64,
-    /// Steps before an unformed episode counts as stuck; `None` for the
-    /// field's default (150,000 on the annulus, 50,000 otherwise).
+    /// Steps before an unformed episode counts as stuck [default: the
+    /// field's: 150000 on the annulus, 50000 otherwise].
+    #[arg(long)]
     pub stuck_limit: Option<u64>,
     /// The learner.
+    #[command(flatten)]
     pub learn: LearnConfig,
     /// Where results go.
+    #[command(flatten)]
     pub output: OutputConfig,
     /// How often formations are checked, and on which world.
+    #[command(flatten)]
     pub formation_check: FormationCheck,
     /// What a check tests: `eval` (default), `eval-prime` (Eval' as
     /// printed) or `eval-prime-spread`.
+    #[arg(skip)]
     pub success: SuccessSignal,
     /// Innies among the robots of an orbital-construction run or of a
-    /// learning run with the role hasher (`original-role`); `None` for half
-    /// the robots on the annulus and none on letters and images
-    /// ([`orbital_innies`]). Other learning runs have none.
+    /// learning run with the role hasher (original-role) [default: half the
+    /// robots on the annulus, none on letters and images]. Other learning
+    /// runs have none.
+    #[arg(long)]
     pub innies: Option<usize>,
     /// The disc sensor model's obstacle discs; `None` for the model's own
     /// (`disc`: radius r/4 seeing any body).
+    #[arg(skip)]
     pub obstacle_discs: Option<ObstacleDiscs>,
     /// Policy selection: the run's policy is the best greedy policy of
     /// periodic evaluations instead of the last one
     /// ([`super::selection`]); `None` for the last.
+    #[arg(skip)]
     pub select: Option<SelectConfig>,
-    /// Steps of orbital construction distilled into the table the run
-    /// starts from ([`super::distil`]); `None` to start from the initial
-    /// Q-values.
+    /// Start from orbital construction: distil this many of its steps, on a
+    /// world of the run's settings, into the table the run starts from
+    /// (docs/training.md) [default: none, the initial Q-values].
+    #[arg(long)]
     pub distil_oc: Option<u64>,
 }
 
 /// When an episode's formation is checked (`[formation_check]`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct FormationCheck {
-    /// Steps between checks (100, the simulator's default).
+    /// Steps between formation checks [default: 100].
+    #[arg(
+        long = "check-every",
+        id = "check_every",
+        value_name = "STEPS",
+        required = false
+    )]
     pub every: u64,
     /// Test the Eval measured at the previous check (at the episode's
     /// start for the first) instead of the current one, as the thesis
     /// author's loop did with `every = 1000` (reference model, "What the
     /// thesis author's own runs did").
+    #[arg(long = "stale-check", id = "stale_check", value_name = "BOOL", action = ArgAction::Set, required = false)]
     pub stale: bool,
 }
 
@@ -116,15 +148,18 @@ pub struct ObstacleDiscs {
 }
 
 /// Where a training run writes, and how often it checkpoints.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct OutputConfig {
-    /// Directory of `<name>.policy` and `<name>.ckpt`.
+    /// Directory of `<name>.policy` and `<name>.ckpt` [default: out].
+    #[arg(long = "out", id = "out", value_name = "DIR", required = false)]
     pub dir: PathBuf,
-    /// File name stem (at most 32 bytes, no path separators); `None` for
-    /// `<field>-<hasher>`, e.g. `annulus-original`.
+    /// Name of the output files and of the policy (at most 32 bytes, no
+    /// path separators) [default: <field>-<hasher>, e.g. annulus-original].
+    #[arg(long)]
     pub name: Option<String>,
-    /// Steps between checkpoints (0: only at the end).
+    /// Steps between checkpoints, 0 for only at the end [default: 1000000].
+    #[arg(long, required = false)]
     pub checkpoint_every: u64,
 }
 
@@ -318,103 +353,92 @@ fn truncate(s: &str) -> String {
     s[..end].to_string()
 }
 
-/// Settings given one by one (the `host train` flags) that change a
-/// [`TrainConfig`]; each overrides the config file's value when given.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TrainOverrides {
-    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
-    pub field: Option<FieldSource>,
-    /// Sensor model: disc (the reference model's discs), disc-thesis (with
-    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
-    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
-    /// or robot:CONFIG.json (docs/robot-sensors.md).
-    pub sensors: Option<SensorChoice>,
-    /// thesis, tv75 or a FILE.toml [default: tv75 with the robot's senses,
-    /// else thesis].
-    pub arena: Option<ArenaChoice>,
-    /// Number of robots [default: the arena's].
-    pub robots: Option<usize>,
-    /// Number of pucks [default: the arena's].
-    pub pucks: Option<usize>,
-    /// Real-world noise in multiples of the default [default: 0].
-    pub noise: Option<f64>,
-    /// Policy selection [default: none, the last greedy policy].
-    pub select: Option<SelectConfig>,
-    /// Steps of orbital construction to distil into the starting table.
-    pub distil_oc: Option<u64>,
-    /// Seed of every random choice [default: 1].
-    pub seed: Option<u64>,
-    /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
-    /// 7, 9), original-role (innies and outies apart) [default: original].
-    pub hasher: Option<StateHasherName>,
-    /// Reward: reference, thesis, collision, collision-spread [default:
-    /// reference].
-    pub reward: Option<Reward>,
-    /// Learning rate [default: 0.2].
-    pub alpha: Option<f64>,
-    /// Discount [default: 0.9].
-    pub gamma: Option<f64>,
-    /// Exploration probability [default: 0].
-    pub epsilon: Option<f64>,
-}
+/// The `host train` flags of [`TrainConfig`]'s settings, as given: each
+/// flag is the config field of the same name (its doc comment is the
+/// flag's help), so a setting is declared once, in [`TrainConfig`]. Only
+/// the flags given override a config file's values.
+#[derive(Clone, Debug, Default)]
+pub struct TrainFlags(ArgMatches);
 
-impl TrainOverrides {
+/// Flags that may go with `--resume`: they say how long to run and where
+/// to write, not what the run is.
+const RESUMABLE: [&str; 4] = ["steps", "out", "name", "checkpoint_every"];
+
+impl TrainFlags {
+    /// The flags of a command line (without the program's name), e.g.
+    /// `["--robots", "4"]`.
+    pub fn parse<I, T>(args: I) -> Result<TrainFlags>
+    where
+        I: IntoIterator<Item = T>,
+        T: Into<std::ffi::OsString> + Clone,
+    {
+        let command = TrainFlags::augment_args(clap::Command::new("train").no_binary_name(true));
+        Ok(TrainFlags(command.try_get_matches_from(args)?))
+    }
+
     /// Writes every given flag into `config`.
-    pub fn apply(&self, config: &mut TrainConfig) {
-        if let Some(v) = &self.field {
-            config.field = v.clone();
+    pub fn apply(&self, config: &mut TrainConfig) -> Result<()> {
+        config.update_from_arg_matches(&self.0)?;
+        if self.given_ids().any(|id| id == "select_every") {
+            config.select = Some(SelectConfig::from_arg_matches(&self.0)?);
         }
-        set(&mut config.sensors, self.sensors.clone());
-        if let Some(arena) = &self.arena {
-            config.arena = Some(arena.clone());
-        }
-        if let Some(robots) = self.robots {
-            config.robots = Some(robots);
-        }
-        if let Some(pucks) = self.pucks {
-            config.pucks = Some(pucks);
-        }
-        set(&mut config.noise, self.noise);
-        if let Some(select) = self.select {
-            config.select = Some(select);
-        }
-        if let Some(steps) = self.distil_oc {
-            config.distil_oc = Some(steps);
-        }
-        set(&mut config.seed, self.seed);
-        set(&mut config.learn.hasher, self.hasher);
-        set(&mut config.learn.reward, self.reward);
-        set(&mut config.learn.alpha, self.alpha);
-        set(&mut config.learn.gamma, self.gamma);
-        set(&mut config.learn.epsilon, self.epsilon);
+        Ok(())
     }
 
-    /// The names of the flags given, for refusing them where they cannot
-    /// apply (a resumed run keeps its settings).
-    pub fn given(&self) -> Vec<&'static str> {
-        let flags = [
-            ("--field", self.field.is_some()),
-            ("--sensors", self.sensors.is_some()),
-            ("--arena", self.arena.is_some()),
-            ("--robots", self.robots.is_some()),
-            ("--pucks", self.pucks.is_some()),
-            ("--noise", self.noise.is_some()),
-            ("--select-every", self.select.is_some()),
-            ("--distil-oc", self.distil_oc.is_some()),
-            ("--seed", self.seed.is_some()),
-            ("--hasher", self.hasher.is_some()),
-            ("--reward", self.reward.is_some()),
-            ("--alpha", self.alpha.is_some()),
-            ("--gamma", self.gamma.is_some()),
-            ("--epsilon", self.epsilon.is_some()),
-        ];
-        flags.into_iter().filter(|f| f.1).map(|f| f.0).collect()
+    /// `--steps`, if given.
+    pub fn steps(&self) -> Option<u64> {
+        self.given_ids()
+            .any(|id| id == "steps")
+            .then(|| self.0.get_one::<u64>("steps").copied())
+            .flatten()
+    }
+
+    /// The flags given that change what the run is (all but `--steps`,
+    /// `--out`, `--name`, `--checkpoint-every`), for refusing them where a
+    /// resumed run keeps its settings.
+    pub fn given_settings(&self) -> Vec<String> {
+        self.given_ids()
+            .filter(|id| !RESUMABLE.contains(id))
+            .map(|id| format!("--{}", id.replace('_', "-")))
+            .collect()
+    }
+
+    /// The ids of the settings flags given on the command line (the
+    /// matches also hold the rest of the command's arguments and the
+    /// groups clap makes of flattened structs).
+    fn given_ids(&self) -> impl Iterator<Item = &str> {
+        let own = TrainFlags::augment_args(clap::Command::new("train"));
+        let own: Vec<String> = own
+            .get_arguments()
+            .map(|a| a.get_id().to_string())
+            .collect();
+        self.0.ids().map(|id| id.as_str()).filter(move |id| {
+            own.iter().any(|o| o == id) && self.0.value_source(id) == Some(ValueSource::CommandLine)
+        })
     }
 }
 
-fn set<T>(slot: &mut T, value: Option<T>) {
-    if let Some(v) = value {
-        *slot = v;
+impl FromArgMatches for TrainFlags {
+    fn from_arg_matches(matches: &ArgMatches) -> std::result::Result<TrainFlags, clap::Error> {
+        Ok(TrainFlags(matches.clone()))
+    }
+
+    fn update_from_arg_matches(
+        &mut self,
+        matches: &ArgMatches,
+    ) -> std::result::Result<(), clap::Error> {
+        self.0 = matches.clone();
+        Ok(())
+    }
+}
+
+impl Args for TrainFlags {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        SelectConfig::augment_args(TrainConfig::augment_args(command))
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        SelectConfig::augment_args_for_update(TrainConfig::augment_args_for_update(command))
     }
 }
 
@@ -432,17 +456,14 @@ mod tests {
             (world.episode.stuck_limit, world.world.pucks),
             (50_000, 250)
         );
-        let flags = TrainOverrides {
-            alpha: Some(0.1),
-            robots: Some(2),
-            ..Default::default()
-        };
-        flags.apply(&mut c);
+        let flags = TrainFlags::parse(["--alpha", "0.1", "--robots", "2", "--steps", "9"]).unwrap();
+        flags.apply(&mut c).unwrap();
         assert_eq!(
-            (c.robots, c.learn.alpha, c.learn.hasher.0.bits()),
-            (Some(2), 0.1, 7)
+            (c.robots, c.learn.alpha, c.learn.hasher.0.bits(), c.steps),
+            (Some(2), 0.1, 7, 9)
         );
-        assert_eq!(flags.given(), ["--robots", "--alpha"]);
+        assert_eq!(flags.given_settings(), ["--alpha", "--robots"]);
+        assert_eq!(flags.steps(), Some(9));
         c.validate().unwrap();
     }
 

@@ -17,7 +17,7 @@ use super::config::TrainConfig;
 use anyhow::{Context, Result};
 use shared::{ActionId, PolicyTable, State};
 use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
-use sim::{control::Controller, control::Perception, math::rng::SimRng};
+use sim::{base::rng::SimRng, control::Controller, control::Perception};
 
 /// Mixed into the run's seed for the distillation world.
 pub const DISTIL_STREAM: u64 = 0xD157_11ED_0000_0001;

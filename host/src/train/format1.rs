@@ -16,14 +16,14 @@ use super::config::{FormationCheck, OutputConfig, TrainConfig};
 use super::format2::{SimConfigV2, SimulationV2, StateV2, TrainConfigV2, WorldConfigV2, WorldV2};
 use super::trainer::TrainingState;
 use crate::learn::{LearnConfig, QLearner};
-use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::{EpisodeConfig, PhysicsConfig, SuccessSignal, Thresholds, WorldConfig};
 use sim::fields::FieldSampling;
+use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
-    config::disc_sensors::DiscSensorConfig, config::BroadPhase, fields::source::FieldSource,
-    math::rng::SimRng, physics::body::Body, physics::body::Robot, simulation::Totals,
+    base::rng::SimRng, config::disc_sensors::DiscSensorConfig, config::BroadPhase,
+    fields::source::FieldSource, physics::body::Body, physics::body::Robot, simulation::Totals,
 };
 
 /// A training state in format 1's layout.

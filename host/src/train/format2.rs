@@ -14,9 +14,7 @@
 
 use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
 use super::trainer::TrainingState;
-use crate::arena_choice::ArenaChoice;
 use crate::learn::{LearnConfig, QLearner};
-use crate::sensor_choice::SensorChoice;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
@@ -24,11 +22,13 @@ use sim::config::{
     EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig,
 };
 use sim::fields::{FieldFrame, FieldSampling};
+use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::{THESIS_PUCKS, THESIS_ROBOTS};
 use sim::{
-    config::disc_sensors::DiscSensorConfig, config::BroadPhase, fields::source::FieldSource,
-    math::rng::SimRng, physics::body::Body, physics::body::Robot, simulation::SimulationState,
-    simulation::Totals, world::World, world::WorldState,
+    base::rng::SimRng, config::disc_sensors::DiscSensorConfig, config::BroadPhase,
+    fields::source::FieldSource, physics::body::Body, physics::body::Robot,
+    simulation::SimulationState, simulation::Totals, world::World, world::WorldState,
 };
 
 /// A training state in format 2's layout.

@@ -13,5 +13,5 @@ pub mod selection;
 pub mod trainer;
 
 pub use command::{train, TrainReport, TrainRequest};
-pub use config::{OutputConfig, TrainConfig, TrainOverrides};
+pub use config::{OutputConfig, TrainConfig, TrainFlags};
 pub use trainer::{Trainer, TrainingState};

@@ -28,12 +28,28 @@ use std::sync::Arc;
 pub const EVALUATION_STREAM: u64 = 0x5E1E_C7ED_0000_0001;
 
 /// `select = { every = 1_000_000, steps = 200_000 }`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::Args)]
 #[serde(deny_unknown_fields)]
 pub struct SelectConfig {
-    /// Steps of training between evaluations (counted over the whole run).
+    /// Policy selection: every N training steps (counted over the whole
+    /// run), evaluate the greedy policy on a fixed evaluation world and keep
+    /// the best as the run's policy (docs/training.md).
+    #[arg(
+        long = "select-every",
+        id = "select_every",
+        value_name = "STEPS",
+        requires = "select_steps",
+        required = false
+    )]
     pub every: u64,
-    /// Steps of each evaluation.
+    /// Steps of each evaluation of --select-every.
+    #[arg(
+        long = "select-steps",
+        id = "select_steps",
+        value_name = "STEPS",
+        requires = "select_every",
+        required = false
+    )]
     pub steps: u64,
 }
 

@@ -10,8 +10,8 @@
 //! step's if the period is dropped): the robot turns `(w + b) p` and drives
 //! `forward_speed f p`.
 
+use crate::base::noise::{self, Purpose};
 use crate::config::validate::{check, ConfigError};
-use crate::math::noise::{self, Purpose};
 use serde::{Deserialize, Serialize};
 
 /// A robot's measured motion (`host replay --fit-profile`'s names).

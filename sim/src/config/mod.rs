@@ -9,11 +9,11 @@ pub mod actuation;
 pub mod disc_sensors;
 pub mod validate;
 
+use crate::base::vec2::Vec2;
 use crate::config::actuation::ActuationNoise;
 use crate::config::disc_sensors::DiscSensorConfig;
 use crate::config::validate::{check, positive, unit, ConfigError};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling};
-use crate::math::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 
 /// How contact candidates and sensor neighbours are found. The choice

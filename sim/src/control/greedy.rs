@@ -1,7 +1,7 @@
 //! A greedy table policy from a policy blob: the robot's behaviour.
 
+use crate::base::rng::SimRng;
 use crate::control::{Controller, Perception};
-use crate::math::rng::SimRng;
 use shared::PolicyBlob;
 
 /// Hashes each reading with the blob's hasher, looks the state up in its

@@ -17,8 +17,8 @@ pub mod orbital;
 pub mod policy_file;
 pub mod random;
 
+use crate::base::rng::SimRng;
 use crate::episodes::{EpisodeStart, StepOutcome};
-use crate::math::rng::SimRng;
 use crate::physics::body::Robot;
 use shared::SensorReading;
 

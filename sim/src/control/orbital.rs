@@ -1,8 +1,8 @@
 //! Orbital construction, the thesis' Algorithm 2.
 
+use crate::base::rng::SimRng;
 use crate::config::Thresholds;
 use crate::control::{Controller, Perception};
-use crate::math::rng::SimRng;
 use crate::physics::body::RobotKind;
 use serde::{Deserialize, Serialize};
 use shared::{FieldValue, SensorReading};

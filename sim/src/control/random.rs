@@ -1,7 +1,7 @@
 //! Uniformly random actions: the baseline that forms nothing.
 
+use crate::base::rng::SimRng;
 use crate::control::{Controller, Perception};
-use crate::math::rng::SimRng;
 use rand::RngExt;
 use shared::ActionTable;
 

@@ -7,10 +7,10 @@
 //!   threshold was tuned with it). No pucks: 1.
 //! - Eval' (thesis chapter 6), two variants; see [`EvalPrime`].
 
+use crate::base::rounding::round_half_away;
+use crate::base::vec2::Vec2;
 use crate::config::Thresholds;
 use crate::fields::{FieldLayout, FieldSampling, ScalarField};
-use crate::math::rounding::round_half_away;
-use crate::math::vec2::Vec2;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 

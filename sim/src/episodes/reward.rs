@@ -12,6 +12,9 @@ use std::str::FromStr;
 
 /// How the step's reward is computed from the world.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+// Serialised by variant (an index in the binary checkpoints, whose frozen
+// formats hold it so): kebab-case gives the same names as `name()`, which a
+// test checks.
 #[serde(rename_all = "kebab-case")]
 pub enum Reward {
     /// `Eval_t - Eval_{t-1}`, minus 1 when that is not positive: the original
@@ -123,5 +126,8 @@ mod tests {
             assert_eq!(r.name().parse::<Reward>(), Ok(r));
         }
         assert!("eval".parse::<Reward>().is_err());
+        for r in Reward::ALL {
+            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{}\"", r.name()));
+        }
     }
 }

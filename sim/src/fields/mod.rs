@@ -17,8 +17,8 @@
 pub mod letters;
 pub mod source;
 
-use crate::math::rounding::floor;
-use crate::math::vec2::Vec2;
+use crate::base::rounding::floor;
+use crate::base::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::FieldValue;
 
@@ -144,10 +144,10 @@ impl ScalarField {
     /// nearest cell by rounding.
     #[cfg(test)]
     pub(crate) fn nearest_cell(&self, p: Vec2, frame: &FieldFrame) -> (i64, i64) {
-        let x = crate::math::rounding::round_half_away(
+        let x = crate::base::rounding::round_half_away(
             self.width as f64 * (p.x - frame.x) / frame.width,
         );
-        let y = crate::math::rounding::round_half_away(
+        let y = crate::base::rounding::round_half_away(
             self.height as f64 * (p.y - frame.y) / frame.height,
         );
         (x, y)
@@ -243,7 +243,7 @@ fn split(t: f64, n: usize) -> (usize, f64) {
 /// exactly when `t > -0.5` (-0.5 rounds away to -1) and below `n` exactly
 /// when `t < n - 0.5` (which rounds up to `n`). Inside, `t as u32`
 /// truncates (to 0 for `t` in (-0.5, 0)) and the fraction is exact, as in
-/// [`crate::math::rounding::round_half_away`]; NaN passes both tests and reads cell 0, as there.
+/// [`crate::base::rounding::round_half_away`]; NaN passes both tests and reads cell 0, as there.
 #[inline]
 fn nearest_index(t: f64, n: usize) -> Option<usize> {
     if (t <= -0.5) | (t >= n as f64 - 0.5) {

@@ -96,18 +96,7 @@ impl FromStr for FieldSource {
     }
 }
 
-impl TryFrom<String> for FieldSource {
-    type Error = FieldError;
-    fn try_from(s: String) -> Result<FieldSource, FieldError> {
-        s.parse()
-    }
-}
-
-impl From<FieldSource> for String {
-    fn from(f: FieldSource) -> String {
-        f.to_string()
-    }
-}
+crate::text_form!(FieldSource);
 
 impl fmt::Display for FieldSource {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -1,6 +1,6 @@
 //! Circle bodies and the robots that drive some of them.
 
-use crate::math::vec2::Vec2;
+use crate::base::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{PI, TAU};
 

@@ -6,8 +6,8 @@
 //! supersets of the exact answer and the callers apply the exact test
 //! afterwards, in a canonical order, so the mode never changes a result.
 
+use crate::base::vec2::Vec2;
 use crate::config::BroadPhase;
-use crate::math::vec2::Vec2;
 use crate::physics::body::Body;
 use crate::physics::grid::{Neighbour, SpatialGrid};
 
@@ -184,7 +184,7 @@ impl NeighbourIndex {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::rng::SimRng;
+    use crate::base::rng::SimRng;
     use rand::{RngExt, SeedableRng};
 
     /// Contact candidates are what the turn needs, in both broad phases and

@@ -8,7 +8,7 @@
 //! between its old and new place shift by one. Updates and queries
 //! allocate nothing.
 
-use crate::math::vec2::Vec2;
+use crate::base::vec2::Vec2;
 
 /// A body as a neighbour query sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -15,10 +15,10 @@ pub mod body;
 pub(crate) mod broadphase;
 pub mod grid;
 
+use crate::base::bitset::BitSet;
+use crate::base::rng::SimRng;
+use crate::base::vec2::Vec2;
 use crate::config::PhysicsConfig;
-use crate::math::bitset::BitSet;
-use crate::math::rng::SimRng;
-use crate::math::vec2::Vec2;
 use crate::physics::body::{Body, Robot};
 use crate::physics::broadphase::{Candidates, NeighbourIndex};
 use rand::RngExt;

@@ -23,11 +23,11 @@
 //! pre-compensated so that the light is `v ^ LIGHT_GAMMA`, the curve the
 //! robots' calibration assumes ([`crate::scenario::panel`], `docs/display.md`).
 
+use crate::base::vec2::Vec2;
 use crate::config::validate::{check, positive, ConfigError};
 use crate::config::SimConfig;
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
-use crate::math::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 
 /// How a field image lies on the screen.

@@ -3,7 +3,9 @@
 //! the thesis' experiments.
 
 pub mod arena;
+pub mod arena_choice;
 pub mod panel;
+pub mod sensor_choice;
 pub mod sensor_setup;
 
 use crate::config::actuation::ActuationNoise;
@@ -314,6 +316,20 @@ pub enum ScenarioError {
     Field(FieldError),
     /// The policy file cannot be used.
     Policy(PolicyFileError),
+    /// A settings file (a screen arena, a robot sensor config) cannot be
+    /// read or is not valid.
+    SettingsFile {
+        /// What the file holds.
+        what: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// No built-in screen arena has this name.
+    UnknownArena(String),
+    /// A screen arena is needed where this arena (the thesis' square) was given.
+    NotAScreen(String),
 }
 
 impl fmt::Display for ScenarioError {
@@ -322,6 +338,21 @@ impl fmt::Display for ScenarioError {
             ScenarioError::Config(e) => write!(f, "invalid simulation settings: {e}"),
             ScenarioError::Field(e) => e.fmt(f),
             ScenarioError::Policy(e) => e.fmt(f),
+            ScenarioError::SettingsFile {
+                what,
+                path,
+                problem,
+            } => write!(f, "{what} {} {problem}", path.display()),
+            ScenarioError::UnknownArena(name) => write!(
+                f,
+                "unknown arena {name:?}: expected thesis, {} or a FILE.toml",
+                ArenaSpec::NAMES
+            ),
+            ScenarioError::NotAScreen(arena) => write!(
+                f,
+                "--arena {arena}: a screen arena is needed ({} or a FILE.toml), not the thesis' square",
+                ArenaSpec::NAMES
+            ),
         }
     }
 }

@@ -47,19 +47,6 @@ pub enum SensorSetup {
 }
 
 impl SensorSetup {
-    /// The models' names, as messages list them.
-    pub const NAMES: &'static str = "disc, disc-thesis, robot";
-
-    /// The model of a name (`robot` with default settings), or `None`.
-    pub fn from_name(name: &str) -> Option<SensorSetup> {
-        match name {
-            "disc" => Some(SensorSetup::Disc),
-            "disc-thesis" => Some(SensorSetup::DiscThesis),
-            "robot" => Some(SensorSetup::Robot(Box::default())),
-            _ => None,
-        }
-    }
-
     /// This setup with the robot sensor model's noise set to `noise`
     /// (in every part of a mix; the disc models have none).
     pub(crate) fn with_noise(&self, noise: &RobotNoise) -> SensorSetup {
@@ -180,17 +167,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn names_give_their_models_and_unknown_names_none() {
-        assert_eq!(SensorSetup::from_name("disc"), Some(SensorSetup::Disc));
-        assert_eq!(
-            SensorSetup::from_name("disc-thesis"),
-            Some(SensorSetup::DiscThesis)
-        );
-        assert_eq!(
-            SensorSetup::from_name("robot"),
-            Some(SensorSetup::Robot(Box::default()))
-        );
-        assert_eq!(SensorSetup::from_name("pixy"), None);
+    fn the_robot_setup_builds_the_robot_sensor_model() {
         let config = SimConfig::default();
         assert!(matches!(
             SensorSetup::Robot(Box::default()).build(&config),

@@ -3,9 +3,9 @@
 //! fixed to the robot's centre and heading, in the geometry of a
 //! [`DiscSensorConfig`].
 
+use crate::base::vec2::Vec2;
 use crate::config::disc_sensors::{DiscSensorConfig, ObstacleTargets, SensorDisc};
 use crate::fields::ScalarField;
-use crate::math::vec2::Vec2;
 use crate::physics::body::RobotKind;
 use crate::sensors::{Footprint, FootprintKind, SensorModel};
 use crate::world::{disc_overlaps, World};

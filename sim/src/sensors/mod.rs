@@ -10,8 +10,8 @@ pub mod pixy_camera;
 pub mod robot;
 pub mod robot_noise;
 
+use crate::base::vec2::Vec2;
 use crate::fields::ScalarField;
-use crate::math::vec2::Vec2;
 use crate::sensors::camera_memory::CameraMemory;
 use crate::world::World;
 use serde::{Deserialize, Serialize};

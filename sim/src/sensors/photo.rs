@@ -27,11 +27,11 @@
 //! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
 //! identical inputs identically.
 
+use crate::base::rng::SimRng;
+use crate::base::rounding;
+use crate::base::vec2::Vec2;
 use crate::config::validate::{check, ConfigError};
 use crate::fields::{FieldLayout, ScalarField};
-use crate::math::rng::SimRng;
-use crate::math::rounding;
-use crate::math::vec2::Vec2;
 use crate::sensors::robot_noise::RobotNoise;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};

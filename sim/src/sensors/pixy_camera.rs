@@ -34,8 +34,8 @@
 //! Block fields follow the Pixy: `width = right - left`, `x = left + width / 2`
 //! (integer), likewise for y, with inclusive pixel bounds.
 
+use crate::base::vec2::Vec2;
 use crate::config::validate::{check, positive, ConfigError};
-use crate::math::vec2::Vec2;
 use crate::physics::grid::Neighbour;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -888,8 +888,8 @@ mod reference;
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::rng::SimRng;
     use crate::config::SimConfig;
-    use crate::math::rng::SimRng;
     use crate::physics::body::RobotKind;
     use rand::{RngExt, SeedableRng};
     use shared::ImageRegion;

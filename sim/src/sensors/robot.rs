@@ -15,7 +15,7 @@
 //! then held for [`shared::camera::HOLD_PERIODS`] periods by the robot's
 //! [`CameraMemory`] as the firmware holds it; the photo-transistors read
 //! with their brightness gain and RC jitter. Every noise draw comes from a
-//! counter-based stream of the world's seed ([`crate::math::noise`]), and what
+//! counter-based stream of the world's seed ([`crate::base::noise`]), and what
 //! the model remembers is saved with a simulation's snapshot, so a run
 //! resumes bit-exactly.
 //!
@@ -24,9 +24,9 @@
 //! the firmware binary. The whole model is configured by a
 //! [`RobotSensorConfig`] (JSON, every field optional; `docs/robot-sensors.md`).
 
+use crate::base::noise::{self, Purpose};
 use crate::config::validate::ConfigError;
 use crate::fields::ScalarField;
-use crate::math::noise::{self, Purpose};
 use crate::sensors::camera_memory::CameraMemory;
 use crate::sensors::photo::PhotoNoise;
 use crate::sensors::photo::{PhotoSensorConfig, PhotoSensors};
@@ -251,8 +251,8 @@ impl SensorModel for RobotSensors {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::base::vec2::Vec2;
     use crate::config::SimConfig;
-    use crate::math::vec2::Vec2;
     use crate::physics::body::RobotKind;
     use shared::FieldValue;
 

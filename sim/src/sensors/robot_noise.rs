@@ -3,14 +3,14 @@
 //! brightness, and the camera's block jitter, missed and spurious blocks
 //! and dropped frames. Without noise ([`RobotNoise::NONE`], the default)
 //! the model is exactly the noiseless one. Every draw comes from
-//! [`crate::math::noise`], a function of the world's seed, the episode or step
+//! [`crate::base::noise`], a function of the world's seed, the episode or step
 //! and the robot.
 
+use crate::base::noise::{self, Purpose};
+use crate::base::rng::SimRng;
+use crate::base::rounding::round_half_away;
+use crate::base::vec2::Vec2;
 use crate::config::validate::{check, ConfigError};
-use crate::math::noise::{self, Purpose};
-use crate::math::rng::SimRng;
-use crate::math::rounding::round_half_away;
-use crate::math::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::PixyBlock;

@@ -5,10 +5,10 @@
 //! the future); deserialising rebuilds the index, so a checkpointed world
 //! resumes bit-exactly.
 
+use crate::base::rng::SimRng;
+use crate::base::vec2::Vec2;
 use crate::config::validate::ConfigError;
 use crate::config::{PhysicsConfig, SimConfig, WorldConfig};
-use crate::math::rng::SimRng;
-use crate::math::vec2::Vec2;
 use crate::physics::body::{Body, Robot, RobotKind};
 use crate::physics::broadphase::NeighbourIndex;
 use crate::physics::grid::Neighbour;
@@ -34,7 +34,7 @@ pub struct WorldState {
     /// Drawn for start positions and the coincident-centre nudge.
     pub rng: SimRng,
     /// The seed the world was created with, from which the noise models
-    /// draw ([`crate::math::noise`]).
+    /// draw ([`crate::base::noise`]).
     pub seed: u64,
     /// Episodes begun before the current one (resets so far).
     pub episode: u64,

@@ -22,9 +22,9 @@ impl Vec2 {
     }
 
     /// The unit vector at `angle` radians (0 = +x, growing clockwise on
-    /// screen), the same on every machine ([`crate::math::trig`]).
+    /// screen), the same on every machine ([`crate::base::trig`]).
     pub fn from_angle(angle: f64) -> Vec2 {
-        let (s, c) = crate::math::trig::sin_cos(angle);
+        let (s, c) = crate::base::trig::sin_cos(angle);
         Vec2 { x: c, y: s }
     }
 

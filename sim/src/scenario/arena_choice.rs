@@ -1,14 +1,13 @@
 //! `--arena` (and `arena = "..."` in training files): `thesis`, the
 //! reference model's 800 x 800 square; a built-in screen arena by name
-//! (`tv75`, [`sim::scenario::arena`]); or the path of a TOML file of a screen arena
+//! (`tv75`, [`ArenaSpec::by_name`]); or the path of a TOML file of a screen arena
 //! (every field optional, the rest `tv75`'s; `docs/robot-sensors.md`).
 //! Without one, runs with the robot's senses use `tv75` and the others the
 //! thesis' square.
 
-use anyhow::{Context, Result};
+use crate::scenario::arena::ArenaSpec;
+use crate::scenario::{Arena, ScenarioError};
 use serde::{Deserialize, Serialize};
-use sim::scenario::arena::ArenaSpec;
-use sim::scenario::Arena;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -44,19 +43,7 @@ impl FromStr for ArenaChoice {
     }
 }
 
-impl TryFrom<String> for ArenaChoice {
-    type Error = String;
-
-    fn try_from(s: String) -> Result<ArenaChoice, String> {
-        s.parse()
-    }
-}
-
-impl From<ArenaChoice> for String {
-    fn from(c: ArenaChoice) -> String {
-        c.to_string()
-    }
-}
+crate::text_form!(ArenaChoice);
 
 impl fmt::Display for ArenaChoice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -69,24 +56,28 @@ impl fmt::Display for ArenaChoice {
 }
 
 /// Reads and validates a screen arena file; errors name the file.
-pub fn read_arena(path: &Path) -> Result<ArenaSpec> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read arena file {}", path.display()))?;
-    let spec: ArenaSpec = toml::from_str(&text)
-        .with_context(|| format!("arena file {} is not valid", path.display()))?;
-    spec.validate()
-        .with_context(|| format!("arena file {}", path.display()))?;
+pub fn read_arena(path: &Path) -> Result<ArenaSpec, ScenarioError> {
+    let problem = |problem: String| ScenarioError::SettingsFile {
+        what: "arena file",
+        path: path.to_path_buf(),
+        problem,
+    };
+    let text =
+        std::fs::read_to_string(path).map_err(|e| problem(format!("cannot be read: {e}")))?;
+    let spec: ArenaSpec =
+        toml::from_str(&text).map_err(|e| problem(format!("is not valid: {e}")))?;
+    spec.validate().map_err(|e| problem(e.to_string()))?;
     Ok(spec)
 }
 
 impl ArenaChoice {
     /// The arena, a file read and checked.
-    pub fn arena(&self) -> Result<Arena> {
+    pub fn arena(&self) -> Result<Arena, ScenarioError> {
         Ok(match self {
             ArenaChoice::Thesis => Arena::default(),
             ArenaChoice::Named(name) => {
-                let spec =
-                    ArenaSpec::by_name(name).with_context(|| format!("unknown arena {name:?}"))?;
+                let spec = ArenaSpec::by_name(name)
+                    .ok_or_else(|| ScenarioError::UnknownArena(name.clone()))?;
                 Arena::Screen(Box::new(spec))
             }
             ArenaChoice::File(path) => Arena::Screen(Box::new(read_arena(path)?)),
@@ -95,13 +86,10 @@ impl ArenaChoice {
 
     /// The screen arena, for the tools of the TV (`host field export`,
     /// `host display`, `host observe`): the thesis' square is refused.
-    pub fn screen(&self) -> Result<ArenaSpec> {
+    pub fn screen(&self) -> Result<ArenaSpec, ScenarioError> {
         match self.arena()? {
             Arena::Screen(spec) => Ok(*spec),
-            Arena::Square(_) => {
-                let names = ArenaSpec::NAMES;
-                anyhow::bail!("--arena {self}: a screen arena is needed ({names} or a FILE.toml), not the thesis' square")
-            }
+            Arena::Square(_) => Err(ScenarioError::NotAScreen(self.to_string())),
         }
     }
 
@@ -150,13 +138,13 @@ mod tests {
         );
         let bad = dir.path().join("bad.toml");
         std::fs::write(&bad, "display_gamma = 0\n").unwrap();
-        let e = format!("{:#}", read_arena(&bad).unwrap_err());
+        let e = read_arena(&bad).unwrap_err().to_string();
         assert!(
             e.contains("bad.toml") && e.contains("arena.display_gamma"),
             "{e}"
         );
         std::fs::write(&bad, "robot_radius = 3\n").unwrap();
-        let e = format!("{:#}", read_arena(&bad).unwrap_err());
+        let e = read_arena(&bad).unwrap_err().to_string();
         assert!(e.contains("bad.toml") && e.contains("robot_radius"), "{e}");
     }
 }

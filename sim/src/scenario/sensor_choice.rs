@@ -1,17 +1,17 @@
 //! `--sensors` (and `sensors = "..."` in training and experiment files):
 //! a sensor model by name, `disc`, `disc-thesis` or `robot`
-//! ([`sim::scenario::sensor_setup`]), or `robot:FILE`, the robot sensor model with
+//! ([`SensorSetup`]), or `robot:FILE`, the robot sensor model with
 //! the settings of a JSON [`RobotSensorConfig`] file (every field
 //! optional; `docs/robot-sensors.md`), or a mix for ablations:
 //! `mix:FIELD+PUCKS+OBSTACLES`, the field values, puck bits and obstacle
 //! bits each of its own model (`mix:robot+disc+disc`), or
 //! `mix:FIELD+OBJECTS` with one model for both kinds of bits.
 
-use anyhow::{Context, Result};
+use crate::config::SimConfig;
+use crate::scenario::sensor_setup::{SelectedSensors, SensorSetup};
+use crate::scenario::ScenarioError;
+use crate::sensors::robot::RobotSensorConfig;
 use serde::{Deserialize, Serialize};
-use sim::config::SimConfig;
-use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
-use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -30,6 +30,11 @@ pub enum SensorChoice {
     /// Field values of the first, puck bits of the second, obstacle bits
     /// of the third.
     Mixed(Box<[SensorChoice; 3]>),
+}
+
+impl SensorChoice {
+    /// The sensor models by name.
+    pub const NAMES: &'static str = "disc, disc-thesis, robot";
 }
 
 impl FromStr for SensorChoice {
@@ -56,26 +61,14 @@ impl FromStr for SensorChoice {
                 Some(path) if !path.is_empty() => Ok(SensorChoice::Robot(Some(PathBuf::from(path)))),
                 _ => Err(format!(
                     "unknown sensor model {s:?}: expected {}, robot:CONFIG.json or mix:FIELD+OBJECTS",
-                    SensorSetup::NAMES
+                    SensorChoice::NAMES
                 )),
             },
         }
     }
 }
 
-impl TryFrom<String> for SensorChoice {
-    type Error = String;
-
-    fn try_from(s: String) -> Result<SensorChoice, String> {
-        s.parse()
-    }
-}
-
-impl From<SensorChoice> for String {
-    fn from(c: SensorChoice) -> String {
-        c.to_string()
-    }
-}
+crate::text_form!(SensorChoice);
 
 impl fmt::Display for SensorChoice {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -90,20 +83,23 @@ impl fmt::Display for SensorChoice {
 }
 
 /// Reads and validates a robot sensor config file; errors name the file.
-pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig> {
-    let text = std::fs::read_to_string(path)
-        .with_context(|| format!("cannot read robot sensor config {}", path.display()))?;
-    let config: RobotSensorConfig = serde_json::from_str(&text)
-        .with_context(|| format!("robot sensor config {} is not valid", path.display()))?;
-    config
-        .validate()
-        .with_context(|| format!("robot sensor config {}", path.display()))?;
+pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig, ScenarioError> {
+    let problem = |problem: String| ScenarioError::SettingsFile {
+        what: "robot sensor config",
+        path: path.to_path_buf(),
+        problem,
+    };
+    let text =
+        std::fs::read_to_string(path).map_err(|e| problem(format!("cannot be read: {e}")))?;
+    let config: RobotSensorConfig =
+        serde_json::from_str(&text).map_err(|e| problem(format!("is not valid: {e}")))?;
+    config.validate().map_err(|e| problem(e.to_string()))?;
     Ok(config)
 }
 
 impl SensorChoice {
     /// The sensor model with its settings (a config file read and checked).
-    pub fn setup(&self) -> Result<SensorSetup> {
+    pub fn setup(&self) -> Result<SensorSetup, ScenarioError> {
         Ok(match self {
             SensorChoice::Disc => SensorSetup::Disc,
             SensorChoice::DiscThesis => SensorSetup::DiscThesis,
@@ -129,7 +125,7 @@ impl SensorChoice {
     }
 
     /// The sensor model for the robots of `config`.
-    pub fn build(&self, config: &SimConfig) -> Result<SelectedSensors> {
+    pub fn build(&self, config: &SimConfig) -> Result<SelectedSensors, ScenarioError> {
         Ok(self.setup()?.build(config))
     }
 }
@@ -137,6 +133,26 @@ impl SensorChoice {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn names_give_their_models() {
+        assert_eq!(
+            "disc".parse::<SensorChoice>().unwrap().setup().unwrap(),
+            SensorSetup::Disc
+        );
+        assert_eq!(
+            "disc-thesis"
+                .parse::<SensorChoice>()
+                .unwrap()
+                .setup()
+                .unwrap(),
+            SensorSetup::DiscThesis
+        );
+        assert_eq!(
+            "robot".parse::<SensorChoice>().unwrap().setup().unwrap(),
+            SensorSetup::Robot(Box::default())
+        );
+    }
 
     #[test]
     fn choices_parse_print_and_errors_name_the_input() {
@@ -176,15 +192,14 @@ mod tests {
         assert_eq!(read_robot_config(&good).unwrap().camera.tilt_deg, 15.0);
         let bad = dir.path().join("bad.json");
         std::fs::write(&bad, r#"{"camera": {"height_mm": 0}}"#).unwrap();
-        let e = format!("{:#}", read_robot_config(&bad).unwrap_err());
+        let e = read_robot_config(&bad).unwrap_err().to_string();
         assert!(
             e.contains("bad.json") && e.contains("camera.height_mm"),
             "{e}"
         );
-        let e = format!(
-            "{:#}",
-            read_robot_config(&dir.path().join("none.json")).unwrap_err()
-        );
+        let e = read_robot_config(&dir.path().join("none.json"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("none.json"), "{e}");
     }
 }

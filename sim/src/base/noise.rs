@@ -7,7 +7,7 @@
 //! Normal draws are the sum of 12 uniforms less 6 (mean 0, variance 1,
 //! bounded by +-6), plain arithmetic that rounds the same on every machine.
 
-use crate::math::rng::SimRng;
+use crate::base::rng::SimRng;
 use rand::{RngExt, SeedableRng};
 
 /// What a draw is for: each use has its own stream.

@@ -1,0 +1,137 @@
+//! Learning: `host train` and `host experiment`.
+
+use clap::{Args, Subcommand};
+use host::experiment::shard::Shard;
+use host::experiment::RunOptions;
+use host::train::{TrainFlags, TrainRequest};
+use std::path::PathBuf;
+
+/// `host train`'s options.
+#[derive(Clone, Debug, Args)]
+pub struct TrainArgs {
+    /// TOML file with any of the settings (docs/training.md); flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The settings flags: every field of a training config.
+    #[command(flatten)]
+    pub flags: TrainFlags,
+    /// Train with the default real-world noise (domain randomisation, the
+    /// same as --noise 1; docs/robot-sensors.md).
+    #[arg(long, conflicts_with = "noise")]
+    pub randomise: bool,
+    /// Continue a run from its checkpoint, with its settings, for --steps more steps.
+    #[arg(long, conflicts_with_all = ["config", "init_from"])]
+    pub resume: Option<PathBuf>,
+    /// Start from the Q-table of a checkpoint (the thesis' RL2), or from a
+    /// policy blob (its actions preferred); hasher and actions must match.
+    #[arg(long)]
+    pub init_from: Option<PathBuf>,
+}
+
+impl TrainArgs {
+    /// The request these flags make.
+    pub fn request(self) -> TrainRequest {
+        TrainRequest {
+            config: self.config,
+            flags: self.flags,
+            randomise: self.randomise,
+            resume: self.resume,
+            init_from: self.init_from,
+        }
+    }
+}
+
+/// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
+#[derive(Clone, Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct ExperimentArgs {
+    /// `merge` or `report` instead of a run.
+    #[command(subcommand)]
+    pub action: Option<ExperimentAction>,
+    /// The run.
+    #[command(flatten)]
+    pub run: ExperimentRunArgs,
+}
+
+/// What `host experiment` does besides running one.
+#[derive(Clone, Debug, Subcommand)]
+pub enum ExperimentAction {
+    /// Join the output directories of the shards of one run (`--shard K/N`,
+    /// every K from 0 to N-1) into the outputs an unsharded run writes.
+    Merge {
+        /// The shards' output directories.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Output directory [default: out/experiments/<name>].
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// From the published trials (<docs>/<document>/<name>/trials/): every
+    /// experiment's table.md, trials.csv and figures, and the documents
+    /// <docs>/reproduction.md and <docs>/robot-sensors.md from their
+    /// templates (<docs>/<document>/template.md). Run from the repository
+    /// root.
+    Report {
+        /// The docs directory.
+        #[arg(long, default_value = "docs")]
+        docs: PathBuf,
+        /// Write nothing; fail if a document is not what the trials give.
+        #[arg(long, conflicts_with = "scale")]
+        check: bool,
+        /// The scale the published trials ran at (another than 1 renders a
+        /// quick run's page).
+        #[arg(long, default_value_t = 1.0)]
+        scale: f64,
+        /// Only these documents: reproduction, robot-sensors [default: both].
+        documents: Vec<String>,
+    },
+}
+
+/// `host experiment NAME`'s options.
+#[derive(Clone, Debug, Args)]
+pub struct ExperimentRunArgs {
+    /// annulus, transfer, letters, letters-generated, state-bits, obstacle,
+    /// collisions (the files of experiments/, built in), or the path of a
+    /// TOML file.
+    #[arg(required = true)]
+    pub experiment: Option<String>,
+    /// Trials per arm.
+    #[arg(long, default_value_t = 10)]
+    pub trials: usize,
+    /// Fraction of the thesis' step counts, for quick runs (e.g. 0.001).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Output directory [default: out/experiments/<name>, with --shard
+    /// out/experiments/<name>/shard-K-of-N].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Experiment seed, from which every trial's seed derives [default: the file's].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads [default: one per core].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Run only shard K of N (K from 0): every N-th trial, with the seeds of
+    /// the whole run; `host experiment merge` joins the shards.
+    #[arg(long)]
+    pub shard: Option<Shard>,
+    /// Another run's output directory (repeatable): its trials of the same
+    /// settings (config hash) are copied instead of run.
+    #[arg(long, value_name = "DIR")]
+    pub reuse: Vec<PathBuf>,
+}
+
+impl ExperimentRunArgs {
+    /// The run options these arguments give.
+    pub fn options(&self) -> RunOptions {
+        RunOptions {
+            trials: self.trials,
+            scale: self.scale,
+            out: self.out.clone(),
+            seed: self.seed,
+            threads: self.threads,
+            shard: self.shard,
+            reuse: self.reuse.clone(),
+        }
+    }
+}

@@ -1,0 +1,92 @@
+//! The command line: every `clap` type of `host`, by concern, and the
+//! conversions from flags into the libraries' plain settings (`main.rs`
+//! gives each command its own function).
+
+pub mod learn;
+pub mod robot;
+pub mod screen;
+pub mod simulate;
+
+use clap::{Parser, Subcommand};
+use learn::{ExperimentArgs, TrainArgs};
+use robot::{FlashArgs, MonitorArgs, ReplayArgs};
+use screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
+use simulate::{BenchArgs, RenderArgs, RunArgs};
+use std::path::PathBuf;
+
+/// Simulate, train and inspect policies for Zumo puck-construction swarms;
+/// flash robots, record and replay their logs.
+#[derive(Parser)]
+#[command(version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Run a simulation and print formations, stuck episodes, collisions,
+    /// mean Eval and speed.
+    Run(RunArgs),
+    /// Draw the world (after --steps steps) as a PNG, or animate an episode.
+    Render(RenderArgs),
+    /// Measure steps per second of the standard configuration (8 robots,
+    /// 250 pucks, annulus, orbital construction), single-threaded; with
+    /// --sensors robot, the same with the robot's senses and random turns.
+    Bench(BenchArgs),
+    /// Learn a policy with Q-learning: writes <out>/<name>.policy (the greedy
+    /// blob for the firmware) and <out>/<name>.ckpt (the complete training
+    /// state), and prints formations, stuck episodes, speed and state
+    /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
+    /// hasher, 2,000,000 steps, into out/.
+    Train(TrainArgs),
+    /// Run one of the thesis' experiments (trials in parallel, resumable)
+    /// and write CSV, JSON, a markdown table beside the thesis' numbers and
+    /// PNG figures into --out.
+    Experiment(ExperimentArgs),
+    /// Work with policy blob files.
+    #[command(subcommand)]
+    Policy(PolicyCommand),
+    /// Record a robot's serial log into a file (each frame with a host
+    /// timestamp) with a live status line; survives unplugging, Ctrl-C ends.
+    Monitor(MonitorArgs),
+    /// Check a recorded log (or a raw serial capture) against a policy:
+    /// divergences, state coverage, actions, faults, damaged records.
+    Replay(ReplayArgs),
+    /// Build the firmware with a policy and flash it with avrdude (double
+    /// press of reset); --dry-run prints the commands.
+    Flash(FlashArgs),
+    /// Work with fields on a screen arena.
+    #[command(subcommand)]
+    Field(FieldCommand),
+    /// Serve the web page that shows the field on the TV, its calibration
+    /// sequence and grey patches (docs/display.md).
+    Display(DisplayArgs),
+    /// Measure a run from a photo of the TV taken from above: the pucks,
+    /// Eval and whether the shape is formed (docs/display.md).
+    Observe(ObserveArgs),
+}
+
+#[derive(Subcommand)]
+pub enum FieldCommand {
+    /// Write the exact panel image the simulator's arena model assumes
+    /// (one pixel per panel pixel, pre-compensated for the display's gamma).
+    Export(FieldExportArgs),
+}
+
+#[derive(Subcommand)]
+pub enum PolicyCommand {
+    /// Print a blob's header and its state -> action table.
+    Inspect {
+        /// The policy blob file.
+        file: PathBuf,
+    },
+}
+
+/// A positive, finite number (lengths, scales).
+pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("{s:?} is not a positive number")),
+    }
+}

@@ -1,0 +1,91 @@
+//! Real robots: `host monitor`, `host replay` and `host flash`.
+
+use clap::Args;
+use shared::StateHasher;
+use std::path::PathBuf;
+
+/// `host monitor`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct MonitorArgs {
+    /// Serial port of the robot's TTL adapter or radio, e.g. /dev/ttyUSB0.
+    #[arg(long, required_unless_present = "list")]
+    pub port: Option<String>,
+    /// Baud rate (the firmware sends 115200 8N1).
+    #[arg(long, default_value_t = host::robot::monitor::DEFAULT_BAUD)]
+    pub baud: u32,
+    /// Recorded-log file to write (refused if it exists, unless --append).
+    #[arg(long, required_unless_present = "list")]
+    pub out: Option<PathBuf>,
+    /// Add to an existing recorded log instead of refusing it.
+    #[arg(long)]
+    pub append: bool,
+    /// Stop after recording this many frames (for scripts and tests).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// List the serial ports and exit.
+    #[arg(long)]
+    pub list: bool,
+}
+
+/// `host replay`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct ReplayArgs {
+    /// Recorded log from `host monitor`, or a raw capture of the serial line.
+    #[arg(long)]
+    pub log: PathBuf,
+    /// The policy blob the robot was flashed with.
+    #[arg(long)]
+    pub policy: PathBuf,
+    /// The policy's training checkpoint (`host train`'s .ckpt), or a JSON
+    /// file of visit counts per state (docs/robot-logs.md): reports the
+    /// states the robot met that training never visited.
+    #[arg(long)]
+    pub visits: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+    /// Write each robot's measured wheel_speed_factor and turn_bias to this
+    /// JSON file ({"robots": [...]}); an existing fit file keeps its other
+    /// robots, so the logs of a swarm merge into one file.
+    #[arg(long)]
+    pub fit_profile: Option<PathBuf>,
+    /// Millimetres per simulator unit (a tenth of the robot radius; 6.5 for
+    /// the Zumo in its 65 mm skirt on the TV arena).
+    #[arg(long, default_value_t = 6.5, value_parser = super::parse_positive)]
+    pub mm_per_unit: f64,
+    /// Wheel encoder counts per millimetre of track travel (909.7 / 119 on 75:1 motors).
+    #[arg(long, default_value_t = 909.7 / 119.0, value_parser = super::parse_positive)]
+    pub counts_per_mm: f64,
+    /// Distance between the tracks' centre lines, mm.
+    #[arg(long, default_value_t = 85.0, value_parser = super::parse_positive)]
+    pub track_mm: f64,
+}
+
+/// `host flash`'s options (docs/robot-logs.md).
+#[derive(Args)]
+pub struct FlashArgs {
+    /// The policy blob to embed.
+    #[arg(long)]
+    pub policy: PathBuf,
+    /// The bootloader's serial port (appears after a double press of reset), e.g. /dev/ttyACM0.
+    #[arg(long)]
+    pub port: Option<String>,
+    /// Build for this hasher; the policy must use it (default: the policy's own).
+    #[arg(long, value_parser = parse_hasher)]
+    pub hasher: Option<StateHasher>,
+    /// The zumo-swarm checkout to build in (default: the one around the current directory).
+    #[arg(long)]
+    pub repo: Option<PathBuf>,
+    /// The robot's id, 0..=255, built into the firmware and sent in every
+    /// log frame (default 0: none); give each robot of a swarm its own.
+    #[arg(long, default_value_t = 0)]
+    pub robot_id: u8,
+    /// Validate and print the exact commands; build and write nothing.
+    #[arg(long)]
+    pub dry_run: bool,
+}
+
+fn parse_hasher(s: &str) -> Result<StateHasher, String> {
+    StateHasher::from_name(s)
+        .ok_or_else(|| format!("{s:?} is not a hasher ({})", StateHasher::NAMES))
+}

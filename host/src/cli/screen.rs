@@ -1,0 +1,156 @@
+//! The field on the TV: `host field export`, `host display` and `host
+//! observe`.
+
+use anyhow::Result;
+use clap::Args;
+use host::display::DisplaySettings;
+use host::observe::ObserveSettings;
+use sim::fields::source::FieldSource;
+use sim::scenario::arena_choice::ArenaChoice;
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+
+/// The screen and field of the TV tools.
+#[derive(Args)]
+pub struct ScreenArgs {
+    /// tv75 (the thesis' 75" TV) or a FILE.toml of a screen arena.
+    #[arg(long, default_value = "tv75")]
+    pub arena: ArenaChoice,
+    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
+    #[arg(long, default_value = "annulus")]
+    pub field: FieldSource,
+}
+
+/// `host field export`'s options.
+#[derive(Args)]
+pub struct FieldExportArgs {
+    #[command(flatten)]
+    pub screen: ScreenArgs,
+    /// PNG file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// `host display`'s options.
+#[derive(Args)]
+pub struct DisplayArgs {
+    #[command(flatten)]
+    pub screen: ScreenArgs,
+    /// Address to listen on, IP or IP:PORT (0.0.0.0 for the TV's own
+    /// browser on the network).
+    #[arg(long, default_value = "127.0.0.1", value_parser = parse_bind)]
+    pub bind: Bind,
+    /// Port, when --bind names none (0: any free port).
+    #[arg(long, default_value_t = 8075)]
+    pub port: u16,
+    /// Seconds the calibration sequence holds white, then black.
+    #[arg(long, default_value_t = 3.0)]
+    pub hold: f64,
+}
+
+/// `--bind`: an address with or without a port.
+#[derive(Clone, Copy, Debug)]
+pub enum Bind {
+    /// Just the IP.
+    Ip(IpAddr),
+    /// IP and port.
+    Socket(SocketAddr),
+}
+
+fn parse_bind(s: &str) -> Result<Bind, String> {
+    s.parse::<SocketAddr>()
+        .map(Bind::Socket)
+        .or_else(|_| s.parse::<IpAddr>().map(Bind::Ip))
+        .map_err(|_| format!("{s:?} is not an IP address or IP:PORT"))
+}
+
+impl DisplayArgs {
+    /// The server's settings.
+    pub fn settings(self) -> Result<DisplaySettings> {
+        let bind = match self.bind {
+            Bind::Socket(a) => a,
+            Bind::Ip(ip) => SocketAddr::new(ip, self.port),
+        };
+        let hold_ms = self.hold * 1000.0;
+        anyhow::ensure!(
+            hold_ms.is_finite() && hold_ms >= 0.0,
+            "--hold {}: give a number of seconds, {} to {}",
+            self.hold,
+            f64::from(host::display::MIN_HOLD_MS) / 1000.0,
+            f64::from(host::display::MAX_HOLD_MS) / 1000.0
+        );
+        Ok(DisplaySettings {
+            arena: self.screen.arena.screen()?,
+            field: self.screen.field,
+            bind,
+            hold_ms: hold_ms.round().min(f64::from(u32::MAX)) as u32,
+        })
+    }
+}
+
+/// `host observe`'s options.
+#[derive(Args)]
+pub struct ObserveArgs {
+    /// Photo of the TV from above (JPEG or PNG).
+    #[arg(long)]
+    pub photo: PathBuf,
+    #[command(flatten)]
+    pub screen: ScreenArgs,
+    /// The screen's visible corners in the photo, pixels:
+    /// x,y of the panel's top-left, top-right, bottom-right, bottom-left.
+    #[arg(long, value_parser = parse_corners)]
+    pub corners: Corners,
+    /// The pucks' colour as the camera sees it, R,G,B [default: the
+    /// simulator's drawing's, 200,44,44].
+    #[arg(long, value_parser = parse_rgb)]
+    pub puck_colour: Option<[u8; 3]>,
+    /// PNG to write: the top-down photo with the detected pucks, above
+    /// them drawn over the field.
+    #[arg(long)]
+    pub picture: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `--corners`: four photo points.
+#[derive(Clone, Copy, Debug)]
+pub struct Corners(pub [[f64; 2]; 4]);
+
+fn parse_corners(s: &str) -> Result<Corners, String> {
+    let numbers: Vec<f64> = s
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{s:?}: the corners are 8 numbers x,y,x,y,x,y,x,y"))?;
+    let [a, b, c, d, e, f, g, h] = numbers[..] else {
+        return Err(format!(
+            "{s:?} has {} numbers: the corners are 8, x,y of 4 points",
+            numbers.len()
+        ));
+    };
+    Ok(Corners([[a, b], [c, d], [e, f], [g, h]]))
+}
+
+fn parse_rgb(s: &str) -> Result<[u8; 3], String> {
+    let parts: Option<Vec<u8>> = s.split(',').map(|t| t.trim().parse::<u8>().ok()).collect();
+    match parts.as_deref() {
+        Some(&[r, g, b]) => Ok([r, g, b]),
+        _ => Err(format!("{s:?} is not R,G,B (three numbers 0 to 255)")),
+    }
+}
+
+impl ObserveArgs {
+    /// The measurement's settings.
+    pub fn settings(self) -> Result<ObserveSettings> {
+        Ok(ObserveSettings {
+            photo: self.photo,
+            arena: self.screen.arena.screen()?,
+            field: self.screen.field,
+            corners: self.corners.0,
+            puck_colour: self.puck_colour.unwrap_or(sim::render::PUCK.0),
+            picture: self.picture,
+        })
+    }
+}
