@@ -3,7 +3,11 @@
 //!
 //! Each 20 ms period: encoder counts of the period before -> buttons -> field sensors (RC timing) -> Pixy blocks
 //! -> supervisor (mode, faults) -> decision -> motors -> EEPROM (after a
-//! calibration from the display's screens) -> LEDs -> log frame on USART1.
+//! calibration from the display's screens) -> LEDs -> log frame on USART1
+//! and, when a host holds the USB serial port open, on USB. USB is served
+//! while the loop waits (`board::usb`); after a 1200-baud touch the loop
+//! only waits, motors stopped, for the watchdog to reset the chip into the
+//! bootloader.
 #![cfg_attr(target_arch = "avr", no_std)]
 #![cfg_attr(target_arch = "avr", no_main)]
 #![cfg_attr(target_arch = "avr", feature(asm_experimental_arch))]
@@ -25,6 +29,7 @@ fn main() -> ! {
 
     let (mut board, scales) = board::Board::take();
     board.init();
+    board.usb_init(embedded::USB_SERIAL);
 
     let mut record = [0u8; RECORD_LEN];
     board.eeprom_read(CALIBRATION_EEPROM_ADDR, &mut record);
@@ -47,6 +52,9 @@ fn main() -> ! {
     board.watchdog_on();
     loop {
         board.wait_period();
+        if board.touched() {
+            continue;
+        }
         board.mark(4);
         let encoder_counts = board.take_encoder_counts();
         let buttons = board.buttons();
@@ -62,8 +70,14 @@ fn main() -> ! {
             &policy,
             embedded::MOTORS,
         );
+        // A touch during this period already stopped the motors: keep them so.
+        let source = if board.touched() {
+            firmware::supervisor::MotorSource::Stop
+        } else {
+            plan.motors
+        };
         let (decision, command) =
-            decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
+            decide_and_drive(&board, &decider, &times, camera.blocks(), source);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;
@@ -95,7 +109,9 @@ fn main() -> ! {
             encoder_counts,
         };
         let n = log.encode(&mut frame);
-        board.send(frame.get(..n).unwrap_or(&[]));
+        let bytes = frame.get(..n).unwrap_or(&[]);
+        board.send(bytes);
+        board.send_usb(bytes);
         board.mark(3);
     }
 }

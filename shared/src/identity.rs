@@ -49,6 +49,23 @@ impl FirmwareIdentity {
         ]
     }
 
+    /// The USB serial number the firmware presents (`robot-` and the robot
+    /// id in three digits, `robot-007`), so that `/dev/serial/by-id/`
+    /// tells robots apart.
+    pub const fn usb_serial(robot_id: u8) -> [u8; 9] {
+        [
+            b'r',
+            b'o',
+            b'b',
+            b'o',
+            b't',
+            b'-',
+            b'0' + robot_id / 100,
+            b'0' + robot_id / 10 % 10,
+            b'0' + robot_id % 10,
+        ]
+    }
+
     /// The CRC-32 a policy blob stores (its last 4 bytes, LE), or `None`
     /// for a slice too short to be a blob.
     pub fn policy_crc_of(blob: &[u8]) -> Option<u32> {
@@ -88,5 +105,12 @@ mod tests {
             Some(0xDEAD_BEEF)
         );
         assert_eq!(FirmwareIdentity::policy_crc_of(&[1, 2]), None);
+    }
+
+    #[test]
+    fn the_usb_serial_number_names_the_robot_in_three_digits() {
+        assert_eq!(&FirmwareIdentity::usb_serial(0), b"robot-000");
+        assert_eq!(&FirmwareIdentity::usb_serial(7), b"robot-007");
+        assert_eq!(&FirmwareIdentity::usb_serial(255), b"robot-255");
     }
 }
