@@ -28,7 +28,7 @@ use avr_device::interrupt::{self, Mutex};
 use core::arch::asm;
 use core::cell::{Cell, RefCell};
 use firmware::camera::{BusError, WordSource};
-use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS};
+use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS, USB_QUIET_TICKS};
 use firmware::embedded;
 use firmware::odometry::Quadrature;
 use firmware::pins;
@@ -348,7 +348,8 @@ impl Board {
         self.watchdog(WDE | WDP2);
     }
 
-    /// Feeds the watchdog and sets it to `setting` (WDTCSR: WDE + prescaler).
+    /// Sets the watchdog to `setting` (WDTCSR: WDE + prescaler) and feeds
+    /// it, before and after: the new timeout counts from the change.
     fn watchdog(&self, setting: u8) {
         avr_device::asm::wdr();
         // SAFETY: timed sequence (<= 4 cycles, interrupts off): WDCE|WDE, then the setting.
@@ -361,6 +362,7 @@ impl Board {
                 options(nostack),
             );
         });
+        avr_device::asm::wdr();
     }
 
     /// Timer3 now, in 4 us ticks.
@@ -373,7 +375,8 @@ impl Board {
         while self.now().wrapping_sub(from) < ticks {}
     }
 
-    /// Waits for the next control period, serving USB, and feeds the
+    /// Waits for the next control period, serving USB but for its last
+    /// [`USB_QUIET_TICKS`] (so that it starts on time), and feeds the
     /// watchdog unless a touch is pending. After an overrun the schedule
     /// restarts from now rather than catching up.
     pub fn wait_period(&mut self) {
@@ -381,9 +384,10 @@ impl Board {
         if self.now().wrapping_sub(self.period_start) >= PERIOD_TICKS {
             self.period_start = self.now();
         } else {
-            while self.now().wrapping_sub(self.period_start) < PERIOD_TICKS {
+            while self.now().wrapping_sub(self.period_start) < PERIOD_TICKS - USB_QUIET_TICKS {
                 self.serve_usb();
             }
+            self.wait_until(self.period_start, PERIOD_TICKS);
             self.period_start = next;
         }
         self.feed_watchdog();
@@ -434,14 +438,19 @@ impl Board {
             .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
         let t = self.now();
         self.wait_until(t, RC_CHARGE_US.div_ceil(TICK_US) + 1);
-        f.ddrf()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        f.portf()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        d.ddrd()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
-        d.portd()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        // Inputs without pull-up, with interrupts off for these few cycles:
+        // an encoder interrupt between a DDR and its PORT write would leave
+        // the pull-up on while the sensor discharges.
+        interrupt::free(|_| {
+            f.ddrf()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+            f.portf()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+            d.ddrd()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+            d.portd()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        });
         // Poll: only sample the pins and the timer; `Discharge` notes when a
         // sensor is first seen low and works the times out afterwards.
         let mut discharge = Discharge::start(self.now());

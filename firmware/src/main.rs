@@ -20,11 +20,9 @@ mod board;
 #[avr_device::entry]
 fn main() -> ! {
     use firmware::calibration_record::{self, RECORD_LEN};
-    use firmware::camera::Camera;
     use firmware::config::{CALIBRATION_EEPROM_ADDR, CAMERA, UNCALIBRATED};
     use firmware::decision::Decider;
     use firmware::embedded;
-    use firmware::supervisor::Supervisor;
     use shared::LogFrame;
 
     let (mut board, scales) = board::Board::take();
@@ -38,9 +36,11 @@ fn main() -> ! {
     let policy = board::FlashPolicy;
     // The curves stay in place (static RAM): each period's decider borrows them.
     scales.calibrate(&calibration);
-    let mut supervisor = Supervisor::new(stored.is_some());
-    let mut camera = Camera::new();
-    let mut frame = [0u8; LogFrame::MAX_ENCODED_LEN];
+    let LoopState {
+        supervisor,
+        camera,
+        frame,
+    } = loop_state(stored.is_some());
     // Frames since the log last carried the calibration in use: it goes out
     // in the first frame, after a new one takes effect, and every
     // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
@@ -108,11 +108,39 @@ fn main() -> ! {
             robot_id,
             encoder_counts,
         };
-        let n = log.encode(&mut frame);
+        let n = log.encode(frame);
         let bytes = frame.get(..n).unwrap_or(&[]);
         board.send(bytes);
         board.send_usb(bytes);
         board.mark(3);
+    }
+}
+
+/// The control loop's state across periods, in static RAM: on the stack
+/// it made the loop's frame about 550 bytes deep, which left too little
+/// room above the bootloader key at 0x0800 (docs/firmware.md, "Measured").
+#[cfg(target_arch = "avr")]
+struct LoopState {
+    supervisor: firmware::supervisor::Supervisor,
+    camera: firmware::camera::Camera,
+    frame: [u8; shared::LogFrame::MAX_ENCODED_LEN],
+}
+
+#[cfg(target_arch = "avr")]
+static mut LOOP_STATE: core::mem::MaybeUninit<LoopState> = core::mem::MaybeUninit::uninit();
+
+/// Sets up the loop's state in place (out of line: its temporaries stay
+/// out of the loop's frame). Called once.
+#[cfg(target_arch = "avr")]
+#[inline(never)]
+fn loop_state(calibrated: bool) -> &'static mut LoopState {
+    // SAFETY: called once, before the loop: the only reference ever made.
+    unsafe {
+        (*core::ptr::addr_of_mut!(LOOP_STATE)).write(LoopState {
+            supervisor: firmware::supervisor::Supervisor::new(calibrated),
+            camera: firmware::camera::Camera::new(),
+            frame: [0; shared::LogFrame::MAX_ENCODED_LEN],
+        })
     }
 }
 

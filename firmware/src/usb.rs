@@ -1,12 +1,14 @@
-//! The USB serial port's logic: what the board layer's driver for the
-//! ATmega32U4's USB controller (`src/board/usb.rs`) and the control loop
-//! decide without touching a register, tested on the host.
+//! The USB serial port's logic, a minimal CDC-ACM device of our own (why
+//! not `usb-device`: `docs/firmware.md`): what the board layer's driver
+//! for the ATmega32U4's USB controller (`src/board/usb.rs`) decides
+//! without touching a register, tested on the host.
 //!
-//! - [`EndpointTable`]: the endpoints `usb-device` allocates (the control
-//!   endpoint, then `usbd-serial`'s notification, bulk OUT and bulk IN
-//!   endpoints, numbered 1, 2, 3), each one's UECFG0X/UECFG1X bytes, and
-//!   the controller's limits: 7 endpoints, 832 bytes of endpoint memory,
-//!   64 bytes per endpoint but endpoint 1 (256), one bank each.
+//! - [`Control`]: the answer to each setup packet on endpoint 0 (the
+//!   standard requests of a device with one configuration, and CDC-ACM's
+//!   SET_LINE_CODING, GET_LINE_CODING, SET_CONTROL_LINE_STATE, SEND_BREAK;
+//!   anything else stalls), with the descriptors it sends
+//!   ([`DEVICE_DESCRIPTOR`], [`CONFIG_DESCRIPTOR`], strings) and the
+//!   endpoints the configuration sets up ([`ENDPOINT_CONFIG`]).
 //! - [`LogQueue`]: the log frames waiting for the bulk IN endpoint. A frame
 //!   goes in whole or not at all (dropped, counted), so a host that stops
 //!   reading never blocks the control period and never sees half a frame;
@@ -21,9 +23,6 @@
 //! sketch on an A-Star 32U4 or a Zumo 32U4 (`../shared/docs/hardware.md`
 //! section 6), the serial number is `robot-NNN` from the robot id
 //! (`shared::FirmwareIdentity::usb_serial`).
-
-use usb_device::endpoint::{EndpointAddress, EndpointType};
-use usb_device::{UsbDirection, UsbError};
 
 /// Vendor id: Pololu (the A-Star 32U4 and Zumo 32U4 boards' vendor).
 pub const VID: u16 = 0x1FFB;
@@ -44,130 +43,288 @@ pub const BOOT_KEY: u16 = 0x7777;
 /// Where the bootloader looks for [`BOOT_KEY`].
 pub const BOOT_KEY_ADDR: u16 = 0x0800;
 
-/// Endpoints of the ATmega32U4's USB controller.
-pub const ENDPOINTS: usize = 7;
-/// Largest packet of each endpoint.
-const MAX_SIZE: [u16; ENDPOINTS] = [64, 256, 64, 64, 64, 64, 64];
-/// The controller's endpoint memory (DPRAM), bytes.
-const DPRAM: u16 = 832;
+/// The device descriptor: USB 2.0, class EF/02/01 (a function made of an
+/// interface association), endpoint 0 of 64 bytes, [`VID`]/[`PID`],
+/// release 1.00, strings 1 (manufacturer), 2 (product), 3 (serial number),
+/// one configuration.
+pub const DEVICE_DESCRIPTOR: [u8; 18] = {
+    let (v, p) = (VID.to_le_bytes(), PID.to_le_bytes());
+    [
+        18, 1, 0x00, 0x02, 0xEF, 0x02, 0x01, 64, v[0], v[1], p[0], p[1], 0x00, 0x01, 1, 2, 3, 1,
+    ]
+};
 
-/// One endpoint's configuration, as the controller takes it.
+/// The notification endpoint (interrupt IN, 8 bytes).
+pub const NOTIFY_EP: u8 = 1;
+/// The data endpoint the host writes to (bulk OUT, 64 bytes).
+pub const OUT_EP: u8 = 2;
+/// The data endpoint the log frames go out on (bulk IN, 64 bytes).
+pub const IN_EP: u8 = 3;
+
+/// The configuration descriptor, 75 bytes: bus powered, 100 mA; an
+/// interface association of interfaces 0 and 1 (CDC, ACM); interface 0
+/// (CDC communication, ACM, no protocol) with its header (CDC 1.10), call
+/// management, ACM (capabilities: line coding and control line state) and
+/// union functional descriptors and the notification endpoint (interrupt
+/// IN 1, 8 bytes, every 255 ms); interface 1 (CDC data) with bulk OUT 2
+/// and bulk IN 3, 64 bytes each.
+pub const CONFIG_DESCRIPTOR: [u8; 75] = [
+    9,
+    2,
+    75,
+    0,
+    2,
+    1,
+    0,
+    0x80,
+    50, // configuration
+    8,
+    11,
+    0,
+    2,
+    0x02,
+    0x02,
+    0x00,
+    0, // interface association
+    9,
+    4,
+    0,
+    0,
+    1,
+    0x02,
+    0x02,
+    0x00,
+    0, // interface 0: CDC ACM
+    5,
+    0x24,
+    0x00,
+    0x10,
+    0x01, // header: CDC 1.10
+    5,
+    0x24,
+    0x01,
+    0x00,
+    1, // call management: data interface 1
+    4,
+    0x24,
+    0x02,
+    0x02, // ACM: line coding and control line state
+    5,
+    0x24,
+    0x06,
+    0,
+    1, // union: 0 controls 1
+    7,
+    5,
+    0x80 | NOTIFY_EP,
+    0x03,
+    8,
+    0,
+    255, // interrupt IN
+    9,
+    4,
+    1,
+    0,
+    2,
+    0x0A,
+    0x00,
+    0x00,
+    0, // interface 1: CDC data
+    7,
+    5,
+    OUT_EP,
+    0x02,
+    64,
+    0,
+    0, // bulk OUT
+    7,
+    5,
+    0x80 | IN_EP,
+    0x02,
+    64,
+    0,
+    0, // bulk IN
+];
+
+/// String descriptor 0: the languages (English, US).
+const LANGUAGES: [u8; 4] = [4, 3, 0x09, 0x04];
+
+/// Each endpoint's configuration (UECFG0X: type and direction; UECFG1X:
+/// size and one bank, ALLOC), as SET_CONFIGURATION sets them up, with
+/// endpoint 0's first.
+pub const ENDPOINT_CONFIG: [(u8, u8, u8); 4] = [
+    (0, 0x00, 0x32),         // control, 64 bytes
+    (NOTIFY_EP, 0xC1, 0x02), // interrupt IN, 8 bytes
+    (OUT_EP, 0x80, 0x32),    // bulk OUT, 64 bytes
+    (IN_EP, 0x81, 0x32),     // bulk IN, 64 bytes
+];
+
+/// Data for the IN data stage of a control transfer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct EndpointConfig {
-    /// Control, bulk, interrupt (isochronous is refused).
-    pub kind: EndpointType,
-    /// IN (device to host).
-    pub is_in: bool,
-    /// Packet size, 8..=256 bytes, a power of two.
-    pub size: u16,
+pub enum Payload {
+    /// Bytes as they are.
+    Bytes(&'static [u8]),
+    /// A string descriptor made from ASCII text (UTF-16LE).
+    Ascii(&'static str),
+    /// The line coding (7 bytes).
+    LineCoding([u8; 7]),
+    /// A two-byte status or a one-byte configuration value.
+    Short([u8; 2], u8),
 }
 
-impl EndpointConfig {
-    /// UECFG0X: EPTYPE (bits 7..6), EPDIR (bit 0).
-    pub fn uecfg0x(&self) -> u8 {
-        let kind = match self.kind {
-            EndpointType::Control => 0b00,
-            EndpointType::Isochronous { .. } => 0b01,
-            EndpointType::Bulk => 0b10,
-            EndpointType::Interrupt => 0b11,
-        };
-        kind << 6 | u8::from(self.is_in)
-    }
-
-    /// UECFG1X: EPSIZE (bits 6..4: 8 << EPSIZE bytes), one bank (EPBK
-    /// 00), ALLOC (bit 1).
-    pub fn uecfg1x(&self) -> u8 {
-        let code = self.size.trailing_zeros() as u8 - 3;
-        code << 4 | 1 << 1
-    }
-
-    /// Whether the endpoint is the control endpoint.
-    pub fn is_control(&self) -> bool {
-        self.kind == EndpointType::Control
-    }
-}
-
-/// The endpoints allocated so far.
-#[derive(Clone, Debug, Default)]
-pub struct EndpointTable {
-    endpoints: [Option<EndpointConfig>; ENDPOINTS],
-    dpram_used: u16,
-}
-
-impl EndpointTable {
-    /// An empty table.
-    pub const fn new() -> EndpointTable {
-        EndpointTable {
-            endpoints: [None; ENDPOINTS],
-            dpram_used: 0,
+impl Payload {
+    /// Its length in bytes.
+    pub fn len(&self) -> usize {
+        match self {
+            Payload::Bytes(b) => b.len(),
+            Payload::Ascii(s) => 2 + 2 * s.len(),
+            Payload::LineCoding(_) => 7,
+            Payload::Short(_, n) => usize::from(*n),
         }
     }
 
-    /// Allocates an endpoint (`usb_device::bus::UsbBus::alloc_ep`): the
-    /// address asked for, or the lowest free endpoint above 0 that can
-    /// hold `max_packet` bytes. The control endpoint is allocated twice
-    /// (OUT and IN) and configured once, as OUT.
-    pub fn alloc(
-        &mut self,
-        dir: UsbDirection,
-        addr: Option<EndpointAddress>,
-        kind: EndpointType,
-        max_packet: u16,
-    ) -> Result<EndpointAddress, UsbError> {
-        if matches!(kind, EndpointType::Isochronous { .. }) {
-            return Err(UsbError::Unsupported);
+    /// Whether it is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Its byte `i` (0 past the end).
+    pub fn byte(&self, i: usize) -> u8 {
+        match self {
+            Payload::Bytes(b) => b.get(i).copied().unwrap_or(0),
+            Payload::Ascii(s) => match i {
+                0 => self.len().min(255) as u8,
+                1 => 3,
+                i if i % 2 == 0 => s.as_bytes().get(i / 2 - 1).copied().unwrap_or(0),
+                _ => 0,
+            },
+            Payload::LineCoding(c) => c.get(i).copied().unwrap_or(0),
+            Payload::Short(b, _) => b.get(i).copied().unwrap_or(0),
         }
-        let index = match addr {
-            Some(a) if a.index() == 0 && kind == EndpointType::Control => {
-                if self.endpoints[0].is_some() {
-                    return Ok(a);
+    }
+}
+
+/// The answer to a setup packet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reply {
+    /// Send the first `len` bytes of the payload (the request's length
+    /// cuts it), then take the host's status packet.
+    In(Payload, u16),
+    /// No data stage: acknowledge with a zero-length packet.
+    Ack,
+    /// SET_ADDRESS: acknowledge, then enable the address once the
+    /// acknowledgement has gone out.
+    Address(u8),
+    /// SET_CONFIGURATION 1: set up the serial port's endpoints, acknowledge.
+    Configure,
+    /// A data stage from the host follows (SET_LINE_CODING): pass it to
+    /// [`Control::line_coding_out`], then acknowledge.
+    ReceiveLineCoding,
+    /// Not supported: stall endpoint 0 until the next setup packet.
+    Stall,
+}
+
+/// The serial port's control state: configuration, line coding, DTR.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Control {
+    configured: bool,
+    line_coding: [u8; 7],
+    dtr: bool,
+}
+
+impl Default for Control {
+    fn default() -> Self {
+        Control::new()
+    }
+}
+
+/// Line coding until the host sets one: 9600 baud, 8N1.
+const DEFAULT_LINE_CODING: [u8; 7] = [0x80, 0x25, 0, 0, 0, 0, 8];
+
+impl Control {
+    /// After power-up or a bus reset: unconfigured, 9600 8N1, DTR low.
+    pub const fn new() -> Control {
+        Control {
+            configured: false,
+            line_coding: DEFAULT_LINE_CODING,
+            dtr: false,
+        }
+    }
+
+    /// The answer to a setup packet (standard requests of a device, the
+    /// CDC-ACM class requests of interface 0); `serial` is the serial
+    /// number string.
+    pub fn setup(&mut self, packet: &[u8; 8], serial: &'static str) -> Reply {
+        let [kind, request, v0, v1, i0, _, l0, l1] = *packet;
+        let (value, length) = (u16::from_le_bytes([v0, v1]), u16::from_le_bytes([l0, l1]));
+        let n = |p: Payload| Reply::In(p, length.min(p.len() as u16));
+        match (kind, request) {
+            // Standard, device.
+            (0x80, 0x06) => match v1 {
+                1 => n(Payload::Bytes(&DEVICE_DESCRIPTOR)),
+                2 if v0 == 0 => n(Payload::Bytes(&CONFIG_DESCRIPTOR)),
+                3 => match v0 {
+                    0 => n(Payload::Bytes(&LANGUAGES)),
+                    1 => n(Payload::Ascii(MANUFACTURER)),
+                    2 => n(Payload::Ascii(PRODUCT)),
+                    3 => n(Payload::Ascii(serial)),
+                    _ => Reply::Stall,
+                },
+                _ => Reply::Stall,
+            },
+            (0x00, 0x05) => Reply::Address(v0 & 0x7F),
+            (0x00, 0x09) => match value {
+                0 => {
+                    self.configured = false;
+                    self.dtr = false;
+                    Reply::Ack
                 }
-                0
-            }
-            Some(a) => {
-                let i = a.index();
-                if i == 0 || i >= ENDPOINTS || self.endpoints[i].is_some() {
-                    return Err(UsbError::InvalidEndpoint);
+                1 => {
+                    self.configured = true;
+                    Reply::Configure
                 }
-                i
+                _ => Reply::Stall,
+            },
+            (0x80, 0x08) => n(Payload::Short([u8::from(self.configured), 0], 1)),
+            (0x80 | 0x81 | 0x82, 0x00) => n(Payload::Short([0, 0], 2)),
+            // CLEAR_FEATURE / SET_FEATURE (endpoint halt, remote wake-up): accepted.
+            (0x00..=0x02, 0x01 | 0x03) => Reply::Ack,
+            (0x81, 0x0A) => n(Payload::Short([0, 0], 1)),
+            (0x01, 0x0B) => Reply::Ack,
+            // CDC class, interface 0.
+            (0x21, 0x20) if i0 == 0 && length == 7 => Reply::ReceiveLineCoding,
+            (0xA1, 0x21) if i0 == 0 => n(Payload::LineCoding(self.line_coding)),
+            (0x21, 0x22) if i0 == 0 => {
+                self.dtr = value & 1 != 0;
+                Reply::Ack
             }
-            None => (1..ENDPOINTS)
-                .find(|&i| self.endpoints[i].is_none() && max_packet <= MAX_SIZE[i])
-                .ok_or(UsbError::EndpointOverflow)?,
-        };
-        let size = max_packet.max(8).next_power_of_two();
-        if size > MAX_SIZE[index] {
-            return Err(UsbError::EndpointMemoryOverflow);
+            (0x21, 0x23) if i0 == 0 => Reply::Ack, // SEND_BREAK
+            _ => Reply::Stall,
         }
-        if DPRAM - self.dpram_used < size {
-            return Err(UsbError::EndpointMemoryOverflow);
+    }
+
+    /// The SET_LINE_CODING data stage: 7 bytes (baud LE, stop bits,
+    /// parity, data bits); anything else is ignored.
+    pub fn line_coding_out(&mut self, data: &[u8]) {
+        if let Ok(coding) = <[u8; 7]>::try_from(data) {
+            self.line_coding = coding;
         }
-        self.dpram_used += size;
-        self.endpoints[index] = Some(EndpointConfig {
-            kind,
-            // The control endpoint is configured as OUT; it answers both ways.
-            is_in: dir == UsbDirection::In && kind != EndpointType::Control,
-            size,
-        });
-        Ok(EndpointAddress::from_parts(index, dir))
     }
 
-    /// The endpoint's configuration, if it was allocated.
-    pub fn get(&self, index: usize) -> Option<EndpointConfig> {
-        self.endpoints.get(index).copied().flatten()
+    /// Whether the host set configuration 1.
+    pub fn configured(&self) -> bool {
+        self.configured
     }
 
-    /// The allocated endpoints in order, with their numbers.
-    pub fn allocated(&self) -> impl Iterator<Item = (usize, EndpointConfig)> + '_ {
-        self.endpoints
-            .iter()
-            .enumerate()
-            .filter_map(|(i, e)| e.map(|e| (i, e)))
+    /// The line coding's baud rate.
+    pub fn baud(&self) -> u32 {
+        let c = self.line_coding;
+        u32::from_le_bytes([c[0], c[1], c[2], c[3]])
     }
 
-    /// Endpoint memory in use, bytes.
-    pub fn dpram_used(&self) -> u16 {
-        self.dpram_used
+    /// Whether the host holds the port open (DTR).
+    pub fn dtr(&self) -> bool {
+        self.dtr
     }
 }
 
@@ -302,102 +459,116 @@ impl Touch {
 mod tests {
     extern crate std;
     use super::*;
+    use std::string::String;
     use std::vec::Vec;
 
-    fn cdc_table() -> (EndpointTable, [EndpointAddress; 5]) {
-        let mut t = EndpointTable::new();
-        let ep0 = Some(EndpointAddress::from_parts(0, UsbDirection::Out));
-        let ep0_in = Some(EndpointAddress::from_parts(0, UsbDirection::In));
-        // The order usb-device and usbd-serial allocate in.
-        let addrs = [
-            t.alloc(UsbDirection::Out, ep0, EndpointType::Control, 64)
-                .unwrap(),
-            t.alloc(UsbDirection::In, ep0_in, EndpointType::Control, 64)
-                .unwrap(),
-            t.alloc(UsbDirection::In, None, EndpointType::Interrupt, 8)
-                .unwrap(),
-            t.alloc(UsbDirection::Out, None, EndpointType::Bulk, 64)
-                .unwrap(),
-            t.alloc(UsbDirection::In, None, EndpointType::Bulk, 64)
-                .unwrap(),
-        ];
-        (t, addrs)
+    fn request(kind: u8, request: u8, value: u16, index: u16, length: u16) -> [u8; 8] {
+        let (v, i, l) = (
+            value.to_le_bytes(),
+            index.to_le_bytes(),
+            length.to_le_bytes(),
+        );
+        [kind, request, v[0], v[1], i[0], i[1], l[0], l[1]]
+    }
+
+    fn bytes(p: Payload, len: u16) -> Vec<u8> {
+        (0..usize::from(len)).map(|i| p.byte(i)).collect()
     }
 
     #[test]
-    fn the_serial_ports_endpoints_are_numbered_0_to_3_with_the_controllers_config_bytes() {
-        let (t, addrs) = cdc_table();
-        let numbers: Vec<_> = addrs.iter().map(|a| (a.index(), a.is_in())).collect();
+    fn descriptors_are_answered_cut_to_the_length_asked_for() {
+        let mut c = Control::new();
+        let Reply::In(p, len) = c.setup(&request(0x80, 6, 0x0100, 0, 64), "robot-003") else {
+            panic!("device descriptor not sent");
+        };
+        assert_eq!(bytes(p, len), DEVICE_DESCRIPTOR);
         assert_eq!(
-            numbers,
-            [(0, false), (0, true), (1, true), (2, false), (3, true)]
+            c.setup(&request(0x80, 6, 0x0200, 0, 9), "robot-003"),
+            Reply::In(Payload::Bytes(&CONFIG_DESCRIPTOR), 9)
         );
-        let cfg: Vec<_> = t
-            .allocated()
-            .map(|(i, c)| (i, c.uecfg0x(), c.uecfg1x()))
+        let Reply::In(p, len) = c.setup(&request(0x80, 6, 0x0303, 0x0409, 255), "robot-003") else {
+            panic!("serial number not sent");
+        };
+        let units: Vec<u16> = bytes(p, len)[2..]
+            .chunks(2)
+            .map(|c| u16::from_le_bytes([c[0], c[1]]))
             .collect();
-        // control OUT 64; interrupt IN 8; bulk OUT 64; bulk IN 64; ALLOC set, one bank.
-        assert_eq!(
-            cfg,
-            [
-                (0, 0x00, 0x32),
-                (1, 0xC1, 0x02),
-                (2, 0x80, 0x32),
-                (3, 0x81, 0x32)
-            ]
-        );
-        assert_eq!(t.dpram_used(), 64 + 8 + 64 + 64);
-        assert!(t.get(0).unwrap().is_control() && t.get(4).is_none());
+        assert_eq!(String::from_utf16(&units).unwrap(), "robot-003");
+        assert_eq!((p.byte(0), p.byte(1)), (20, 3));
+        assert_eq!(c.setup(&request(0x80, 6, 0x0304, 0, 255), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x80, 6, 0x0600, 0, 10), ""), Reply::Stall);
     }
 
     #[test]
-    fn allocation_refuses_what_the_controller_cannot_do() {
-        let mut t = EndpointTable::new();
-        let at = |i| Some(EndpointAddress::from_parts(i, UsbDirection::In));
-        assert_eq!(
-            t.alloc(UsbDirection::In, at(2), EndpointType::Bulk, 128),
-            Err(UsbError::EndpointMemoryOverflow)
-        );
-        assert!(t
-            .alloc(UsbDirection::In, at(1), EndpointType::Bulk, 256)
-            .is_ok());
-        assert_eq!(
-            t.alloc(UsbDirection::In, at(1), EndpointType::Bulk, 8),
-            Err(UsbError::InvalidEndpoint)
-        );
-        assert_eq!(
-            t.alloc(UsbDirection::In, at(7), EndpointType::Bulk, 8),
-            Err(UsbError::InvalidEndpoint)
-        );
-        for _ in 2..ENDPOINTS {
-            t.alloc(UsbDirection::Out, None, EndpointType::Bulk, 64)
-                .unwrap();
+    fn the_configuration_descriptor_is_well_formed_and_its_endpoints_match_the_setup() {
+        let d = &CONFIG_DESCRIPTOR;
+        assert_eq!(usize::from(u16::from_le_bytes([d[2], d[3]])), d.len());
+        let mut at = 0;
+        let mut endpoints = Vec::new();
+        while at < d.len() {
+            let len = usize::from(d[at]);
+            assert!(len >= 2 && at + len <= d.len(), "descriptor at {at}");
+            if d[at + 1] == 5 {
+                endpoints.push((d[at + 2], d[at + 3], d[at + 4]));
+            }
+            at += len;
         }
-        assert_eq!(t.dpram_used(), 256 + 5 * 64);
-        assert_eq!(
-            t.alloc(UsbDirection::Out, None, EndpointType::Bulk, 8),
-            Err(UsbError::EndpointOverflow)
-        );
-        let mut u = EndpointTable::new();
-        for _ in 1..4 {
-            u.alloc(UsbDirection::Out, None, EndpointType::Bulk, 64)
-                .unwrap();
-        }
-        assert_eq!(
-            u.alloc(
-                UsbDirection::Out,
-                None,
-                EndpointType::Isochronous {
-                    synchronization:
-                        usb_device::endpoint::IsochronousSynchronizationType::NoSynchronization,
-                    usage: usb_device::endpoint::IsochronousUsageType::Data,
-                },
-                64
-            ),
-            Err(UsbError::Unsupported)
-        );
+        assert_eq!(at, d.len());
+        let configured: Vec<_> = ENDPOINT_CONFIG[1..]
+            .iter()
+            .map(|&(n, cfg0, cfg1)| {
+                let dir = if cfg0 & 1 != 0 { 0x80 } else { 0 };
+                (n | dir, cfg0 >> 6, 8u8 << (cfg1 >> 4))
+            })
+            .collect();
+        assert_eq!(endpoints, configured);
     }
 
+    #[test]
+    fn cdc_requests_set_the_line_coding_and_dtr_and_others_stall() {
+        let mut c = Control::new();
+        assert_eq!(c.baud(), 9600);
+        assert_eq!(c.setup(&request(0x00, 5, 12, 0, 0), ""), Reply::Address(12));
+        assert_eq!(c.setup(&request(0x00, 9, 1, 0, 0), ""), Reply::Configure);
+        assert!(c.configured());
+        assert_eq!(
+            c.setup(&request(0x21, 0x20, 0, 0, 7), ""),
+            Reply::ReceiveLineCoding
+        );
+        c.line_coding_out(&[0x00, 0xC2, 0x01, 0x00, 0, 0, 8]);
+        assert_eq!(c.baud(), 115_200);
+        c.line_coding_out(&[1, 2, 3]);
+        assert_eq!(c.baud(), 115_200, "a short data stage is ignored");
+        let Reply::In(p, len) = c.setup(&request(0xA1, 0x21, 0, 0, 7), "") else {
+            panic!("line coding not sent");
+        };
+        assert_eq!(bytes(p, len), [0x00, 0xC2, 0x01, 0x00, 0, 0, 8]);
+        assert_eq!(c.setup(&request(0x21, 0x22, 3, 0, 0), ""), Reply::Ack);
+        assert!(c.dtr());
+        assert_eq!(c.setup(&request(0x21, 0x22, 2, 0, 0), ""), Reply::Ack);
+        assert!(!c.dtr());
+        assert_eq!(c.setup(&request(0xA1, 0x7F, 0, 0, 4), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x21, 0x20, 0, 0, 3), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x00, 9, 0, 0, 0), ""), Reply::Ack);
+        assert!(!c.configured());
+    }
+
+    #[test]
+    fn any_setup_packet_gets_an_answer_without_panicking() {
+        let mut c = Control::new();
+        for kind in [0x00u8, 0x01, 0x02, 0x21, 0x80, 0x81, 0x82, 0xA1, 0xC0, 0x40] {
+            for req in 0..=255u8 {
+                for value in [
+                    0u16, 1, 0x0100, 0x0200, 0x0201, 0x0300, 0x0303, 0x03FF, 0xFFFF,
+                ] {
+                    let reply = c.setup(&request(kind, req, value, 0, 255), "x");
+                    if let Reply::In(p, len) = reply {
+                        assert!(usize::from(len) <= p.len());
+                    }
+                }
+            }
+        }
+    }
     #[test]
     fn frames_go_in_whole_or_are_dropped_and_counted() {
         let mut q = LogQueue::<128>::new();

@@ -942,6 +942,29 @@ impl Zumo {
         &self.state.watchdog_resets
     }
 
+    /// Runs the firmware with simavr's own stepping (avr-tester cannot
+    /// step over a reset: simavr restarts its cycle counter) until it
+    /// starts again after a watchdog reset, or `max_ms` pass. Returns the
+    /// simulated milliseconds until that start, if it came.
+    pub fn run_until_watchdog_reset(&mut self, max_ms: u64) -> Option<u64> {
+        let avr = self.state.avr;
+        let seen = self.state.watchdog_resets.len();
+        let mut elapsed = 0u64;
+        // SAFETY: the core is live; simavr steps it on this thread.
+        let mut last = unsafe { (*avr).cycle };
+        while elapsed < max_ms * (CLOCK_HZ / 1000) {
+            // SAFETY: as above.
+            unsafe { ffi::avr_run(avr) };
+            let now = unsafe { (*avr).cycle };
+            elapsed += if now >= last { now - last } else { now };
+            last = now;
+            if self.state.watchdog_resets.len() > seen {
+                return Some(elapsed / (CLOCK_HZ / 1000));
+            }
+        }
+        None
+    }
+
     /// Every byte the firmware has sent on USART1 since boot: the raw
     /// serial stream a host would receive (for the monitor and replay tests).
     pub fn uart_bytes(&self) -> &[u8] {

@@ -11,7 +11,9 @@
 //! suspend: [`Zumo::plug_usb`] and [`Zumo::suspend_usb`] set the register
 //! bits the silicon would (USBSTA.VBUS, UDINT.SUSPI, UDINT.WAKEUPI) in the
 //! core's data memory. Between tries of a NAKed transaction the host lets
-//! the firmware run 20 us (a full-speed host retries within a frame).
+//! the firmware run 20 us (a full-speed host retries within a frame). The
+//! model does not NAK an OUT data stage while the setup packet before it
+//! is unread (it overwrites it), so the host waits 5 ms before one.
 
 use super::Zumo;
 use simavr_ffi as ffi;
@@ -27,6 +29,8 @@ const UDCON: usize = 0xE0;
 const UDADDR: usize = 0xE3;
 const NAK: i32 = -2;
 const STALL: i32 = -3;
+/// How long the host waits between a setup packet and its OUT data stage.
+const SETUP_TO_DATA_US: u64 = 5_000;
 /// How long a transaction may be NAKed before the host gives up.
 const TIMEOUT_US: u64 = 50_000;
 
@@ -169,6 +173,13 @@ impl Zumo {
             self.usb_out(0, &[])?;
             Ok(got)
         } else {
+            if !data.is_empty() {
+                // The model would let the data stage overwrite a setup
+                // packet the firmware has not read yet (the silicon NAKs
+                // it): give the firmware longer than its longest gap
+                // between two services first.
+                self.run_us(SETUP_TO_DATA_US);
+            }
             for chunk in data.chunks(64) {
                 self.usb_out(0, chunk)?;
             }
@@ -258,5 +269,32 @@ impl Zumo {
             t += 100;
         }
         out
+    }
+
+    /// A host streaming the log: reads the bulk IN endpoint `ep` for `us`
+    /// microseconds and, every `request_every_us`, asks for the
+    /// configuration descriptor (75 bytes, two packets) as a host's
+    /// driver might mid-run, so that control transfers fall anywhere in
+    /// the control period. Returns every byte read from `ep`.
+    pub fn usb_stream(&mut self, ep: u8, us: u64, request_every_us: u64) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut t = 0;
+        while t < us {
+            let slice = request_every_us.min(us - t);
+            out.extend(self.usb_read_bulk(ep, slice));
+            t += slice;
+            let start = self.cycle();
+            let config = self
+                .usb_control(setup(0x80, 6, 0x0200, 0, 255), &[])
+                .expect("GET_DESCRIPTOR(configuration) stalled mid-run");
+            assert_eq!(config.len(), usize::from(config[2]));
+            t += (self.cycle() - start) / 16;
+        }
+        out
+    }
+
+    fn cycle(&self) -> u64 {
+        // SAFETY: the core is live.
+        unsafe { (*self.state.avr).cycle }
     }
 }
