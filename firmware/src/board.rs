@@ -15,7 +15,7 @@
 //! | LEDs                | yellow PC7 (high = on), green PD5 and red PB0 (low = on) |
 //! | markers             | GPIOR0 (simulator cycle counting): 4 at a period's start, 1 before a decision, 2 after the motor writes, 3 after the log frame is sent |
 //! | identity            | `shared::FirmwareIdentity` record in flash: robot id and policy CRC |
-//! | USB serial port     | the USB controller, polled (`board::usb`): while waiting for the next period, a TWI step, a USART byte, an EEPROM write |
+//! | USB serial port     | the USB controller, polled (`board::usb`): while waiting for the next period, once per TWI step and per USART byte (while the hardware moves the byte), while an EEPROM write completes |
 //!
 //! Interrupts: only the two encoder interrupts are enabled; the timed
 //! sequences (watchdog, EEPROM) and the reads of the counts run with
@@ -515,14 +515,14 @@ impl Board {
         });
     }
 
-    /// Sends bytes on USART1 (blocking; serves USB while it waits).
+    /// Sends bytes on USART1 (blocking; serves USB once per byte, while
+    /// the byte goes out: 87 us).
     pub fn send(&self, bytes: &[u8]) {
         let u = &self.dp.USART1;
         for byte in bytes {
-            while u.ucsr1a().read().bits() & (1 << 5) == 0 {
-                self.serve_usb(); // UDRE1
-            }
+            while u.ucsr1a().read().bits() & (1 << 5) == 0 {} // UDRE1
             u.udr1().write(|w| unsafe { w.bits(*byte) });
+            self.serve_usb();
         }
     }
 
@@ -559,12 +559,14 @@ impl Board {
         let t = &self.dp.TWI;
         t.twcr().write(|w| unsafe { w.bits(control) });
         let start = self.now();
+        // USB once per step, while the TWI moves the byte (90 us at 100
+        // kHz): serving in the wait itself would delay noticing TWINT.
+        self.serve_usb();
         while t.twcr().read().bits() & TWINT == 0 {
             if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
                 self.twi_recover();
                 return Err(BusError::Stalled);
             }
-            self.serve_usb();
         }
         Ok(t.twsr().read().bits() & 0xF8)
     }

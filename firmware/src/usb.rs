@@ -47,7 +47,7 @@ pub const BOOT_KEY_ADDR: u16 = 0x0800;
 /// interface association), endpoint 0 of 64 bytes, [`VID`]/[`PID`],
 /// release 1.00, strings 1 (manufacturer), 2 (product), 3 (serial number),
 /// one configuration.
-pub const DEVICE_DESCRIPTOR: [u8; 18] = {
+pub static DEVICE_DESCRIPTOR: [u8; 18] = {
     let (v, p) = (VID.to_le_bytes(), PID.to_le_bytes());
     [
         18, 1, 0x00, 0x02, 0xEF, 0x02, 0x01, 64, v[0], v[1], p[0], p[1], 0x00, 0x01, 1, 2, 3, 1,
@@ -68,7 +68,7 @@ pub const IN_EP: u8 = 3;
 /// union functional descriptors and the notification endpoint (interrupt
 /// IN 1, 8 bytes, every 255 ms); interface 1 (CDC data) with bulk OUT 2
 /// and bulk IN 3, 64 bytes each.
-pub const CONFIG_DESCRIPTOR: [u8; 75] = [
+pub static CONFIG_DESCRIPTOR: [u8; 75] = [
     9,
     2,
     75,
@@ -147,7 +147,7 @@ pub const CONFIG_DESCRIPTOR: [u8; 75] = [
 ];
 
 /// String descriptor 0: the languages (English, US).
-const LANGUAGES: [u8; 4] = [4, 3, 0x09, 0x04];
+static LANGUAGES: [u8; 4] = [4, 3, 0x09, 0x04];
 
 /// Each endpoint's configuration (UECFG0X: type and direction; UECFG1X:
 /// size and one bank, ALLOC), as SET_CONFIGURATION sets them up, with
@@ -286,7 +286,7 @@ impl Control {
                 _ => Reply::Stall,
             },
             (0x80, 0x08) => n(Payload::Short([u8::from(self.configured), 0], 1)),
-            (0x80 | 0x81 | 0x82, 0x00) => n(Payload::Short([0, 0], 2)),
+            (0x80..=0x82, 0x00) => n(Payload::Short([0, 0], 2)),
             // CLEAR_FEATURE / SET_FEATURE (endpoint halt, remote wake-up): accepted.
             (0x00..=0x02, 0x01 | 0x03) => Reply::Ack,
             (0x81, 0x0A) => n(Payload::Short([0, 0], 1)),

@@ -560,6 +560,7 @@ pub struct Zumo {
     external: Box<ExternalPins>,
     decoded: usize,
     pullup_on: Rc<Cell<u32>>,
+    usb_background: Option<Box<usb_host::BackgroundHost>>,
 }
 
 impl Zumo {
@@ -691,6 +692,7 @@ impl Zumo {
             external,
             decoded: 0,
             pullup_on,
+            usb_background: None,
         };
         zumo.tester
             .twi0()

@@ -20,18 +20,15 @@ fn frames_of(bytes: &[u8]) -> Vec<&[u8]> {
 
 fn plugged_zumo() -> Zumo {
     let mut z = Zumo::boot();
-    z.run_ms(60);
     z.plug_usb(true);
-    z.run_ms(25);
+    z.run_ms(100);
     z
 }
 
 /// A host that has enumerated the robot and opened its port.
 fn open_port() -> Zumo {
-    let mut z = plugged_zumo();
-    z.usb_enumerate(5);
-    z.usb_set_line_coding(115_200).unwrap();
-    z.usb_set_dtr(true).unwrap();
+    let mut z = Zumo::boot();
+    z.usb_open(5);
     z
 }
 

@@ -15,7 +15,7 @@
 //! model does not NAK an OUT data stage while the setup packet before it
 //! is unread (it overwrites it), so the host waits 5 ms before one.
 
-use super::Zumo;
+use super::{Zumo, CLOCK_HZ};
 use simavr_ffi as ffi;
 use std::ffi::c_void;
 
@@ -48,22 +48,142 @@ pub fn setup(request_type: u8, request: u8, value: u16, index: u16, length: u16)
     [request_type, request, v[0], v[1], i[0], i[1], l[0], l[1]]
 }
 
+/// Calls one of the USB ioctls on endpoint `ep` with `buf` (`len` bytes
+/// in, the count out).
+fn ioctl(avr: *mut ffi::avr_t, code: [u8; 4], ep: u8, buf: &mut [u8], len: usize) -> (i32, usize) {
+    let mut io = ffi::avr_io_usb {
+        pipe: ep,
+        sz: len as u32,
+        buf: buf.as_mut_ptr(),
+    };
+    // SAFETY: the caller passes a live core; `buf` holds at least 64 bytes or `len`.
+    let r = unsafe {
+        ffi::avr_ioctl(
+            avr,
+            u32::from_be_bytes(code),
+            &mut io as *mut _ as *mut c_void,
+        )
+    };
+    (r, io.sz as usize)
+}
+
+/// A host that reads the bulk IN endpoint every 100 us and, every
+/// `every` cycles, asks for the configuration descriptor, from a cycle
+/// timer, while the test runs the firmware as it likes.
+pub(super) struct BackgroundHost {
+    avr: *mut ffi::avr_t,
+    ep: u8,
+    every: u64,
+    next_request: u64,
+    stage: Stage,
+    /// Bytes read from the bulk IN endpoint.
+    pub(super) bytes: Vec<u8>,
+    /// Control transfers completed.
+    pub(super) requests: u32,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    Idle,
+    DataIn(usize),
+    StatusOut,
+}
+
+/// Cycles between the background host's visits (100 us).
+const VISIT: u64 = CLOCK_HZ / 10_000;
+
+unsafe extern "C" fn visit(
+    avr: *mut ffi::avr_t,
+    when: ffi::avr_cycle_count_t,
+    param: *mut c_void,
+) -> u64 {
+    // SAFETY: `param` is the boxed `BackgroundHost` of the `Zumo`, which
+    // outlives the core's timers (field order).
+    let h = unsafe { &mut *(param as *mut BackgroundHost) };
+    let mut buf = [0u8; 64];
+    let (r, n) = ioctl(avr, *b"usbr", h.ep, &mut buf, 64);
+    if r == 0 {
+        h.bytes.extend_from_slice(&buf[..n]);
+    }
+    h.stage = match h.stage {
+        Stage::Idle if when >= h.next_request => {
+            let mut packet = setup(0x80, 6, 0x0200, 0, 255).to_vec();
+            packet.resize(64, 0);
+            let (r, _) = ioctl(avr, *b"usbs", 0, &mut packet, 8);
+            assert_eq!(r, 0, "setup packet refused");
+            Stage::DataIn(0)
+        }
+        Stage::DataIn(got) => match ioctl(avr, *b"usbr", 0, &mut buf, 64) {
+            (0, n) if n < 64 => Stage::StatusOut,
+            (0, n) => Stage::DataIn(got + n),
+            (NAK, _) => Stage::DataIn(got),
+            (r, _) => panic!("background GET_DESCRIPTOR: simavr error {r}"),
+        },
+        Stage::StatusOut => match ioctl(avr, *b"usbw", 0, &mut buf, 0) {
+            (0, _) => {
+                h.requests += 1;
+                h.next_request = when + h.every;
+                Stage::Idle
+            }
+            _ => Stage::StatusOut,
+        },
+        idle => idle,
+    };
+    when + VISIT
+}
+
 impl Zumo {
+    /// From now on, a host in the background (a simavr cycle timer) reads
+    /// the bulk IN endpoint `ep` every 100 us and asks for the
+    /// configuration descriptor every `request_every_us`, however the test
+    /// runs the firmware: the port is enumerated, open and streaming, with
+    /// control transfers falling anywhere in the control period.
+    pub fn stream_usb_in_background(&mut self, ep: u8, request_every_us: u64) {
+        let every = request_every_us * (CLOCK_HZ / 1_000_000);
+        let mut host = Box::new(BackgroundHost {
+            avr: self.state.avr,
+            ep,
+            every,
+            next_request: 0,
+            stage: Stage::Idle,
+            bytes: Vec::new(),
+            requests: 0,
+        });
+        let param = &mut *host as *mut BackgroundHost as *mut c_void;
+        // SAFETY: the core is live; the host is boxed in `self`, dropped after the core.
+        unsafe { ffi::avr_cycle_timer_register(host.avr, VISIT, Some(visit), param) };
+        self.usb_background = Some(host);
+    }
+
+    /// What the background host has read from the bulk IN endpoint, and
+    /// how many control transfers it completed.
+    pub fn usb_background(&self) -> (&[u8], u32) {
+        self.usb_background
+            .as_ref()
+            .map_or((&[][..], 0), |h| (&h.bytes[..], h.requests))
+    }
+
     fn usb_ioctl(&mut self, code: [u8; 4], ep: u8, buf: &mut [u8], len: usize) -> (i32, usize) {
-        let mut io = ffi::avr_io_usb {
-            pipe: ep,
-            sz: len as u32,
-            buf: buf.as_mut_ptr(),
-        };
-        // SAFETY: the core is live; `buf` holds at least 64 bytes or `len`.
-        let r = unsafe {
-            ffi::avr_ioctl(
-                self.state.avr,
-                u32::from_be_bytes(code),
-                &mut io as *mut _ as *mut c_void,
-            )
-        };
-        (r, io.sz as usize)
+        ioctl(self.state.avr, code, ep, buf, len)
+    }
+
+    /// A host holding the port open: the cable plugged in (the device
+    /// attaches within 100 ms), the device enumerated at `address`, line
+    /// coding 115200 8N1, DTR set.
+    pub fn usb_open(&mut self, address: u8) {
+        self.plug_usb(true);
+        for _ in 0..100 {
+            if !self.usb_detached() {
+                break;
+            }
+            self.run_ms(1);
+        }
+        assert!(!self.usb_detached(), "VBUS high for 100 ms: still detached");
+        self.usb_enumerate(address);
+        self.usb_set_line_coding(115_200)
+            .expect("SET_LINE_CODING stalled");
+        self.usb_set_dtr(true)
+            .expect("SET_CONTROL_LINE_STATE stalled");
     }
 
     /// Plugs the cable in (VBUS high) or pulls it (VBUS low).
@@ -111,41 +231,38 @@ impl Zumo {
     /// One IN transaction on `ep`, retried while NAKed; an empty bulk
     /// answer counts as NAK unless `zlp_ok`.
     fn usb_in(&mut self, ep: u8, zlp_ok: bool) -> Result<Vec<u8>, Stalled> {
-        let mut waited = 0;
-        loop {
-            let mut buf = [0u8; 64];
-            let (r, n) = self.usb_ioctl(*b"usbr", ep, &mut buf, 64);
-            match r {
-                0 if n > 0 || zlp_ok => return Ok(buf[..n].to_vec()),
-                0 | NAK => {}
-                STALL => return Err(Stalled),
-                r => panic!("IN on endpoint {ep}: simavr error {r}"),
-            }
-            assert!(
-                waited < TIMEOUT_US,
-                "IN on endpoint {ep} NAKed for {TIMEOUT_US} us"
-            );
-            self.run_us(20);
-            waited += 20;
-        }
+        self.usb_transaction(*b"usbr", ep, &[], zlp_ok)
     }
 
     /// One OUT transaction on `ep`, retried while NAKed.
     fn usb_out(&mut self, ep: u8, data: &[u8]) -> Result<(), Stalled> {
+        self.usb_transaction(*b"usbw", ep, data, true).map(|_| ())
+    }
+
+    /// One transaction (`code`: `usbr` IN, `usbw` OUT of `data`) retried
+    /// every 20 us while NAKed, for at most `TIMEOUT_US`.
+    fn usb_transaction(
+        &mut self,
+        code: [u8; 4],
+        ep: u8,
+        data: &[u8],
+        zlp_ok: bool,
+    ) -> Result<Vec<u8>, Stalled> {
+        let is_in = code == *b"usbr";
         let mut waited = 0;
         loop {
             let mut buf = data.to_vec();
             buf.resize(64, 0);
-            let (r, _) = self.usb_ioctl(*b"usbw", ep, &mut buf, data.len());
+            let (r, n) = self.usb_ioctl(code, ep, &mut buf, if is_in { 64 } else { data.len() });
             match r {
-                0 => return Ok(()),
-                NAK => {}
+                0 if !is_in || n > 0 || zlp_ok => return Ok(buf[..n.min(64)].to_vec()),
+                0 | NAK => {}
                 STALL => return Err(Stalled),
-                r => panic!("OUT on endpoint {ep}: simavr error {r}"),
+                r => panic!("transaction on endpoint {ep}: simavr error {r}"),
             }
             assert!(
                 waited < TIMEOUT_US,
-                "OUT on endpoint {ep} NAKed for {TIMEOUT_US} us"
+                "transaction on endpoint {ep} NAKed for {TIMEOUT_US} us"
             );
             self.run_us(20);
             waited += 20;
