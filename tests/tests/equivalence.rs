@@ -472,7 +472,7 @@ fn equivalence(v: &Variant) {
     ]);
 
     // The host read the log over USB all the while, whole frames that decode.
-    let (usb, requests) = z.usb_background();
+    let (usb, requests, _) = z.usb_background();
     let usb_frames: Vec<&[u8]> = usb.split(|b| *b == LogFrame::DELIMITER).collect();
     let decoded = usb_frames
         .iter()

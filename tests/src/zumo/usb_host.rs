@@ -80,6 +80,10 @@ pub(super) struct BackgroundHost {
     pub(super) bytes: Vec<u8>,
     /// Control transfers completed.
     pub(super) requests: u32,
+    setup_at: u64,
+    /// The longest wait, in cycles, from a setup packet to the first
+    /// packet of its answer.
+    pub(super) longest_wait: u64,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -111,11 +115,20 @@ unsafe extern "C" fn visit(
             packet.resize(64, 0);
             let (r, _) = ioctl(avr, *b"usbs", 0, &mut packet, 8);
             assert_eq!(r, 0, "setup packet refused");
+            h.setup_at = when;
             Stage::DataIn(0)
         }
         Stage::DataIn(got) => match ioctl(avr, *b"usbr", 0, &mut buf, 64) {
-            (0, n) if n < 64 => Stage::StatusOut,
-            (0, n) => Stage::DataIn(got + n),
+            (0, n) => {
+                if got == 0 {
+                    h.longest_wait = h.longest_wait.max(when - h.setup_at);
+                }
+                if n < 64 {
+                    Stage::StatusOut
+                } else {
+                    Stage::DataIn(got + n)
+                }
+            }
             (NAK, _) => Stage::DataIn(got),
             (r, _) => panic!("background GET_DESCRIPTOR: simavr error {r}"),
         },
@@ -148,6 +161,8 @@ impl Zumo {
             stage: Stage::Idle,
             bytes: Vec::new(),
             requests: 0,
+            setup_at: 0,
+            longest_wait: 0,
         });
         let param = &mut *host as *mut BackgroundHost as *mut c_void;
         // SAFETY: the core is live; the host is boxed in `self`, dropped after the core.
@@ -155,12 +170,14 @@ impl Zumo {
         self.usb_background = Some(host);
     }
 
-    /// What the background host has read from the bulk IN endpoint, and
-    /// how many control transfers it completed.
-    pub fn usb_background(&self) -> (&[u8], u32) {
-        self.usb_background
-            .as_ref()
-            .map_or((&[][..], 0), |h| (&h.bytes[..], h.requests))
+    /// What the background host has read from the bulk IN endpoint, how
+    /// many control transfers it completed, and the longest wait from a
+    /// setup packet to its answer's first packet, in cycles (at the host's
+    /// 100 us resolution).
+    pub fn usb_background(&self) -> (&[u8], u32, u64) {
+        self.usb_background.as_ref().map_or((&[][..], 0, 0), |h| {
+            (&h.bytes[..], h.requests, h.longest_wait)
+        })
     }
 
     fn usb_ioctl(&mut self, code: [u8; 4], ep: u8, buf: &mut [u8], len: usize) -> (i32, usize) {
