@@ -36,7 +36,7 @@ pub const PRODUCT: &str = "Zumo 32U4 robot";
 /// Packet size of the control and bulk endpoints.
 pub const PACKET: u16 = 64;
 /// The line coding's baud rate that, with DTR low, asks for the bootloader.
-pub const TOUCH_BAUD: u32 = 1200;
+pub const TOUCH_BAUD: u32 = shared::identity::USB_TOUCH_BAUD;
 /// The bootloader enters itself after a watchdog reset when this word is
 /// at SRAM [`BOOT_KEY_ADDR`] (`../shared/docs/hardware.md` section 6).
 pub const BOOT_KEY: u16 = 0x7777;

@@ -11,6 +11,12 @@
 //! | 7      | 1    | robot id                                   |
 //! | 8      | 4    | the policy blob's CRC-32 (its last 4 bytes), LE |
 
+/// The baud rate that, set on the robot's USB serial port with DTR then
+/// dropped (the port opened at it and closed), resets the robot into its
+/// bootloader: the "1200-baud touch" of Arduino's tools, which the
+/// firmware answers and `host flash` sends.
+pub const USB_TOUCH_BAUD: u32 = 1200;
+
 /// The identity of one firmware build.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FirmwareIdentity {

@@ -178,7 +178,10 @@ fn a_1200_baud_touch_stops_the_motors_stores_the_key_and_resets_by_the_watchdog(
         .run_until_watchdog_reset(400)
         .expect("no watchdog reset within 400 ms of the touch");
     println!("watchdog reset {ms} ms after the touch");
-    assert!((120..=140).contains(&ms), "{ms} ms, not the 125 ms watchdog");
+    assert!(
+        (120..=140).contains(&ms),
+        "{ms} ms, not the 125 ms watchdog"
+    );
     assert_eq!(z.watchdog_resets(), [BOOT_KEY]);
 }
 

@@ -338,7 +338,7 @@ pub fn system_ports() -> Vec<String> {
 
 /// The 1200-baud touch: opens `port` at 1200 baud, drops DTR, closes it.
 pub fn touch(port: &str) -> Result<()> {
-    let mut p = serialport::new(port, 1200)
+    let mut p = serialport::new(port, shared::identity::USB_TOUCH_BAUD)
         .timeout(Duration::from_millis(100))
         .open()
         .with_context(|| format!("cannot open {port} at 1200 baud"))?;
