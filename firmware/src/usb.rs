@@ -10,7 +10,8 @@
 //!   ([`DEVICE_DESCRIPTOR`], [`CONFIG_DESCRIPTOR`], strings) and the
 //!   endpoints the configuration sets up ([`ENDPOINT_CONFIG`]).
 //! - [`LogQueue`]: the log frames waiting for the bulk IN endpoint. A frame
-//!   goes in whole or not at all (dropped, counted), so a host that stops
+//!   goes in whole or not at all (dropped: its tick is missing from the
+//!   host's recording, `host replay` counts them), so a host that stops
 //!   reading never blocks the control period and never sees half a frame;
 //!   it comes out in packets of at most 64 bytes, with a zero-length
 //!   packet after a full one that ends the data, which completes the host's
@@ -337,7 +338,6 @@ pub struct LogQueue<const N: usize> {
     /// The last packet sent was a full one: the data ends with a
     /// zero-length packet when nothing follows.
     last_full: bool,
-    dropped: u16,
 }
 
 impl<const N: usize> Default for LogQueue<N> {
@@ -354,15 +354,14 @@ impl<const N: usize> LogQueue<N> {
             start: 0,
             len: 0,
             last_full: false,
-            dropped: 0,
         }
     }
 
-    /// Queues a whole frame, or drops it (and counts it) when it does not
-    /// fit in the room left. Returns whether it was queued.
+    /// Queues a whole frame, or drops it when it does not fit in the room
+    /// left (its tick is then missing from what the host records, which
+    /// `host replay` counts). Returns whether it was queued.
     pub fn push(&mut self, frame: &[u8]) -> bool {
         if frame.len() > N - self.len {
-            self.dropped = self.dropped.wrapping_add(1);
             return false;
         }
         for &b in frame {
@@ -408,11 +407,6 @@ impl<const N: usize> LogQueue<N> {
     /// Whether nothing waits.
     pub fn is_empty(&self) -> bool {
         self.len == 0
-    }
-
-    /// Frames dropped because the host did not read them in time (wraps).
-    pub fn dropped(&self) -> u16 {
-        self.dropped
     }
 }
 
@@ -570,18 +564,17 @@ mod tests {
         }
     }
     #[test]
-    fn frames_go_in_whole_or_are_dropped_and_counted() {
+    fn frames_go_in_whole_or_are_dropped_whole() {
         let mut q = LogQueue::<128>::new();
         assert!(q.push(&[1; 71]));
         assert!(q.push(&[2; 50]));
         assert!(!q.push(&[3; 8]), "7 bytes left");
-        assert_eq!((q.len(), q.dropped()), (121, 1));
+        assert_eq!(q.len(), 121);
         // A host reading again makes room for whole frames only.
         assert_eq!(q.packet(64), Some(&[1u8; 64][..]));
         q.sent(64, 64);
         assert!(q.push(&[3; 50]));
         assert!(!q.push(&[4; 71]));
-        assert_eq!(q.dropped(), 2);
     }
 
     #[test]
