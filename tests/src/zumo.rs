@@ -3,8 +3,8 @@
 //! while they discharge), a Pixy on TWI (its frames encoded here, from the
 //! Pixy's protocol, not by the firmware's code), wheel encoders, the I2C
 //! lines' pull-ups (and a device that can hold SDA low), buttons, motor
-//! registers, the USART1 log, the firmware's cycle markers and a USB host
-//! (`usb_host`, over simavr's USB controller model).
+//! registers, the USART1 log and the firmware's cycle markers (the USB
+//! host is `crate::usb_host`).
 //!
 //! `avr-tester` runs the simulation; what it does not offer (USART1 on the
 //! 32U4, data memory, the cycle counter, EEPROM, I/O register hooks) goes
@@ -12,10 +12,6 @@
 //! the global logger when `avr-tester` loads an ELF, and avr-tester installs
 //! its own logger at its first load only, so ours, installed after a first
 //! throwaway load, catches every later core's handle (see `load`).
-
-mod usb_host;
-
-pub use usb_host::{setup, Stalled};
 
 use avr_tester::{AvrTester, TwiPacket};
 use firmware::pins::{self, Pin, Port, PIXY_ADDRESS};
@@ -560,7 +556,9 @@ pub struct Zumo {
     external: Box<ExternalPins>,
     decoded: usize,
     pullup_on: Rc<Cell<u32>>,
-    usb_background: Option<Box<usb_host::BackgroundHost>>,
+    /// What simavr's callbacks registered by other modules point to
+    /// (`usb_host`'s background host), dropped after the core.
+    kept: Vec<Box<dyn std::any::Any>>,
 }
 
 impl Zumo {
@@ -692,7 +690,7 @@ impl Zumo {
             external,
             decoded: 0,
             pullup_on,
-            usb_background: None,
+            kept: Vec::new(),
         };
         zumo.tester
             .twi0()
@@ -889,7 +887,32 @@ impl Zumo {
         self.state.decisions
     }
 
-    fn data(&self, addr: usize) -> u8 {
+    /// simavr's handle of the running core (for the USB host's ioctls).
+    pub(crate) fn core(&self) -> *mut ffi::avr_t {
+        self.state.avr
+    }
+
+    /// Runs the firmware for `us` simulated microseconds.
+    pub fn run_us(&mut self, us: u64) {
+        self.tester.run_for_us(us);
+    }
+
+    /// Keeps `value` alive as long as the core (a callback's parameter).
+    pub(crate) fn keep<T: 'static>(&mut self, value: Box<T>) -> &T {
+        self.kept.push(value);
+        self.kept
+            .last()
+            .and_then(|b| b.downcast_ref::<T>())
+            .expect("just kept")
+    }
+
+    /// A value kept by [`Zumo::keep`], by type.
+    pub(crate) fn kept<T: 'static>(&self) -> Option<&T> {
+        self.kept.iter().find_map(|b| b.downcast_ref::<T>())
+    }
+
+    /// A byte of the core's data space (registers, I/O, SRAM).
+    pub(crate) fn data(&self, addr: usize) -> u8 {
         assert!(
             addr < RAM_END,
             "data address {addr:#x} outside the 32U4's data space"

@@ -6,7 +6,8 @@
 use firmware::embedded;
 use firmware::usb::{BOOT_KEY, PID, VID};
 use shared::{LogFrame, PolicyBlob, RunMode};
-use tests::zumo::{setup, Zumo};
+use tests::usb_host::setup;
+use tests::zumo::Zumo;
 
 /// The bulk IN endpoint (`firmware::usb::IN_EP`; the configuration descriptor says so).
 const BULK_IN: u8 = 3;

@@ -15,7 +15,7 @@
 //! model does not NAK an OUT data stage while the setup packet before it
 //! is unread (it overwrites it), so the host waits 5 ms before one.
 
-use super::{Zumo, CLOCK_HZ};
+use crate::zumo::{Zumo, CLOCK_HZ};
 use simavr_ffi as ffi;
 use std::ffi::c_void;
 
@@ -70,20 +70,20 @@ fn ioctl(avr: *mut ffi::avr_t, code: [u8; 4], ep: u8, buf: &mut [u8], len: usize
 /// A host that reads the bulk IN endpoint every 100 us and, every
 /// `every` cycles, asks for the configuration descriptor, from a cycle
 /// timer, while the test runs the firmware as it likes.
-pub(super) struct BackgroundHost {
+pub struct BackgroundHost {
     avr: *mut ffi::avr_t,
     ep: u8,
     every: u64,
     next_request: u64,
     stage: Stage,
     /// Bytes read from the bulk IN endpoint.
-    pub(super) bytes: Vec<u8>,
+    bytes: Vec<u8>,
     /// Control transfers completed.
-    pub(super) requests: u32,
+    requests: u32,
     setup_at: u64,
     /// The longest wait, in cycles, from a setup packet to the first
     /// packet of its answer.
-    pub(super) longest_wait: u64,
+    longest_wait: u64,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -154,7 +154,7 @@ impl Zumo {
     pub fn stream_usb_in_background(&mut self, ep: u8, request_every_us: u64) {
         let every = request_every_us * (CLOCK_HZ / 1_000_000);
         let mut host = Box::new(BackgroundHost {
-            avr: self.state.avr,
+            avr: self.core(),
             ep,
             every,
             next_request: 0,
@@ -167,7 +167,7 @@ impl Zumo {
         let param = &mut *host as *mut BackgroundHost as *mut c_void;
         // SAFETY: the core is live; the host is boxed in `self`, dropped after the core.
         unsafe { ffi::avr_cycle_timer_register(host.avr, VISIT, Some(visit), param) };
-        self.usb_background = Some(host);
+        self.keep(host);
     }
 
     /// What the background host has read from the bulk IN endpoint, how
@@ -175,13 +175,13 @@ impl Zumo {
     /// setup packet to its answer's first packet, in cycles (at the host's
     /// 100 us resolution).
     pub fn usb_background(&self) -> (&[u8], u32, u64) {
-        self.usb_background.as_ref().map_or((&[][..], 0, 0), |h| {
+        self.kept::<BackgroundHost>().map_or((&[][..], 0, 0), |h| {
             (&h.bytes[..], h.requests, h.longest_wait)
         })
     }
 
     fn usb_ioctl(&mut self, code: [u8; 4], ep: u8, buf: &mut [u8], len: usize) -> (i32, usize) {
-        ioctl(self.state.avr, code, ep, buf, len)
+        ioctl(self.core(), code, ep, buf, len)
     }
 
     /// A host holding the port open: the cable plugged in (the device
@@ -216,7 +216,7 @@ impl Zumo {
     fn set_data_bit(&mut self, addr: usize, bit: u8, on: bool) {
         // SAFETY: the core is live and `addr` is one of its I/O registers.
         unsafe {
-            let p = (*self.state.avr).data.add(addr);
+            let p = (*self.core()).data.add(addr);
             *p = if on { *p | 1 << bit } else { *p & !(1 << bit) };
         }
     }
@@ -238,11 +238,6 @@ impl Zumo {
         let (r, _) = self.usb_ioctl(*b"usbR", 0, &mut none, 0);
         assert_eq!(r, 0, "bus reset refused");
         self.run_us(1000);
-    }
-
-    /// Runs the firmware for `us` simulated microseconds.
-    pub fn run_us(&mut self, us: u64) {
-        self.tester.run_for_us(us);
     }
 
     /// One IN transaction on `ep`, retried while NAKed; an empty bulk
@@ -429,6 +424,6 @@ impl Zumo {
 
     fn cycle(&self) -> u64 {
         // SAFETY: the core is live.
-        unsafe { (*self.state.avr).cycle }
+        unsafe { (*self.core()).cycle }
     }
 }
