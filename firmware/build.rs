@@ -105,6 +105,18 @@ fn main() {
         "pub const IDENTITY: [u8; shared::FirmwareIdentity::LEN] = {identity:?};"
     )
     .unwrap();
+    let serial = FirmwareIdentity::usb_serial(robot_id);
+    writeln!(
+        out,
+        "/// The USB serial number (`shared::FirmwareIdentity::usb_serial`)."
+    )
+    .unwrap();
+    writeln!(
+        out,
+        "pub const USB_SERIAL: &str = {:?};",
+        String::from_utf8_lossy(&serial)
+    )
+    .unwrap();
     writeln!(out, "/// The policy's state hasher.").unwrap();
     writeln!(
         out,

@@ -15,22 +15,26 @@
 //! | LEDs                | yellow PC7 (high = on), green PD5 and red PB0 (low = on) |
 //! | markers             | GPIOR0 (simulator cycle counting): 4 at a period's start, 1 before a decision, 2 after the motor writes, 3 after the log frame is sent |
 //! | identity            | `shared::FirmwareIdentity` record in flash: robot id and policy CRC |
+//! | USB serial port     | the USB controller, polled (`board::usb`): while waiting for the next period, once per TWI step and per USART byte (while the hardware moves the byte), while an EEPROM write completes |
 //!
 //! Interrupts: only the two encoder interrupts are enabled; the timed
 //! sequences (watchdog, EEPROM) and the reads of the counts run with
 //! interrupts off.
 
+mod usb;
+
 use avr_device::atmega32u4::Peripherals;
 use avr_device::interrupt::{self, Mutex};
 use core::arch::asm;
-use core::cell::Cell;
+use core::cell::{Cell, RefCell};
 use firmware::camera::{BusError, WordSource};
-use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS};
+use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS, USB_QUIET_TICKS};
 use firmware::embedded;
 use firmware::odometry::Quadrature;
 use firmware::pins;
 use firmware::rc::Discharge;
 use firmware::supervisor::{Buttons, Leds};
+use firmware::usb::{TouchChange, BOOT_KEY};
 use shared::{DriveOutputs, FieldScales};
 
 /// The policy table, in flash (read with `lpm`, never copied to SRAM).
@@ -151,15 +155,21 @@ const PIXY_READ: u8 = (pins::PIXY_ADDRESS << 1) | 1;
 const WDE: u8 = 1 << 3;
 const WDCE: u8 = 1 << 4;
 const WDP2: u8 = 1 << 2; // with WDP1..0 = 0: 250 ms
+const WDP1_0: u8 = 0b11; // with WDP2 = 0: 125 ms, the touch's reset
 
 /// The bootloader enters itself after a watchdog reset when this word holds
-/// 0x7777; the firmware clears it at start-up and never writes it.
-const BOOT_KEY: *mut u16 = 0x0800 as *mut u16;
+/// 0x7777 (`firmware::usb::BOOT_KEY`); the firmware clears it at start-up
+/// and writes it only for a 1200-baud touch.
+const BOOT_KEY_AT: *mut u16 = firmware::usb::BOOT_KEY_ADDR as *mut u16;
 
-/// The peripherals and the control period's clock.
+/// The peripherals, the control period's clock and the USB serial port.
 pub struct Board {
     dp: Peripherals,
     period_start: u16,
+    usb: RefCell<Option<&'static mut usb::UsbPort>>,
+    /// A 1200-baud touch is pending: motors stopped, key stored, the
+    /// watchdog (125 ms) no longer fed.
+    touched: Cell<bool>,
 }
 
 /// The field sensors' calibration curves: 246 bytes, kept in static RAM
@@ -186,7 +196,7 @@ impl Board {
                 zero = in(reg) 0u8,
                 options(nostack),
             );
-            core::ptr::write_volatile(BOOT_KEY, 0);
+            core::ptr::write_volatile(BOOT_KEY_AT, 0);
         }
         // SAFETY: `take` runs once, so this is the only reference ever made.
         let scales = unsafe { &mut *core::ptr::addr_of_mut!(FIELD_SCALES) };
@@ -194,6 +204,8 @@ impl Board {
             Board {
                 dp,
                 period_start: 0,
+                usb: RefCell::new(None),
+                touched: Cell::new(false),
             },
             scales,
         )
@@ -265,6 +277,59 @@ impl Board {
         unsafe { interrupt::enable() };
     }
 
+    /// Turns the USB controller on: the serial port `serial` (the robot's
+    /// USB serial number) attaches once VBUS is seen.
+    pub fn usb_init(&mut self, serial: &'static str) {
+        *self.usb.get_mut() = usb::UsbPort::take(serial);
+    }
+
+    /// One round of USB work (`board::usb`), and the touch it may bring:
+    /// armed, the motors stop, the bootloader's key is stored and the
+    /// watchdog is set to 125 ms and no longer fed; cancelled, the key is
+    /// cleared and the control loop's watchdog (250 ms) is back.
+    fn serve_usb(&self) {
+        let Ok(mut port) = self.usb.try_borrow_mut() else {
+            return;
+        };
+        let Some(port) = port.as_mut() else {
+            return;
+        };
+        match port.service() {
+            TouchChange::None => {}
+            TouchChange::Armed => {
+                emergency_stop();
+                // SAFETY: 0x0800 is SRAM above the statics and below the
+                // stack's budget (tests/tests/firmware_smoke.rs checks both).
+                unsafe { core::ptr::write_volatile(BOOT_KEY_AT, BOOT_KEY) };
+                self.touched.set(true);
+                self.watchdog(WDE | WDP1_0);
+            }
+            TouchChange::Cancelled => {
+                // SAFETY: as above.
+                unsafe { core::ptr::write_volatile(BOOT_KEY_AT, 0) };
+                self.touched.set(false);
+                self.watchdog(WDE | WDP2);
+            }
+        }
+    }
+
+    /// Whether a 1200-baud touch is pending: the control loop then leaves
+    /// the motors stopped and does nothing but wait for the watchdog.
+    pub fn touched(&self) -> bool {
+        self.touched.get()
+    }
+
+    /// Queues a log frame for the USB serial port (sent if a host holds
+    /// it open; dropped whole if the host stopped reading).
+    pub fn send_usb(&self, frame: &[u8]) {
+        if let Ok(mut port) = self.usb.try_borrow_mut() {
+            if let Some(port) = port.as_mut() {
+                port.send(frame);
+            }
+        }
+        self.serve_usb();
+    }
+
     /// The encoder counts (left, right) since the last call.
     pub fn take_encoder_counts(&self) -> [i16; 2] {
         interrupt::free(|cs| {
@@ -280,17 +345,24 @@ impl Board {
 
     /// Enables the watchdog (250 ms) for the control loop.
     pub fn watchdog_on(&mut self) {
+        self.watchdog(WDE | WDP2);
+    }
+
+    /// Sets the watchdog to `setting` (WDTCSR: WDE + prescaler) and feeds
+    /// it, before and after: the new timeout counts from the change.
+    fn watchdog(&self, setting: u8) {
         avr_device::asm::wdr();
-        // SAFETY: timed sequence (<= 4 cycles, interrupts off): WDCE|WDE, then WDE + prescaler.
+        // SAFETY: timed sequence (<= 4 cycles, interrupts off): WDCE|WDE, then the setting.
         interrupt::free(|_| unsafe {
             asm!(
                 "sts 0x60, {ce}",
                 "sts 0x60, {on}",
                 ce = in(reg) WDCE | WDE,
-                on = in(reg) WDE | WDP2,
+                on = in(reg) setting,
                 options(nostack),
             );
         });
+        avr_device::asm::wdr();
     }
 
     /// Timer3 now, in 4 us ticks.
@@ -303,22 +375,30 @@ impl Board {
         while self.now().wrapping_sub(from) < ticks {}
     }
 
-    /// Waits for the next control period and feeds the watchdog. After an
-    /// overrun the schedule restarts from now rather than catching up.
+    /// Waits for the next control period, serving USB but for its last
+    /// [`USB_QUIET_TICKS`] (so that it starts on time), and feeds the
+    /// watchdog unless a touch is pending. After an overrun the schedule
+    /// restarts from now rather than catching up.
     pub fn wait_period(&mut self) {
         let next = self.period_start.wrapping_add(PERIOD_TICKS);
         if self.now().wrapping_sub(self.period_start) >= PERIOD_TICKS {
             self.period_start = self.now();
         } else {
+            while self.now().wrapping_sub(self.period_start) < PERIOD_TICKS - USB_QUIET_TICKS {
+                self.serve_usb();
+            }
             self.wait_until(self.period_start, PERIOD_TICKS);
             self.period_start = next;
         }
-        avr_device::asm::wdr();
+        self.feed_watchdog();
     }
 
-    /// Feeds the watchdog (long operations: EEPROM writes).
+    /// Feeds the watchdog (long operations: EEPROM writes), unless a
+    /// touch is pending.
     pub fn feed_watchdog(&self) {
-        avr_device::asm::wdr();
+        if !self.touched.get() {
+            avr_device::asm::wdr();
+        }
     }
 
     /// Reads both buttons. B shares its pin with the green LED: the pin becomes
@@ -358,14 +438,19 @@ impl Board {
             .modify(|r, w| unsafe { w.bits(r.bits() | SENSOR_RIGHT) });
         let t = self.now();
         self.wait_until(t, RC_CHARGE_US.div_ceil(TICK_US) + 1);
-        f.ddrf()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        f.portf()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
-        d.ddrd()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
-        d.portd()
-            .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        // Inputs without pull-up, with interrupts off for these few cycles:
+        // an encoder interrupt between a DDR and its PORT write would leave
+        // the pull-up on while the sensor discharges.
+        interrupt::free(|_| {
+            f.ddrf()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+            f.portf()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !(SENSOR_LEFT | SENSOR_MID)) });
+            d.ddrd()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+            d.portd()
+                .modify(|r, w| unsafe { w.bits(r.bits() & !SENSOR_RIGHT) });
+        });
         // Poll: only sample the pins and the timer; `Discharge` notes when a
         // sensor is first seen low and works the times out afterwards.
         let mut discharge = Discharge::start(self.now());
@@ -430,12 +515,14 @@ impl Board {
         });
     }
 
-    /// Sends bytes on USART1 (blocking).
+    /// Sends bytes on USART1 (blocking; serves USB once per byte, while
+    /// the byte goes out: 87 us).
     pub fn send(&self, bytes: &[u8]) {
         let u = &self.dp.USART1;
         for byte in bytes {
             while u.ucsr1a().read().bits() & (1 << 5) == 0 {} // UDRE1
             u.udr1().write(|w| unsafe { w.bits(*byte) });
+            self.serve_usb();
         }
     }
 
@@ -456,6 +543,7 @@ impl Board {
         for (i, byte) in bytes.iter().enumerate() {
             while e.eecr().read().bits() & (1 << 1) != 0 {
                 self.feed_watchdog();
+                self.serve_usb();
             }
             e.eear().write(|w| w.set(addr + i as u16));
             e.eedr().write(|w| unsafe { w.bits(*byte) });
@@ -471,6 +559,9 @@ impl Board {
         let t = &self.dp.TWI;
         t.twcr().write(|w| unsafe { w.bits(control) });
         let start = self.now();
+        // USB once per step, while the TWI moves the byte (90 us at 100
+        // kHz): serving in the wait itself would delay noticing TWINT.
+        self.serve_usb();
         while t.twcr().read().bits() & TWINT == 0 {
             if self.now().wrapping_sub(start) >= TWI_TIMEOUT_TICKS {
                 self.twi_recover();

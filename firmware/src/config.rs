@@ -10,6 +10,10 @@ use shared::{CameraConfig, FieldCalibration, SensorRange};
 pub const TICK_US: u16 = shared::calibration::RC_TICK_US;
 /// Control period: 20 ms, one Pixy frame (50 frames/s).
 pub const PERIOD_TICKS: u16 = 20_000 / TICK_US;
+/// The end of each period's wait, without USB work, so that the next
+/// period starts on time: 200 us (serving USB once takes at most about
+/// 100 us, a 64-byte packet written byte by byte).
+pub const USB_QUIET_TICKS: u16 = 200 / TICK_US;
 /// RC discharge timeout: 2000 us, as in Pololu's Zumo library. A sensor
 /// still high after it reads this value.
 pub const RC_TIMEOUT_TICKS: u16 = shared::calibration::RC_TIMEOUT_TICKS;

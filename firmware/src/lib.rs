@@ -20,3 +20,4 @@ pub mod pixy;
 pub mod rc;
 pub mod screen_calibration;
 pub mod supervisor;
+pub mod usb;

@@ -3,7 +3,11 @@
 //!
 //! Each 20 ms period: encoder counts of the period before -> buttons -> field sensors (RC timing) -> Pixy blocks
 //! -> supervisor (mode, faults) -> decision -> motors -> EEPROM (after a
-//! calibration from the display's screens) -> LEDs -> log frame on USART1.
+//! calibration from the display's screens) -> LEDs -> log frame on USART1
+//! and, when a host holds the USB serial port open, on USB. USB is served
+//! while the loop waits (`board::usb`); after a 1200-baud touch the loop
+//! only waits, motors stopped, for the watchdog to reset the chip into the
+//! bootloader.
 #![cfg_attr(target_arch = "avr", no_std)]
 #![cfg_attr(target_arch = "avr", no_main)]
 #![cfg_attr(target_arch = "avr", feature(asm_experimental_arch))]
@@ -16,15 +20,14 @@ mod board;
 #[avr_device::entry]
 fn main() -> ! {
     use firmware::calibration_record::{self, RECORD_LEN};
-    use firmware::camera::Camera;
     use firmware::config::{CALIBRATION_EEPROM_ADDR, CAMERA, UNCALIBRATED};
     use firmware::decision::Decider;
     use firmware::embedded;
-    use firmware::supervisor::Supervisor;
     use shared::LogFrame;
 
     let (mut board, scales) = board::Board::take();
     board.init();
+    board.usb_init(embedded::USB_SERIAL);
 
     let mut record = [0u8; RECORD_LEN];
     board.eeprom_read(CALIBRATION_EEPROM_ADDR, &mut record);
@@ -33,9 +36,11 @@ fn main() -> ! {
     let policy = board::FlashPolicy;
     // The curves stay in place (static RAM): each period's decider borrows them.
     scales.calibrate(&calibration);
-    let mut supervisor = Supervisor::new(stored.is_some());
-    let mut camera = Camera::new();
-    let mut frame = [0u8; LogFrame::MAX_ENCODED_LEN];
+    let LoopState {
+        supervisor,
+        camera,
+        frame,
+    } = loop_state(stored.is_some());
     // Frames since the log last carried the calibration in use: it goes out
     // in the first frame, after a new one takes effect, and every
     // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
@@ -47,6 +52,9 @@ fn main() -> ! {
     board.watchdog_on();
     loop {
         board.wait_period();
+        if board.touched() {
+            continue;
+        }
         board.mark(4);
         let encoder_counts = board.take_encoder_counts();
         let buttons = board.buttons();
@@ -62,8 +70,14 @@ fn main() -> ! {
             &policy,
             embedded::MOTORS,
         );
+        // A touch during this period already stopped the motors: keep them so.
+        let source = if board.touched() {
+            firmware::supervisor::MotorSource::Stop
+        } else {
+            plan.motors
+        };
         let (decision, command) =
-            decide_and_drive(&board, &decider, &times, camera.blocks(), plan.motors);
+            decide_and_drive(&board, &decider, &times, camera.blocks(), source);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;
@@ -94,9 +108,39 @@ fn main() -> ! {
             robot_id,
             encoder_counts,
         };
-        let n = log.encode(&mut frame);
-        board.send(frame.get(..n).unwrap_or(&[]));
+        let n = log.encode(frame);
+        let bytes = frame.get(..n).unwrap_or(&[]);
+        board.send(bytes);
+        board.send_usb(bytes);
         board.mark(3);
+    }
+}
+
+/// The control loop's state across periods, in static RAM: on the stack
+/// it made the loop's frame about 550 bytes deep, which left too little
+/// room above the bootloader key at 0x0800 (docs/firmware.md, "Measured").
+#[cfg(target_arch = "avr")]
+struct LoopState {
+    supervisor: firmware::supervisor::Supervisor,
+    camera: firmware::camera::Camera,
+    frame: [u8; shared::LogFrame::MAX_ENCODED_LEN],
+}
+
+#[cfg(target_arch = "avr")]
+static mut LOOP_STATE: core::mem::MaybeUninit<LoopState> = core::mem::MaybeUninit::uninit();
+
+/// Sets up the loop's state in place (out of line: its temporaries stay
+/// out of the loop's frame). Called once.
+#[cfg(target_arch = "avr")]
+#[inline(never)]
+fn loop_state(calibrated: bool) -> &'static mut LoopState {
+    // SAFETY: called once, before the loop: the only reference ever made.
+    unsafe {
+        (*core::ptr::addr_of_mut!(LOOP_STATE)).write(LoopState {
+            supervisor: firmware::supervisor::Supervisor::new(calibrated),
+            camera: firmware::camera::Camera::new(),
+            frame: [0; shared::LogFrame::MAX_ENCODED_LEN],
+        })
     }
 }
 

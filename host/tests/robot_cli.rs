@@ -319,8 +319,10 @@ fn flash_dry_run_prints_the_exact_commands_and_validates_first() {
     let expected = format!(
         "env -u CARGO_TARGET_DIR FIRMWARE_POLICY={} FIRMWARE_HASHER=original FIRMWARE_ROBOT_ID=3 \
          FIRMWARE_OUT={}/target/flash/{crc:08x}-robot3 {}/scripts/build-firmware\n\
-         # check that the hex embeds policy CRC {crc:08x} and robot id 3, then double-press the robot's reset button \
-         (its bootloader waits 8 s); once /dev/ttyACM0 appears:\n\
+         # check that the hex embeds policy CRC {crc:08x} and robot id 3, then the 1200-baud touch: open /dev/ttyACM0 at \
+         1200 baud and drop DTR (the robot resets into its bootloader; if /dev/ttyACM0 does not exist or the touch fails, \
+         double-press the robot's reset button: its bootloader waits 8 s); once the bootloader's port appears \
+         (a port new since the touch, or /dev/ttyACM0 back):\n\
          avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U flash:w:{}/target/flash/{crc:08x}-robot3/firmware.hex:i\n",
         policy_path().display(),
         repo.display(),

@@ -11,6 +11,12 @@
 //! | 7      | 1    | robot id                                   |
 //! | 8      | 4    | the policy blob's CRC-32 (its last 4 bytes), LE |
 
+/// The baud rate that, set on the robot's USB serial port with DTR then
+/// dropped (the port opened at it and closed), resets the robot into its
+/// bootloader: the "1200-baud touch" of Arduino's tools, which the
+/// firmware answers and `host flash` sends.
+pub const USB_TOUCH_BAUD: u32 = 1200;
+
 /// The identity of one firmware build.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct FirmwareIdentity {
@@ -46,6 +52,23 @@ impl FirmwareIdentity {
             c[1],
             c[2],
             c[3],
+        ]
+    }
+
+    /// The USB serial number the firmware presents (`robot-` and the robot
+    /// id in three digits, `robot-007`), so that `/dev/serial/by-id/`
+    /// tells robots apart.
+    pub const fn usb_serial(robot_id: u8) -> [u8; 9] {
+        [
+            b'r',
+            b'o',
+            b'b',
+            b'o',
+            b't',
+            b'-',
+            b'0' + robot_id / 100,
+            b'0' + robot_id / 10 % 10,
+            b'0' + robot_id % 10,
         ]
     }
 
@@ -88,5 +111,12 @@ mod tests {
             Some(0xDEAD_BEEF)
         );
         assert_eq!(FirmwareIdentity::policy_crc_of(&[1, 2]), None);
+    }
+
+    #[test]
+    fn the_usb_serial_number_names_the_robot_in_three_digits() {
+        assert_eq!(&FirmwareIdentity::usb_serial(0), b"robot-000");
+        assert_eq!(&FirmwareIdentity::usb_serial(7), b"robot-007");
+        assert_eq!(&FirmwareIdentity::usb_serial(255), b"robot-255");
     }
 }

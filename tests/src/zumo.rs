@@ -3,7 +3,8 @@
 //! while they discharge), a Pixy on TWI (its frames encoded here, from the
 //! Pixy's protocol, not by the firmware's code), wheel encoders, the I2C
 //! lines' pull-ups (and a device that can hold SDA low), buttons, motor
-//! registers, the USART1 log and the firmware's cycle markers.
+//! registers, the USART1 log and the firmware's cycle markers (the USB
+//! host is `crate::usb_host`).
 //!
 //! `avr-tester` runs the simulation; what it does not offer (USART1 on the
 //! 32U4, data memory, the cycle counter, EEPROM, I/O register hooks) goes
@@ -37,10 +38,12 @@ const OCR1B: usize = 0x8A;
 const PORTB: usize = 0x25;
 /// GPIOR0, the firmware's decision marker, in data memory.
 const GPIOR0: u16 = 0x3E;
+/// MCUSR (reset flags) in data memory.
+const MCUSR: u16 = 0x54;
 /// The stack pointer (SPL, SPH) in data memory.
 const SP: usize = 0x5D;
-/// Above the firmware's statics at their budget (0x0100 + 1 KiB of .data + .bss).
-const STATICS_END: usize = 0x0500;
+/// Above the firmware's statics at their budget (0x0100 + 1,536 bytes of .data + .bss).
+const STATICS_END: usize = 0x0700;
 /// One past the last SRAM byte.
 const RAM_END: usize = 0x0B00;
 /// The stack paint pattern.
@@ -403,6 +406,9 @@ struct State {
     marks: Vec<(u8, u64)>,
     /// Decision-end markers seen.
     decisions: u64,
+    /// The bootloader key (SRAM 0x0800) at each start-up that followed a
+    /// watchdog reset (MCUSR.WDRF set when the firmware clears MCUSR).
+    watchdog_resets: Vec<u16>,
     ddr: [u8; 2],
     /// Discharge delay of each sensor in cycles; `None` = never (timeout).
     delays: [Option<u64>; 3],
@@ -430,6 +436,25 @@ unsafe extern "C" fn on_gpior0(
         let state = &mut *(param as *mut State);
         state.marks.push((v, (*avr).cycle));
         state.decisions += u64::from(v == 2);
+    }
+}
+
+/// MCUSR written (the firmware clears it first thing): after a watchdog
+/// reset (WDRF, bit 3) the key at 0x0800 is what the bootloader would see.
+unsafe extern "C" fn on_mcusr(
+    avr: *mut ffi::avr_t,
+    addr: ffi::avr_io_addr_t,
+    v: u8,
+    param: *mut c_void,
+) {
+    // SAFETY: as in `on_gpior0`.
+    unsafe {
+        let reg = (*avr).data.add(usize::from(addr));
+        if *reg & 1 << 3 != 0 {
+            let key = u16::from_le_bytes([*(*avr).data.add(0x0800), *(*avr).data.add(0x0801)]);
+            (*(param as *mut State)).watchdog_resets.push(key);
+        }
+        *reg = v;
     }
 }
 
@@ -531,6 +556,9 @@ pub struct Zumo {
     external: Box<ExternalPins>,
     decoded: usize,
     pullup_on: Rc<Cell<u32>>,
+    /// What simavr's callbacks registered by other modules point to
+    /// (`usb_host`'s background host), dropped after the core.
+    kept: Vec<Box<dyn std::any::Any>>,
 }
 
 impl Zumo {
@@ -559,6 +587,7 @@ impl Zumo {
             uart: Vec::new(),
             marks: Vec::new(),
             decisions: 0,
+            watchdog_resets: Vec::new(),
             ddr: [0; 2],
             delays: [Some(CLOCK_HZ / 1000); 3],
             sensors: pins::FIELD_SENSORS.map(|pin| RcSensor {
@@ -634,6 +663,7 @@ impl Zumo {
                 ffi::avr_irq_register_notify(irq, Some(f), state_ptr as *mut c_void);
             }
             ffi::avr_register_io_write(avr, GPIOR0, Some(on_gpior0), state_ptr as *mut c_void);
+            ffi::avr_register_io_write(avr, MCUSR, Some(on_mcusr), state_ptr as *mut c_void);
             for e in &encoders {
                 e.drive();
             }
@@ -660,6 +690,7 @@ impl Zumo {
             external,
             decoded: 0,
             pullup_on,
+            kept: Vec::new(),
         };
         zumo.tester
             .twi0()
@@ -856,7 +887,32 @@ impl Zumo {
         self.state.decisions
     }
 
-    fn data(&self, addr: usize) -> u8 {
+    /// simavr's handle of the running core (for the USB host's ioctls).
+    pub(crate) fn core(&self) -> *mut ffi::avr_t {
+        self.state.avr
+    }
+
+    /// Runs the firmware for `us` simulated microseconds.
+    pub fn run_us(&mut self, us: u64) {
+        self.tester.run_for_us(us);
+    }
+
+    /// Keeps `value` alive as long as the core (a callback's parameter).
+    pub(crate) fn keep<T: 'static>(&mut self, value: Box<T>) -> &T {
+        self.kept.push(value);
+        self.kept
+            .last()
+            .and_then(|b| b.downcast_ref::<T>())
+            .expect("just kept")
+    }
+
+    /// A value kept by [`Zumo::keep`], by type.
+    pub(crate) fn kept<T: 'static>(&self) -> Option<&T> {
+        self.kept.iter().find_map(|b| b.downcast_ref::<T>())
+    }
+
+    /// A byte of the core's data space (registers, I/O, SRAM).
+    pub(crate) fn data(&self, addr: usize) -> u8 {
         assert!(
             addr < RAM_END,
             "data address {addr:#x} outside the 32U4's data space"
@@ -903,6 +959,35 @@ impl Zumo {
     /// The word at SRAM 0x0800 (the bootloader's key).
     pub fn boot_key(&self) -> u16 {
         self.word(0x0800)
+    }
+
+    /// The bootloader key found at each watchdog reset so far (0x7777:
+    /// the A-Star bootloader would have stayed in itself).
+    pub fn watchdog_resets(&self) -> &[u16] {
+        &self.state.watchdog_resets
+    }
+
+    /// Runs the firmware with simavr's own stepping (avr-tester cannot
+    /// step over a reset: simavr restarts its cycle counter) until it
+    /// starts again after a watchdog reset, or `max_ms` pass. Returns the
+    /// simulated milliseconds until that start, if it came.
+    pub fn run_until_watchdog_reset(&mut self, max_ms: u64) -> Option<u64> {
+        let avr = self.state.avr;
+        let seen = self.state.watchdog_resets.len();
+        let mut elapsed = 0u64;
+        // SAFETY: the core is live; simavr steps it on this thread.
+        let mut last = unsafe { (*avr).cycle };
+        while elapsed < max_ms * (CLOCK_HZ / 1000) {
+            // SAFETY: as above.
+            unsafe { ffi::avr_run(avr) };
+            let now = unsafe { (*avr).cycle };
+            elapsed += if now >= last { now - last } else { now };
+            last = now;
+            if self.state.watchdog_resets.len() > seen {
+                return Some(elapsed / (CLOCK_HZ / 1000));
+            }
+        }
+        None
     }
 
     /// Every byte the firmware has sent on USART1 since boot: the raw

@@ -100,7 +100,8 @@ struct Observed {
     directions: (bool, bool),
 }
 
-/// A Zumo running `elf`, calibrated by the real procedure (button B, then
+/// A Zumo running `elf`, its USB serial port open and streaming to a host
+/// in the background, calibrated by the real procedure (button B, then
 /// the display's white and black screens as RC delays on the sensor pins:
 /// each sensor's model time at field 1.0 and at 0.0, placed mid-tick as in
 /// the exact check), driving, stopped right after a decision. Panics unless
@@ -108,6 +109,9 @@ struct Observed {
 fn driving_zumo(elf: &std::path::Path, model: &RobotSensors, latency_us: f64) -> Zumo {
     let mut z = Zumo::boot_elf(elf);
     z.run_ms(40);
+    // USB enumerated and streaming all along, a control request every 7 ms.
+    z.usb_open(4);
+    z.stream_usb_in_background(firmware::usb::IN_EP, 7_000);
     let cal = model.calibration();
     let screen = |ticks: [u16; 3]| ticks.map(|t| Some(cycles_of_ticks(t, latency_us)));
     z.calibrate_cycles(
@@ -469,6 +473,22 @@ fn equivalence(v: &Variant) {
             thousands(worst)
         ),
     ]);
+
+    // The host read the log over USB all the while, whole frames that decode.
+    let (usb, requests, _) = z.usb_background();
+    let usb_frames: Vec<&[u8]> = usb.split(|b| *b == LogFrame::DELIMITER).collect();
+    let decoded = usb_frames
+        .iter()
+        .filter(|f| LogFrame::decode(f).is_ok())
+        .count();
+    println!(
+        "USB: {} bytes, {decoded} frames decoded, {requests} control requests answered meanwhile",
+        usb.len()
+    );
+    assert!(
+        decoded >= n && requests as usize >= n,
+        "USB streamed {decoded} frames and answered {requests} requests over {n} periods"
+    );
 
     assert!(
         mismatches.is_empty(),

@@ -53,7 +53,8 @@ pub enum Command {
     /// Check a recorded log (or a raw serial capture) against a policy:
     /// divergences, state coverage, actions, faults, damaged records.
     Replay(ReplayArgs),
-    /// Build the firmware with a policy and flash it with avrdude (double
+    /// Build the firmware with a policy and flash it with avrdude (the
+    /// robot's USB port touched at 1200 baud into its bootloader, or a double
     /// press of reset); --dry-run prints the commands.
     Flash(FlashArgs),
     /// Work with fields on a screen arena.

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 /// `host monitor`'s options (docs/robot-logs.md).
 #[derive(Args)]
 pub struct MonitorArgs {
-    /// Serial port of the robot's TTL adapter or radio, e.g. /dev/ttyUSB0.
+    /// The robot's USB serial port (/dev/ttyACM0, or its /dev/serial/by-id/ link) or its TTL adapter's or radio's, e.g. /dev/ttyUSB0.
     #[arg(long, required_unless_present = "list")]
     pub port: Option<String>,
     /// Baud rate (the firmware sends 115200 8N1).
@@ -67,7 +67,7 @@ pub struct FlashArgs {
     /// The policy blob to embed.
     #[arg(long)]
     pub policy: PathBuf,
-    /// The bootloader's serial port (appears after a double press of reset), e.g. /dev/ttyACM0.
+    /// The robot's USB serial port (touched at 1200 baud to enter its bootloader), or the bootloader's, e.g. /dev/ttyACM0.
     #[arg(long)]
     pub port: Option<String>,
     /// Build for this hasher; the policy must use it (default: the policy's own).

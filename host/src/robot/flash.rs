@@ -7,9 +7,20 @@
 //! builds that policy (and robot id) into its own fresh output directory,
 //! `target/flash/<policy CRC>-robot<id>/` (whatever `CARGO_TARGET_DIR` or
 //! `FIRMWARE_OUT` the environment holds), the hex is checked to embed that
-//! policy's CRC and robot id (`shared::FirmwareIdentity`), the user
-//! double-presses reset, and once the bootloader's port *appears* (a port
-//! that was there before the request does not count) avrdude writes the hex.
+//! policy's CRC and robot id (`shared::FirmwareIdentity`), the robot is
+//! sent into its bootloader, and once the bootloader's port *appears* (a
+//! port that was there before does not count) avrdude writes the hex.
+//!
+//! Into the bootloader: when `--port` exists (the robot's own USB serial
+//! port), the 1200-baud touch: open it at 1200 baud, drop DTR, close it;
+//! the firmware stops its motors and lets the watchdog reset the chip into
+//! the bootloader, whose port is a new one (another USB product id, no
+//! serial number): the first serial port to appear that was not there
+//! before the touch, or `--port` itself once it went away and came back.
+//! Several new ports at once (several robots' bootloaders) are refused:
+//! nothing tells them apart. When `--port` does not exist, or the touch
+//! fails (firmware without USB), the user double-presses reset and the
+//! port must appear.
 
 use anyhow::{bail, Context, Result};
 use shared::{FirmwareIdentity, StateHasher};
@@ -206,8 +217,10 @@ impl FlashPlan {
             quote(&self.build_script().display().to_string())
         ));
         out.push_str(&format!(
-            "# check that the hex embeds policy CRC {:08x} and robot id {}, then double-press the robot's reset button \
-             (its bootloader waits 8 s); once {port} appears:\n",
+            "# check that the hex embeds policy CRC {:08x} and robot id {}, then the 1200-baud touch: open {port} at \
+             1200 baud and drop DTR (the robot resets into its bootloader; if {port} does not exist or the touch fails, \
+             double-press the robot's reset button: its bootloader waits 8 s); once the bootloader's port appears \
+             (a port new since the touch, or {port} back):\n",
             self.policy_crc, self.robot_id
         ));
         out.push_str(&format!("avrdude {}\n", avrdude.join(" ")));
@@ -316,11 +329,81 @@ fn is_executable(p: &Path) -> bool {
     p.is_file()
 }
 
+/// The serial ports the system lists now (USB ones included), by name.
+pub fn system_ports() -> Vec<String> {
+    serialport::available_ports()
+        .map(|ports| ports.into_iter().map(|p| p.port_name).collect())
+        .unwrap_or_default()
+}
+
+/// The 1200-baud touch: opens `port` at 1200 baud, drops DTR, closes it.
+pub fn touch(port: &str) -> Result<()> {
+    let mut p = serialport::new(port, shared::identity::USB_TOUCH_BAUD)
+        .timeout(Duration::from_millis(100))
+        .open()
+        .with_context(|| format!("cannot open {port} at 1200 baud"))?;
+    p.write_data_terminal_ready(false)
+        .with_context(|| format!("cannot drop DTR on {port}"))?;
+    Ok(())
+}
+
+/// Watches for the bootloader's port after a touch: a port listed now
+/// that was not listed before the touch, or that was and went away since
+/// (`/dev/ttyACM0` coming back as the bootloader), or `port` itself back
+/// after it went away.
+#[derive(Clone, Debug)]
+pub struct NewPort {
+    port: String,
+    before: Vec<String>,
+    gone: Vec<String>,
+    port_gone: bool,
+}
+
+impl NewPort {
+    /// Starts watching, with the ports listed just before the touch.
+    pub fn new(port: &str, before: Vec<String>) -> NewPort {
+        NewPort {
+            port: port.to_string(),
+            before,
+            gone: Vec::new(),
+            port_gone: false,
+        }
+    }
+
+    /// Looks at the ports listed now and whether `port` exists: the new
+    /// port once exactly one appeared, an error if several did.
+    pub fn check(&mut self, listed: &[String], port_exists: bool) -> Result<Option<String>> {
+        self.port_gone |= !port_exists;
+        for p in &self.before {
+            if !listed.contains(p) && !self.gone.contains(p) {
+                self.gone.push(p.clone());
+            }
+        }
+        let mut new: Vec<String> = listed
+            .iter()
+            .filter(|p| !self.before.contains(p) || self.gone.contains(p))
+            .cloned()
+            .collect();
+        if self.port_gone && port_exists && !new.contains(&self.port) {
+            new.push(self.port.clone());
+        }
+        match new.len() {
+            0 => Ok(None),
+            1 => Ok(new.pop()),
+            _ => bail!(
+                "several new serial ports appeared ({}): several robots entering their bootloaders cannot be told \
+                 apart (the bootloader has no serial number); flash one robot at a time. Nothing was written",
+                new.join(", ")
+            ),
+        }
+    }
+}
+
 /// Builds and flashes: checks the port and avrdude (`None`: not installed)
 /// first, builds into the plan's fresh output, checks the hex's identity,
-/// asks for the double press, waits up to `port_wait` for the port to
-/// appear (one there already must go away first: it is not the bootloader
-/// the user just started), runs avrdude. Progress goes to `out`; the build's and
+/// sends the robot into its bootloader (the module's touch, or the user's
+/// double press), waits up to `port_wait` for the bootloader's port to
+/// appear, runs avrdude on it. Progress goes to `out`; the build's and
 /// avrdude's own output to this process's.
 pub fn flash(
     plan: &FlashPlan,
@@ -330,8 +413,9 @@ pub fn flash(
 ) -> Result<()> {
     let Some(port) = plan.port.as_deref() else {
         bail!(
-            "--port is required to flash: after a double press of reset the bootloader appears as a serial port \
-             (usually /dev/ttyACM0; `host monitor --list` lists ports). Nothing was built or written."
+            "--port is required to flash: the robot's USB serial port (e.g. /dev/ttyACM0 or its /dev/serial/by-id/ link, \
+             `host monitor --list` lists ports), or the port its bootloader appears as after a double press of reset. \
+             Nothing was built or written."
         );
     };
     let Some(avrdude) = avrdude else {
@@ -374,12 +458,64 @@ pub fn flash(
         );
     }
     plan.check_hex()?;
-    let mut was_there = Path::new(port).exists();
     writeln!(
         out,
         "flash: the hex embeds policy CRC {:08x} and robot id {}",
         plan.policy_crc, plan.robot_id
     )?;
+    let before = system_ports();
+    let touched = Path::new(port).exists() && {
+        match touch(port) {
+            Ok(()) => true,
+            Err(e) => {
+                writeln!(out, "flash: the 1200-baud touch failed ({e:#})")?;
+                false
+            }
+        }
+    };
+    let bootloader = if touched {
+        writeln!(
+            out,
+            "flash: 1200-baud touch on {port}: the robot resets into its bootloader; waiting up to {} s for its port",
+            port_wait.as_secs()
+        )?;
+        out.flush()?;
+        let mut watch = NewPort::new(port, before);
+        let start = Instant::now();
+        loop {
+            if let Some(found) = watch.check(&system_ports(), Path::new(port).exists())? {
+                break found;
+            }
+            if start.elapsed() >= port_wait {
+                bail!(
+                    "no bootloader port appeared within {} s of the 1200-baud touch on {port}: double-press reset and \
+                     run again. Nothing was written to the robot",
+                    port_wait.as_secs()
+                );
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    } else {
+        wait_for_double_press(port, port_wait, out)?;
+        port.to_string()
+    };
+    writeln!(out, "flash: writing through {bootloader}")?;
+    let status = Command::new(avrdude)
+        .args(plan.avrdude_args(&bootloader))
+        .status()
+        .with_context(|| format!("cannot run {}", avrdude.display()))?;
+    if !status.success() {
+        bail!("avrdude failed ({status}); the robot keeps its bootloader, so double-press reset and try again");
+    }
+    writeln!(out, "flash: done; the robot runs the new firmware")?;
+    Ok(())
+}
+
+/// Asks for the double press of reset and waits up to `port_wait` for
+/// `port` to appear (one there already must go away first: it is not the
+/// bootloader the user just started).
+fn wait_for_double_press(port: &str, port_wait: Duration, out: &mut dyn Write) -> Result<()> {
+    let mut was_there = Path::new(port).exists();
     writeln!(
         out,
         "flash: double-press the robot's reset button now; waiting up to {} s for {port} to appear",
@@ -393,7 +529,7 @@ pub fn flash(
     loop {
         let there = Path::new(port).exists();
         if there && !was_there {
-            break;
+            return Ok(());
         }
         was_there &= there;
         if start.elapsed() >= port_wait {
@@ -405,15 +541,6 @@ pub fn flash(
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-    let status = Command::new(avrdude)
-        .args(plan.avrdude_args(port))
-        .status()
-        .with_context(|| format!("cannot run {}", avrdude.display()))?;
-    if !status.success() {
-        bail!("avrdude failed ({status}); the robot keeps its bootloader, so double-press reset and try again");
-    }
-    writeln!(out, "flash: done; the robot runs the new firmware")?;
-    Ok(())
 }
 
 #[cfg(test)]
@@ -490,13 +617,51 @@ mod tests {
             plan.describe(),
             format!(
                 "env -u CARGO_TARGET_DIR FIRMWARE_POLICY={} FIRMWARE_HASHER=original FIRMWARE_ROBOT_ID=4 FIRMWARE_OUT='{}/target/flash/{crc:08x}-robot4' '{}/scripts/build-firmware'\n\
-                 # check that the hex embeds policy CRC {crc:08x} and robot id 4, then double-press the robot's reset button (its bootloader waits 8 s); once /dev/ttyACM0 appears:\n\
+                 # check that the hex embeds policy CRC {crc:08x} and robot id 4, then the 1200-baud touch: open /dev/ttyACM0 at 1200 baud and drop DTR (the robot resets into its bootloader; if /dev/ttyACM0 does not exist or the touch fails, double-press the robot's reset button: its bootloader waits 8 s); once the bootloader's port appears (a port new since the touch, or /dev/ttyACM0 back):\n\
                  avrdude -p atmega32u4 -c avr109 -P /dev/ttyACM0 -b 57600 -D -U 'flash:w:{}/target/flash/{crc:08x}-robot4/firmware.hex:i'\n",
                 policy.display(),
                 repo.display(),
                 repo.display(),
                 repo.display()
             )
+        );
+    }
+
+    #[test]
+    fn after_a_touch_the_bootloaders_port_is_the_one_that_appears() {
+        let s = |v: &[&str]| v.iter().map(|p| p.to_string()).collect::<Vec<_>>();
+        // The robot's port goes away and comes back under its name.
+        let mut w = NewPort::new("/dev/ttyACM0", s(&["/dev/ttyACM0", "/dev/ttyACM1"]));
+        assert_eq!(
+            w.check(&s(&["/dev/ttyACM0", "/dev/ttyACM1"]), true)
+                .unwrap(),
+            None
+        );
+        assert_eq!(w.check(&s(&["/dev/ttyACM1"]), false).unwrap(), None);
+        assert_eq!(
+            w.check(&s(&["/dev/ttyACM0", "/dev/ttyACM1"]), true)
+                .unwrap(),
+            Some("/dev/ttyACM0".to_string())
+        );
+        // Given by its by-id link (which the bootloader does not bring
+        // back): the bootloader's port is a new name.
+        let by_id = "/dev/serial/by-id/usb-zumo-swarm_Zumo_32U4_robot_robot-003-if00";
+        let mut w = NewPort::new(by_id, s(&["/dev/ttyACM0", "/dev/ttyACM1"]));
+        assert_eq!(w.check(&s(&["/dev/ttyACM1"]), false).unwrap(), None);
+        assert_eq!(
+            w.check(&s(&["/dev/ttyACM1", "/dev/ttyACM2"]), false)
+                .unwrap(),
+            Some("/dev/ttyACM2".to_string())
+        );
+        // Two bootloaders at once cannot be told apart.
+        let mut w = NewPort::new("/dev/ttyACM0", s(&["/dev/ttyACM0"]));
+        let e = w
+            .check(&s(&["/dev/ttyACM1", "/dev/ttyACM2"]), false)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("several new serial ports") && e.contains("one robot at a time"),
+            "{e}"
         );
     }
 

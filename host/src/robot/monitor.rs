@@ -37,6 +37,13 @@ pub struct SerialOpener {
 
 impl PortOpener for SerialOpener {
     fn open(&mut self) -> Result<Box<dyn Read + Send>> {
+        if self.baud == shared::identity::USB_TOUCH_BAUD {
+            anyhow::bail!(
+                "{} baud on a robot's USB port is the touch that resets it into its bootloader when the port \
+                 closes: monitor at another rate (any rate works on USB)",
+                self.baud
+            );
+        }
         let port = serialport::new(&self.port, self.baud)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
@@ -366,6 +373,16 @@ mod tests {
     use shared::{ActionId, LogFrame};
     use std::collections::VecDeque;
     use std::io::Cursor;
+
+    #[test]
+    fn monitoring_at_1200_baud_is_refused_since_closing_would_reset_the_robot() {
+        let mut opener = SerialOpener {
+            port: "/dev/ttyACM0".to_string(),
+            baud: shared::identity::USB_TOUCH_BAUD,
+        };
+        let e = opener.open().err().unwrap().to_string();
+        assert!(e.contains("resets it into its bootloader"), "{e}");
+    }
 
     fn frame(tick: u32, action: u8) -> Vec<u8> {
         let f = LogFrame {

@@ -127,7 +127,10 @@ mod tests {
         }
         assert!("eval".parse::<Reward>().is_err());
         for r in Reward::ALL {
-            assert_eq!(serde_json::to_string(&r).unwrap(), format!("\"{}\"", r.name()));
+            assert_eq!(
+                serde_json::to_string(&r).unwrap(),
+                format!("\"{}\"", r.name())
+            );
         }
     }
 }
