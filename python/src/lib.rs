@@ -93,7 +93,10 @@ impl PyBatch {
         actions = None, forward_speed = ActionTable::DEFAULT_FORWARD_SPEED, autoreset = "next-step".to_string(),
         threads = None, arena = None
     ))]
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "each argument is a Python keyword argument of the constructor"
+    )]
     fn new(
         py: Python<'_>,
         num_worlds: i64,
@@ -444,7 +447,10 @@ impl PyBatch {
 /// Encodes a greedy table (one action per state) as policy blob bytes.
 #[pyfunction]
 #[pyo3(signature = (table, *, hasher, actions, forward_speed, field, name, trainer_steps, seed))]
-#[allow(clippy::too_many_arguments)]
+#[allow(
+    clippy::too_many_arguments,
+    reason = "each argument is a Python keyword argument of the function"
+)]
 fn encode_policy<'py>(
     py: Python<'py>,
     table: Vec<i64>,

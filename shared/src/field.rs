@@ -44,9 +44,10 @@ impl FieldValue {
     /// Converts a real number: clamped to [0, 1] (NaN reads as 0), then
     /// rounded to the nearest 1/32768, ties upwards.
     pub fn from_f32(value: f32) -> FieldValue {
-        // `!(value > 0.0)` also catches NaN, in one comparison (the AVR's
-        // flash is nearly full).
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        #[allow(
+            clippy::neg_cmp_op_on_partial_ord,
+            reason = "`!(value > 0.0)` also catches NaN, in one comparison (the AVR's flash is tight)"
+        )]
         if !(value > 0.0) {
             return Self::ZERO;
         }

@@ -2,6 +2,9 @@
 //! background (0 black, 1 white), pucks red, robots blue with a heading
 //! line, optionally each robot's sensor footprints. (Writing them as PNG
 //! or GIF files is the host's.)
+//!
+//! Room 11 of the simulator (`lib.rs`), at the top: it reads a simulation and
+//! changes nothing.
 
 use crate::base::vec2::Vec2;
 use crate::fields::ScalarField;

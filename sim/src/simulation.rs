@@ -19,6 +19,9 @@
 //! [`Simulation::readings`], choose the turns, [`Simulation::advance`], and
 //! [`Simulation::reset_episode`] when the [`StepReport`] says the episode
 //! ended. Both give the same trajectory for the same turns.
+//!
+//! Room 9 of the simulator (`lib.rs`): the loop that runs the four stages of a
+//! step, checks formations and resets stuck episodes.
 
 use crate::base::rng::SimRng;
 use crate::config::validate::ConfigError;

@@ -125,8 +125,10 @@ impl UsbPort {
     /// Turns the controller on: pad regulator, controller, PLL (16 MHz
     /// crystal), VBUS pad; detached until VBUS is seen. `serial` is the
     /// USB serial number. The port exists once: `None` on a second call.
-    // The port comes from the PORT static, taken once, not from `serial`.
-    #[allow(clippy::mut_from_ref)]
+    #[allow(
+        clippy::mut_from_ref,
+        reason = "the port comes from the PORT static, taken once, not from `serial`"
+    )]
     pub fn take(serial: &'static str) -> Option<&'static mut UsbPort> {
         // SAFETY: the only reference to PORT ever made: set here, once.
         let slot = unsafe { &mut *core::ptr::addr_of_mut!(PORT) };

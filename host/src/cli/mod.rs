@@ -4,6 +4,7 @@
 
 pub mod learn;
 pub mod robot;
+pub mod scenario;
 pub mod screen;
 pub mod simulate;
 

@@ -1,8 +1,10 @@
 //! The field on the TV: `host field export`, `host display` and `host
 //! observe`.
 
+use super::scenario::train_config_args;
 use anyhow::Result;
-use clap::Args;
+use clap::error::ErrorKind;
+use clap::{ArgMatches, Args, FromArgMatches};
 use host::display::DisplaySettings;
 use host::observe::ObserveSettings;
 use sim::fields::source::FieldSource;
@@ -10,15 +12,58 @@ use sim::scenario::arena_choice::ArenaChoice;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
-/// The screen and field of the TV tools.
-#[derive(Args)]
+/// The screen and field of the TV tools: a training config's `--arena`
+/// (a screen arena; `tv75` by default) and `--field` ([`TrainConfig`]'s
+/// fields, declared there once).
+#[derive(Clone, Debug)]
 pub struct ScreenArgs {
-    /// tv75 (the thesis' 75" TV) or a FILE.toml of a screen arena.
-    #[arg(long, default_value = "tv75")]
+    /// The screen arena.
     pub arena: ArenaChoice,
-    /// annulus, letter:T (T, I, L, V, X, Z) or an image file (PNG, JPEG).
-    #[arg(long, default_value = "annulus")]
+    /// The field.
     pub field: FieldSource,
+}
+
+impl Args for ScreenArgs {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        command.args(train_config_args(&["arena", "field"]).into_iter().map(|a| {
+            let default = if a.get_id() == "arena" {
+                "tv75"
+            } else {
+                "annulus"
+            };
+            a.default_value(default)
+        }))
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        ScreenArgs::augment_args(command)
+    }
+}
+
+impl FromArgMatches for ScreenArgs {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<ScreenArgs, clap::Error> {
+        let missing = |id| {
+            clap::Error::raw(
+                ErrorKind::MissingRequiredArgument,
+                format!("--{id} is missing"),
+            )
+        };
+        Ok(ScreenArgs {
+            arena: matches
+                .get_one::<ArenaChoice>("arena")
+                .cloned()
+                .ok_or_else(|| missing("arena"))?,
+            field: matches
+                .get_one::<FieldSource>("field")
+                .cloned()
+                .ok_or_else(|| missing("field"))?,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        *self = ScreenArgs::from_arg_matches(matches)?;
+        Ok(())
+    }
 }
 
 /// `host field export`'s options.

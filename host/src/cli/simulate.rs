@@ -1,14 +1,10 @@
-//! Simulating: the scenario flags `run`, `render` and `bench` share, and
-//! their own options.
+//! Simulating: `run`, `render` and `bench` (the scenario flags the first
+//! two share are in [`super::scenario`]).
 
-use anyhow::Result;
+use super::scenario::ScenarioArgs;
 use clap::Args;
 use host::bench::BenchVariant;
-use sim::config::BroadPhase;
-use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
-use sim::scenario::sensor_choice::SensorChoice;
-use sim::scenario::{ControllerChoice, Scenario};
 use std::path::PathBuf;
 
 /// `host bench`'s options.
@@ -37,7 +33,7 @@ pub struct BenchArgs {
 
 impl BenchArgs {
     /// The configuration to measure, an arena file read and checked.
-    pub fn variant(&self) -> Result<BenchVariant> {
+    pub fn variant(&self) -> anyhow::Result<BenchVariant> {
         let arena = match &self.arena {
             ArenaChoice::Thesis => None,
             other => Some(other.arena()?),
@@ -68,70 +64,6 @@ pub enum BenchSensors {
     Disc,
     /// The robot's photo-transistors and Pixy camera.
     Robot,
-}
-
-/// What to simulate.
-#[derive(Args)]
-pub struct ScenarioArgs {
-    /// oc, random or policy:FILE.
-    #[arg(long, default_value = "oc")]
-    pub controller: ControllerChoice,
-    /// annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the thesis' T, L, V, X, Z) or an image file (PNG, JPEG).
-    #[arg(long, default_value = "annulus")]
-    pub field: FieldSource,
-    /// Number of robots [default: the arena's: 8 in the thesis' arena, 5 on tv75].
-    #[arg(long)]
-    pub robots: Option<usize>,
-    /// Number of pucks [default: the arena's: 250 in the thesis' arena, 12 on tv75].
-    #[arg(long)]
-    pub pucks: Option<usize>,
-    /// Seed of every random choice.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
-    /// thesis (the reference model's 800 x 800 square), tv75 (the thesis'
-    /// 75" TV lying flat) or a FILE.toml of a screen arena
-    /// (docs/robot-sensors.md) [default: tv75 with --sensors robot, else thesis].
-    #[arg(long)]
-    pub arena: Option<ArenaChoice>,
-    /// All-pairs contact checks instead of the spatial grid (same results).
-    #[arg(long)]
-    pub naive: bool,
-    /// Sensor model: disc (the reference model's discs), disc-thesis (with
-    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
-    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
-    /// or robot:CONFIG.json (the same with settings from a JSON file;
-    /// docs/robot-sensors.md).
-    #[arg(long, default_value = "disc")]
-    pub sensors: SensorChoice,
-    /// Real-world noise, in multiples of the default (0 none, 1 the
-    /// default, 2 twice as much; docs/robot-sensors.md): wheel speeds,
-    /// turns and timing always, the robot senses' noise with --sensors robot.
-    #[arg(long, default_value_t = 0.0)]
-    pub noise: f64,
-}
-
-impl ScenarioArgs {
-    /// The scenario, with robot sensor and arena files read and checked.
-    pub fn scenario(self) -> Result<Scenario> {
-        let arena = self
-            .arena
-            .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()));
-        Ok(Scenario {
-            field: self.field,
-            controller: self.controller,
-            robots: self.robots,
-            pucks: self.pucks,
-            seed: self.seed,
-            broad_phase: if self.naive {
-                BroadPhase::Naive
-            } else {
-                BroadPhase::Grid
-            },
-            arena: arena.arena()?,
-            sensors: self.sensors.setup()?,
-            noise: self.noise,
-        })
-    }
 }
 
 /// `host run`'s options.

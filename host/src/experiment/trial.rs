@@ -113,8 +113,10 @@ impl Recorder {
 
 /// A trial's run, stepped by its caller: orbital construction on its own
 /// simulation, or a learner's training run.
-// One per trial: the policy variant's table inline costs nothing.
-#[allow(clippy::large_enum_variant)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per trial: the policy variant's table inline costs nothing"
+)]
 pub enum Running {
     /// Orbital construction.
     Oc(Box<Simulation<SelectedSensors>>, OrbitalConstruction),

@@ -1,6 +1,6 @@
 //! What every room uses: plane vectors, our own `sin_cos`, floor and
 //! rounding without libm, bit sets, the seeded generator, the
-//! counter-based draws of the noise models, and [`text_form!`], the one
+//! counter-based draws of the noise models, and [`crate::text_form!`], the one
 //! way a named choice (a field, a sensor model, an arena, a reward, a
 //! hasher) reads from and writes to config files. Depends on nothing else
 //! in the crate.

@@ -4,6 +4,8 @@
 //! Every struct deserialises with `#[serde(default)]`, so a TOML or JSON
 //! file only names what it changes. [`SimConfig::validate`] runs before a
 //! simulation is built and names the first offending value.
+//!
+//! Room 3 of the simulator (`lib.rs`): the settings every stage reads, below them all.
 
 pub mod actuation;
 pub mod disc_sensors;

@@ -11,6 +11,8 @@
 //! 4. calls [`Controller::observe`] with the [`StepOutcome`]: the new
 //!    readings, Eval when requested or at a formation check, and whether the
 //!    episode ended (it is reset right after `observe` returns).
+//!
+//! Room 8 of the simulator (`lib.rs`), the fourth stage of a step (world -> physics -> sensors -> **control**).
 
 pub mod greedy;
 pub mod orbital;

@@ -1,5 +1,7 @@
 //! What the simulation tells a controller about episodes: the fresh world
 //! at an episode's start, each step's outcome, and why an episode ended.
+//!
+//! Room 7 of the simulator (`lib.rs`): Eval, rewards and the episode events the simulation hands to the control stage.
 
 pub mod eval;
 pub mod reward;

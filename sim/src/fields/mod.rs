@@ -13,6 +13,8 @@
 //!   around it (past the outermost centres, the edge pixels extend to the
 //!   frame's border); outside the frame the screen is black (0). Sensors
 //!   and the evaluation of pucks both read this value.
+//!
+//! Room 2 of the simulator (`lib.rs`): what the robots read and Eval measures, below every stage.
 
 pub mod letters;
 pub mod source;

@@ -68,7 +68,10 @@ impl NeighbourIndex {
     /// than `threshold` (no centre closer than `r_body + max_radius -
     /// threshold`, which bounds the contact test's `r_body + r_j -
     /// threshold`): then the turn would test them all and change nothing.
-    #[allow(clippy::too_many_arguments)]
+    #[allow(
+        clippy::too_many_arguments,
+        reason = "the hot contact query takes its inputs as plain values; a struct built per call would cost a copy"
+    )]
     pub(crate) fn contact_candidates(
         &self,
         bodies: &[Body],

@@ -10,6 +10,8 @@
 //! recorded in that order and their impulses applied in it. The neighbour
 //! index only narrows down which pairs are tested, so the grid and the
 //! all-pairs search give bit-identical results.
+//!
+//! Room 4 of the simulator (`lib.rs`), the second stage of a step (world -> **physics** -> sensors -> control).
 
 pub mod body;
 pub(crate) mod broadphase;

@@ -12,13 +12,13 @@
 //! image's aspect ratio, as large as fits and centred, the rest of the
 //! screen black (field 0); `stretch` fills the screen. The annulus is a
 //! generated field and is generated for the screen's shape instead
-//! ([`ArenaSpec::annulus_cells`]: circular contours, 0 in the screen's
+//! (`ArenaSpec::annulus_cells`: circular contours, 0 in the screen's
 //! corners), filling it.
 //!
 //! The screen shows the image scaled smoothly (bilinear), so the robots
 //! read the field with [`FieldSampling::Bilinear`] ([`ArenaSpec::field_layout`]);
 //! panel pixel `(i, j)` shows the field at its centre
-//! ([`ArenaSpec::panel_pixel_centre`]). Light: the display's light is
+//! (`ArenaSpec::panel_pixel_centre`). Light: the display's light is
 //! `pixel ^ display_gamma`; the pixel a field value is shown with is
 //! pre-compensated so that the light is `v ^ LIGHT_GAMMA`, the curve the
 //! robots' calibration assumes ([`crate::scenario::panel`], `docs/display.md`).

@@ -1,6 +1,8 @@
 //! A built simulation and its controller from a few choices (field,
 //! controller, sensor model, counts, seed), with the per-field defaults of
 //! the thesis' experiments.
+//!
+//! Room 10 of the simulator (`lib.rs`): above the step loop, it chooses and builds what runs.
 
 pub mod arena;
 pub mod arena_choice;

@@ -3,10 +3,10 @@
 //! it, `host display` shows it; `docs/display.md`).
 //!
 //! Pixel `(i, j)` shows the field value `v` the simulator reads at the
-//! pixel's centre ([`ArenaSpec::panel_pixel_centre`], [`ScalarField::shown`]
+//! pixel's centre (`ArenaSpec::panel_pixel_centre`, [`ScalarField::shown`]
 //! with the arena's [`ArenaSpec::field_layout`]: bilinear between the field
 //! image's pixel centres, black outside its frame), as the 8-bit level
-//! [`panel_level`]: `round(255 v ^ (LIGHT_GAMMA / display_gamma))`. The
+//! `panel_level`: `round(255 v ^ (LIGHT_GAMMA / display_gamma))`. The
 //! display turns level `p` into the light `(p / 255) ^ display_gamma` of
 //! its full white, so the light is `v ^ LIGHT_GAMMA` (to the level's
 //! rounding), the light curve the robots' calibration inverts
@@ -46,7 +46,7 @@ fn level_of(v: f64, exponent: f64) -> u8 {
 }
 
 /// The panel image of `field` on `arena`: `screen_px` pixels, each the
-/// [`panel_level`] of the field value at its centre.
+/// `panel_level` of the field value at its centre.
 pub fn panel_image(arena: &ArenaSpec, field: &ScalarField) -> GrayImage {
     let layout = arena.field_layout(field);
     let exponent = level_exponent(arena.display_gamma);

@@ -116,8 +116,10 @@ impl SensorSetup {
 }
 
 /// The model a [`SensorSetup`] built.
-// One per simulation; the disc model, the common one, stays unboxed.
-#[allow(clippy::large_enum_variant)]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per simulation; the disc model, the common one, stays unboxed"
+)]
 #[derive(Clone, Debug)]
 pub enum SelectedSensors {
     /// The thesis' discs.

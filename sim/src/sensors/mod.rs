@@ -1,6 +1,8 @@
 //! The interface between the world and the controllers: a sensor model
 //! turns the world into one [`SensorReading`] per robot, and can show what
 //! it senses for drawing.
+//!
+//! Room 6 of the simulator (`lib.rs`), the third stage of a step (world -> physics -> **sensors** -> control).
 
 pub(crate) mod camera_memory;
 pub mod disc;

@@ -281,8 +281,10 @@ impl PhotoSensors {
     ) -> PhotoReading {
         let mut r = PhotoReading::default();
         let mut shown = [0.0; 3];
-        // Sensor `i` of four arrays: an index reads plainer than a zip.
-        #[allow(clippy::needless_range_loop)]
+        #[allow(
+            clippy::needless_range_loop,
+            reason = "sensor i of four arrays: an index reads plainer than a zip"
+        )]
         for i in 0..3 {
             let point = pos + self.points[i].rotated(direction);
             shown[i] = field.shown(point, layout);

@@ -13,7 +13,7 @@
 //! missed and joined by spurious ones as [`RobotNoise`] says), delayed by
 //! the camera's latency (frames in flight per robot), possibly dropped,
 //! then held for [`shared::camera::HOLD_PERIODS`] periods by the robot's
-//! [`CameraMemory`] as the firmware holds it; the photo-transistors read
+//! `CameraMemory` as the firmware holds it; the photo-transistors read
 //! with their brightness gain and RC jitter. Every noise draw comes from a
 //! counter-based stream of the world's seed ([`crate::base::noise`]), and what
 //! the model remembers is saved with a simulation's snapshot, so a run

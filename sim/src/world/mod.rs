@@ -4,6 +4,8 @@
 //! [`World`] serialises as its [`WorldState`] (everything that determines
 //! the future); deserialising rebuilds the index, so a checkpointed world
 //! resumes bit-exactly.
+//!
+//! Room 5 of the simulator (`lib.rs`), the first stage of a step (**world** -> physics -> sensors -> control): it owns the bodies and calls physics to move them.
 
 use crate::base::rng::SimRng;
 use crate::base::vec2::Vec2;
