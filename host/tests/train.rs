@@ -148,6 +148,52 @@ fn a_noisy_run_of_the_robot_senses_on_the_tv_resumes_exactly_from_a_format_3_che
 }
 
 #[test]
+fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_format_4_checkpoint()
+{
+    let rules = TrainConfig {
+        walls: Some(sim::config::Walls::Clamp),
+        rules: host::learn::LearnerRules {
+            tie_tolerance: 0.001,
+            updates: host::learn::Updates::Batched,
+        },
+        stuck_limit: Some(800),
+        ..small(13)
+    };
+    assert_eq!(resumes_exactly(rules.clone(), 1300, 2700), 4);
+    // each setting changes the run: none is silently dropped
+    let base = {
+        let mut t = trainer(small(13));
+        t.run(10_000);
+        t.learner().table().clone()
+    };
+    for changed in [
+        TrainConfig {
+            walls: Some(sim::config::Walls::Clamp),
+            ..small(13)
+        },
+        TrainConfig {
+            rules: host::learn::LearnerRules {
+                tie_tolerance: 0.05,
+                ..Default::default()
+            },
+            ..small(13)
+        },
+        TrainConfig {
+            rules: host::learn::LearnerRules {
+                updates: host::learn::Updates::Batched,
+                ..Default::default()
+            },
+            ..small(13)
+        },
+    ] {
+        let what = format!("walls {:?}, rules {:?}", changed.walls, changed.rules);
+        let mut t = trainer(changed);
+        t.run(10_000);
+        assert_ne!(t.learner().table(), &base, "{what} changed nothing");
+    }
+}
+
+#[test]
 fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_byte() {
     // the published pre-trained tables of docs/reproduction were written by earlier builds
     let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");

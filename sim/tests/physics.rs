@@ -80,9 +80,11 @@ fn a_contact_step_matches_the_hand_computed_result() {
     assert_eq!(w.contacts().len(), 1);
 }
 
-#[test]
-fn a_wall_contact_reverses_the_velocity_into_the_wall() {
-    let config = SimConfig::default();
+/// A puck half a unit from the left border moving into it at (-2, 0.5),
+/// one step later, with the border `walls`.
+fn a_puck_at_the_border_after_one_step(walls: sim::config::Walls) -> World {
+    let mut config = SimConfig::default();
+    config.physics.walls = walls;
     let robot_far = (Vec2::new(400.0, 400.0), 0.0, RobotKind::Outie);
     let mut state = World::scene(&config, &[robot_far], &[Vec2::new(10.5, 400.0)], 1)
         .state()
@@ -90,6 +92,12 @@ fn a_wall_contact_reverses_the_velocity_into_the_wall() {
     state.bodies[1].vel = Vec2::new(-2.0, 0.5);
     let mut w = World::from_state(state);
     w.step(&[0.0]);
+    w
+}
+
+#[test]
+fn a_wall_contact_reverses_the_velocity_into_the_wall() {
+    let w = a_puck_at_the_border_after_one_step(sim::config::Walls::Segments);
     let p = w.bodies()[1];
     // after integration v = (-1.2, 0.3); the wall reflects x and keeps y
     assert!(close(p.vel.x, 1.2) && close(p.vel.y, 0.3), "{:?}", p.vel);
@@ -98,6 +106,17 @@ fn a_wall_contact_reverses_the_velocity_into_the_wall() {
         "pushed out to touch the wall: {:?}",
         p.pos
     );
+}
+
+#[test]
+fn a_clamping_border_puts_a_body_back_and_keeps_its_velocity() {
+    let w = a_puck_at_the_border_after_one_step(sim::config::Walls::Clamp);
+    let p = w.bodies()[1];
+    // after integration x = 8.5, v = (-1.2, 0.3): clamped to its radius,
+    // no contact, no impulse
+    assert!(close(p.pos.x, 10.0), "{:?}", p.pos);
+    assert!(close(p.vel.x, -1.2) && close(p.vel.y, 0.3), "{:?}", p.vel);
+    assert!(w.contacts().is_empty(), "{:?}", w.contacts());
 }
 
 #[test]

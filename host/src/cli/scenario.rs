@@ -3,7 +3,7 @@
 
 use clap::{Arg, ArgMatches, Args, FromArgMatches};
 use host::train::TrainConfig;
-use sim::config::BroadPhase;
+use sim::config::{BroadPhase, Walls};
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::sensor_choice::SensorChoice;
@@ -31,8 +31,8 @@ struct ScenarioOwnArgs {
 }
 
 /// The training config's flags a scenario takes.
-const WORLD_FLAGS: [&str; 7] = [
-    "field", "sensors", "arena", "robots", "pucks", "seed", "noise",
+const WORLD_FLAGS: [&str; 8] = [
+    "field", "sensors", "arena", "robots", "pucks", "seed", "noise", "walls",
 ];
 
 /// The arguments of [`TrainConfig`] with these ids, declared there.
@@ -88,6 +88,7 @@ impl ScenarioArgs {
         if let Some(&noise) = m.get_one::<f64>("noise") {
             config.noise = noise;
         }
+        config.walls = m.get_one::<Walls>("walls").copied();
         let mut scenario = config.scenario()?;
         scenario.controller = self.own.controller;
         if self.own.naive {

@@ -10,6 +10,7 @@
 use super::spec::{ArmController, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
 use crate::train::format2::TrainConfigV2;
+use crate::train::format3::TrainConfigV3;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
@@ -84,9 +85,11 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to the field's
 /// default counts as unset (the same run either way), and settings that use
-/// nothing newer than format 1 or 2 are hashed in its layout
-/// ([`TrainConfigV1`], [`TrainConfigV2`]), so that trials run before the
-/// newer settings existed keep their hashes. Settings with the robot's
+/// nothing newer than format 1, 2 or 3 are hashed in its layout
+/// ([`TrainConfigV1`], [`TrainConfigV2`], [`TrainConfigV3`]), so that trials
+/// run before the newer settings existed keep their hashes. (Those formats'
+/// runs had wall segments: a run in the thesis' square that clamps at its
+/// border, the default since, is of the newest layout and hashes anew.) Settings with the robot's
 /// senses also hash their model's version
 /// ([`sim::sensors::robot::MODEL_VERSION`]): trials of another model are
 /// run again.
@@ -95,6 +98,7 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 enum Hashed {
     V1(TrainConfigV1),
     V2(TrainConfigV2),
+    V3(TrainConfigV3),
     Current(TrainConfig),
     /// Settings with the robot's senses, and the version of their model.
     RobotSenses {
@@ -110,10 +114,14 @@ fn hashed(config: &TrainConfig) -> Hashed {
         c.innies = None;
     }
     let robot_senses = c.sensors.is_robot();
-    let settings = match (TrainConfigV1::of(&c), TrainConfigV2::of(&c)) {
-        (Some(v1), _) => Hashed::V1(v1),
-        (None, Some(v2)) => Hashed::V2(v2),
-        (None, None) => Hashed::Current(c),
+    let settings = if let Some(v1) = TrainConfigV1::of(&c) {
+        Hashed::V1(v1)
+    } else if let Some(v2) = TrainConfigV2::of(&c) {
+        Hashed::V2(v2)
+    } else if let Some(v3) = TrainConfigV3::of(&c) {
+        Hashed::V3(v3)
+    } else {
+        Hashed::Current(c)
     };
     if robot_senses {
         Hashed::RobotSenses {

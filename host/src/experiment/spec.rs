@@ -118,6 +118,9 @@ pub enum ArmController {
     /// A policy blob's greedy actions (the arm's `policy` file), as the
     /// robot runs them: no learning.
     Policy,
+    /// Each robot's turn drawn uniformly from the learner's actions every
+    /// step: the baseline a learned result must beat.
+    Random,
 }
 
 impl ArmController {
@@ -127,6 +130,7 @@ impl ArmController {
             ArmController::Oc => "oc",
             ArmController::Learn => "learn",
             ArmController::Policy => "policy",
+            ArmController::Random => "random",
         }
     }
 }

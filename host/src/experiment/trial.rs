@@ -7,8 +7,10 @@ use crate::learn::QTable;
 use crate::train::{TrainConfig, Trainer};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use shared::ActionTable;
 use sim::control::greedy::GreedyPolicy;
 use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
+use sim::control::random::RandomTurns;
 use sim::scenario::sensor_setup::SelectedSensors;
 use sim::{episodes::EpisodeEnd, simulation::Simulation, simulation::Totals};
 use std::path::{Path, PathBuf};
@@ -124,6 +126,8 @@ pub enum Running {
     Learn(Box<Trainer<SelectedSensors>>),
     /// A policy's greedy actions.
     Policy(Box<Simulation<SelectedSensors>>, GreedyPolicy),
+    /// Uniformly random turns.
+    Random(Box<Simulation<SelectedSensors>>, RandomTurns),
 }
 
 impl Running {
@@ -154,6 +158,14 @@ impl Running {
                 let sim = prepared.simulation(c.seed).context("invalid settings")?;
                 Running::Policy(Box::new(sim), GreedyPolicy::new(blob))
             }
+            ArmController::Random => {
+                let prepared = c.prepare()?;
+                let forward_speed = prepared.config().world.forward_speed as f32;
+                let actions =
+                    ActionTable::new(&c.learn.actions, forward_speed).context("invalid actions")?;
+                let sim = prepared.simulation(c.seed).context("invalid settings")?;
+                Running::Random(Box::new(sim), RandomTurns::new(actions))
+            }
         })
     }
 
@@ -163,13 +175,14 @@ impl Running {
             Running::Oc(sim, oc) => sim.step(oc),
             Running::Learn(trainer) => trainer.step(),
             Running::Policy(sim, policy) => sim.step(policy),
+            Running::Random(sim, random) => sim.step(random),
         }
     }
 
     /// The simulation.
     pub fn simulation(&self) -> &Simulation<SelectedSensors> {
         match self {
-            Running::Oc(sim, _) | Running::Policy(sim, _) => sim,
+            Running::Oc(sim, _) | Running::Policy(sim, _) | Running::Random(sim, _) => sim,
             Running::Learn(trainer) => trainer.simulation(),
         }
     }
@@ -177,7 +190,7 @@ impl Running {
     /// The learner's states visited and states in all, for a learning run.
     fn states(&self) -> Option<(usize, usize)> {
         match self {
-            Running::Oc(..) | Running::Policy(..) => None,
+            Running::Oc(..) | Running::Policy(..) | Running::Random(..) => None,
             Running::Learn(trainer) => {
                 let q = trainer.learner().table();
                 Some((q.states_visited(), q.hasher().num_states()))

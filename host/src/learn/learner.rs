@@ -37,6 +37,83 @@ pub struct LearnConfig {
     pub reward: Reward,
 }
 
+/// How the learner chooses among near-best actions and applies a step's
+/// updates: settings of the ablations of `docs/reproduction.md` whose
+/// defaults are the thesis author's program (exact ties, robot-order
+/// updates each seeing the ones before). Kept beside [`LearnConfig`], not in
+/// it, so that the checkpoint formats that hold a `LearnConfig` keep their
+/// layout.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
+#[serde(default, deny_unknown_fields)]
+pub struct LearnerRules {
+    /// Greedy choice among every action within this of the best value,
+    /// uniformly at random (0: exact ties only, the author's program; its
+    /// unused `m_diffThresh` would be 0.001) [default: 0].
+    #[arg(long, required = false)]
+    pub tie_tolerance: f64,
+    /// How one step's updates are applied: sequential (in robot order, each
+    /// seeing the ones before: the author's program) or batched (every
+    /// robot's TD error from the table as it was before the step)
+    /// [default: sequential].
+    #[arg(long, required = false)]
+    pub updates: Updates,
+}
+
+impl Default for LearnerRules {
+    /// The thesis author's program: exact ties, sequential updates.
+    fn default() -> LearnerRules {
+        LearnerRules {
+            tie_tolerance: 0.0,
+            updates: Updates::Sequential,
+        }
+    }
+}
+
+impl LearnerRules {
+    /// Checks ranges before a run; errors name the setting.
+    pub fn validate(&self) -> Result<()> {
+        let t = self.tie_tolerance;
+        if !(t.is_finite() && t >= 0.0) {
+            bail!("rules.tie_tolerance = {t}: must be a finite number, not negative");
+        }
+        Ok(())
+    }
+}
+
+/// How one step's Q-updates are applied ([`LearnerRules::updates`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Updates {
+    /// In robot order, each seeing the ones before.
+    #[default]
+    Sequential,
+    /// Every TD error from the table before the step, then applied.
+    Batched,
+}
+
+impl std::str::FromStr for Updates {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Updates, String> {
+        match s {
+            "sequential" => Ok(Updates::Sequential),
+            "batched" => Ok(Updates::Batched),
+            _ => Err(format!(
+                "unknown updates {s:?}: expected sequential or batched"
+            )),
+        }
+    }
+}
+
+impl std::fmt::Display for Updates {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Updates::Sequential => "sequential",
+            Updates::Batched => "batched",
+        })
+    }
+}
+
 /// A [`StateHasher`] as configs and the CLI name it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
@@ -125,6 +202,14 @@ pub struct QLearner {
     /// The reward signal (Eval or Eval') of the world before the step in
     /// flight; set at every episode start.
     last_signal: f64,
+    /// The rules: a run's setting, given again on every start and resume
+    /// ([`QLearner::with_rules`]), so not part of the learner's layout in a
+    /// checkpoint.
+    #[serde(skip)]
+    rules: LearnerRules,
+    /// Batched updates' TD errors of the step in flight.
+    #[serde(skip)]
+    errors: Vec<f64>,
 }
 
 impl QLearner {
@@ -137,6 +222,8 @@ impl QLearner {
             q,
             chosen: Vec::new(),
             last_signal: 0.0,
+            rules: LearnerRules::default(),
+            errors: Vec::new(),
         })
     }
 
@@ -156,6 +243,17 @@ impl QLearner {
         }
         learner.q = q;
         Ok(learner)
+    }
+
+    /// This learner with `rules`.
+    pub fn with_rules(mut self, rules: LearnerRules) -> QLearner {
+        self.rules = rules;
+        self
+    }
+
+    /// The rules.
+    pub fn rules(&self) -> LearnerRules {
+        self.rules
     }
 
     /// The Q-table.
@@ -186,7 +284,9 @@ impl Controller for QLearner {
             .zip(perception.robots)
         {
             let state = hasher.hash_as(reading, robot.kind.role());
-            let action = self.q.select(state, self.config.epsilon, rng);
+            let action = self
+                .q
+                .select(state, self.config.epsilon, self.rules.tie_tolerance, rng);
             *turn = self.config.actions[action.index()];
             self.chosen.push((state, action));
         }
@@ -212,14 +312,26 @@ impl Controller for QLearner {
         let hasher = self.q.hasher();
         let params = self.config.params();
         let robots = outcome.world.robots();
-        for ((&(s, a), reading), robot) in self.chosen.iter().zip(outcome.readings).zip(robots) {
-            self.q.update(
-                s,
-                a,
-                reward,
-                hasher.hash_as(reading, robot.kind.role()),
-                params,
-            );
+        let next = outcome
+            .readings
+            .iter()
+            .zip(robots)
+            .map(|(reading, robot)| hasher.hash_as(reading, robot.kind.role()));
+        match self.rules.updates {
+            Updates::Sequential => {
+                for (&(s, a), s2) in self.chosen.iter().zip(next) {
+                    self.q.update(s, a, reward, s2, params);
+                }
+            }
+            Updates::Batched => {
+                self.errors.clear();
+                for (&(s, a), s2) in self.chosen.iter().zip(next) {
+                    self.errors.push(self.q.td_error(s, a, reward, s2, params));
+                }
+                for (&(s, a), &error) in self.chosen.iter().zip(&self.errors) {
+                    self.q.apply(s, a, error, params);
+                }
+            }
         }
         self.last_signal = signal;
     }
@@ -235,10 +347,10 @@ mod tests {
         world::World,
     };
 
-    /// Two robots in the same state take the same action and reach the
-    /// same state: the second update sees the first.
-    #[test]
-    fn updates_are_applied_in_robot_order_each_seeing_the_last() {
+    /// Two robots in the same state with action 0 greedy (Q 2, the other
+    /// actions 1), one step with no pucks (the reference reward is -1):
+    /// the turns they chose and the learner after the step.
+    fn two_robots_one_step(rules: LearnerRules) -> ([f32; 2], QLearner, State) {
         let config = SimConfig::default();
         let robots = [
             (Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie),
@@ -253,10 +365,10 @@ mod tests {
         };
         let s = StateHasher::Original.hash(&reading);
         policy.set(s, ActionId(0));
-        let learn = LearnConfig::default();
         let mut learner =
-            QLearner::with_table(learn.clone(), QTable::from_policy(&policy, 4, 1.0)).unwrap();
-
+            QLearner::with_table(LearnConfig::default(), QTable::from_policy(&policy, 4, 1.0))
+                .unwrap()
+                .with_rules(rules);
         // no pucks: Eval stays 1, so the reference reward is 0 - 1 = -1
         learner.episode_start(&EpisodeStart {
             world: &world,
@@ -271,7 +383,6 @@ mod tests {
             episode_step: 0,
         };
         learner.decide(&perception, &mut turns, &mut SimRng::seed_from_u64(1));
-        assert_eq!(turns, [learn.actions[0]; 2]);
         learner.observe(&StepOutcome {
             episode_step: 1,
             eval: Some(1.0),
@@ -282,6 +393,15 @@ mod tests {
             config: &config,
             readings: &readings,
         });
+        (turns, learner, s)
+    }
+
+    /// Two robots in the same state take the same action and reach the
+    /// same state: the second update sees the first.
+    #[test]
+    fn updates_are_applied_in_robot_order_each_seeing_the_last() {
+        let (turns, learner, s) = two_robots_one_step(LearnerRules::default());
+        assert_eq!(turns, [LearnConfig::default().actions[0]; 2]);
         // first: 2 + 0.2 (-1 + 0.9 x 2 - 2) = 1.76; second sees it:
         // 1.76 + 0.2 (-1 + 0.9 x 1.76 - 1.76) = 1.5248
         let q = learner.table();
@@ -292,6 +412,20 @@ mod tests {
         );
         assert_eq!(q.visits(s, ActionId(0)), 2);
         assert_eq!(learner.signal(), 1.0);
+    }
+
+    /// The same step as above, batched: both TD errors come from the table
+    /// before the step.
+    #[test]
+    fn batched_updates_take_every_td_error_from_the_table_before_the_step() {
+        let rules = LearnerRules {
+            updates: Updates::Batched,
+            ..LearnerRules::default()
+        };
+        let (_, learner, s) = two_robots_one_step(rules);
+        // each error -1 + 0.9 x 2 - 2 = -1.2; 2 + 0.2 (-1.2) x 2 = 1.52
+        let q = learner.table().value(s, ActionId(0));
+        assert!((q - 1.52).abs() < 1e-12, "{q}");
     }
 
     #[test]

@@ -5,5 +5,5 @@
 pub mod learner;
 pub mod qtable;
 
-pub use learner::{LearnConfig, QLearner, StateHasherName};
+pub use learner::{LearnConfig, LearnerRules, QLearner, StateHasherName, Updates};
 pub use qtable::{QParams, QTable};

@@ -107,15 +107,46 @@ impl QTable {
         ActionId(index as u8)
     }
 
-    /// Epsilon-greedy choice: with probability `epsilon` a uniformly random
-    /// action, otherwise [`QTable::greedy`]. With `epsilon == 0` the
-    /// exploration draw is skipped.
+    /// An action within `tolerance` of the greatest value, chosen uniformly
+    /// at random among them (the generator is drawn only when there are two
+    /// or more); with `tolerance == 0`, exactly [`QTable::greedy`].
     #[inline]
-    pub fn select(&self, state: State, epsilon: f64, rng: &mut impl RngExt) -> ActionId {
+    pub fn greedy_within(&self, state: State, tolerance: f64, rng: &mut impl RngExt) -> ActionId {
+        if tolerance == 0.0 {
+            return self.greedy(state, rng);
+        }
+        let row = self.row(state);
+        let floor = row.iter().copied().fold(f64::NEG_INFINITY, f64::max) - tolerance;
+        let near = row.iter().filter(|&&v| v >= floor).count();
+        let pick = if near > 1 {
+            rng.random_range(0..near)
+        } else {
+            0
+        };
+        let index = row
+            .iter()
+            .enumerate()
+            .filter(|(_, &v)| v >= floor)
+            .nth(pick)
+            .map_or(0, |(i, _)| i);
+        ActionId(index as u8)
+    }
+
+    /// Epsilon-greedy choice: with probability `epsilon` a uniformly random
+    /// action, otherwise [`QTable::greedy_within`] `tolerance`. With
+    /// `epsilon == 0` the exploration draw is skipped.
+    #[inline]
+    pub fn select(
+        &self,
+        state: State,
+        epsilon: f64,
+        tolerance: f64,
+        rng: &mut impl RngExt,
+    ) -> ActionId {
         if epsilon > 0.0 && rng.random::<f64>() < epsilon {
             ActionId(rng.random_range(0..self.actions) as u8)
         } else {
-            self.greedy(state, rng)
+            self.greedy_within(state, tolerance, rng)
         }
     }
 
@@ -129,6 +160,32 @@ impl QTable {
             .fold(f64::NEG_INFINITY, f64::max);
         let i = s.index() * self.actions + a.index();
         self.values[i] += params.alpha * (reward + params.gamma * next_best - self.values[i]);
+        self.visits[i] += 1;
+    }
+
+    /// The TD error r + gamma max_a' Q(s',a') - Q(s,a), without updating.
+    #[inline]
+    pub fn td_error(
+        &self,
+        s: State,
+        a: ActionId,
+        reward: f64,
+        next: State,
+        params: QParams,
+    ) -> f64 {
+        let next_best = self
+            .row(next)
+            .iter()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max);
+        reward + params.gamma * next_best - self.values[s.index() * self.actions + a.index()]
+    }
+
+    /// Q(s,a) += alpha `error`, a TD error computed earlier ([`QTable::td_error`]).
+    #[inline]
+    pub fn apply(&mut self, s: State, a: ActionId, error: f64, params: QParams) {
+        let i = s.index() * self.actions + a.index();
+        self.values[i] += params.alpha * error;
         self.visits[i] += 1;
     }
 
@@ -174,6 +231,35 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_pcg::Pcg64Mcg;
+
+    #[test]
+    fn a_tie_tolerance_picks_uniformly_among_near_ties_and_never_outside() {
+        let mut q = QTable::new(StateHasher::Bits7, 4, 0.0);
+        let s = State(3);
+        // values 1.0, 0.9995, 0.5, 0.9991: within 0.001 of the best are 0, 1, 3
+        for (a, v) in [1.0, 0.9995, 0.5, 0.9991].into_iter().enumerate() {
+            q.values[s.index() * 4 + a] = v;
+        }
+        let mut rng = Pcg64Mcg::seed_from_u64(7);
+        let mut counts = [0u32; 4];
+        let draws = 30_000;
+        for _ in 0..draws {
+            counts[q.greedy_within(s, 0.001, &mut rng).index()] += 1;
+        }
+        assert_eq!(counts[2], 0, "{counts:?}");
+        for a in [0, 1, 3] {
+            let share = f64::from(counts[a]) / f64::from(draws);
+            assert!((share - 1.0 / 3.0).abs() < 0.015, "{counts:?}");
+        }
+        // no tolerance: the exact maximum only, and the same draws as greedy
+        let (mut a, mut b) = (Pcg64Mcg::seed_from_u64(3), Pcg64Mcg::seed_from_u64(3));
+        for state in 0..q.hasher().num_states() as u16 {
+            assert_eq!(
+                q.greedy_within(State(state), 0.0, &mut a),
+                q.greedy(State(state), &mut b)
+            );
+        }
+    }
 
     #[test]
     fn update_matches_a_hand_computed_example() {
@@ -238,7 +324,7 @@ mod tests {
         let mut rng = Pcg64Mcg::seed_from_u64(3);
         let mut seen = [false; 3];
         for _ in 0..200 {
-            seen[q.select(State(0), 1.0, &mut rng).index()] = true;
+            seen[q.select(State(0), 1.0, 0.0, &mut rng).index()] = true;
         }
         assert_eq!(seen, [true; 3]);
     }

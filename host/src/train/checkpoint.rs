@@ -6,15 +6,16 @@
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1 to 3), u16                         |
+//! | 8      | 2    | format version (1 to 4), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
-//! Format 3's body is the [`TrainingState`]; formats 1 and 2 are the
+//! Format 4's body is the [`TrainingState`]; formats 1 to 3 are the
 //! state without the settings added since ([`super::format1`],
-//! [`super::format2`]). A state is written in the oldest format that
-//! holds it, byte for byte what earlier builds wrote; all three are read.
+//! [`super::format2`], [`super::format3`]). A state is written in the
+//! oldest format that holds it, byte for byte what earlier builds wrote;
+//! all four are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
@@ -22,6 +23,7 @@
 
 use super::format1::StateV1;
 use super::format2::StateV2;
+use super::format3::StateV3;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
@@ -37,8 +39,9 @@ pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// field's frame and sampling, puck mass, millimetres per unit). 3: the
 /// run's arena and noise, the counts left to the arena, the motion noise,
 /// the world's seed, episode count and dropped-period turns, the robot
-/// senses' memory.
-pub const VERSION: u16 = 3;
+/// senses' memory. 4: the arena's border (`walls`) and the learner's
+/// rules (`rules`).
+pub const VERSION: u16 = 4;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
@@ -114,10 +117,14 @@ impl std::error::Error for CheckpointError {}
 
 /// Encodes a training state into `w`.
 pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
-    let (version, body) = match (StateV1::of(state), StateV2::of(state)) {
-        (Some(v1), _) => (1u16, postcard::to_stdvec(&v1)),
-        (None, Some(v2)) => (2, postcard::to_stdvec(&v2)),
-        (None, None) => (VERSION, postcard::to_stdvec(state)),
+    let (version, body) = if let Some(v1) = StateV1::of(state) {
+        (1u16, postcard::to_stdvec(&v1))
+    } else if let Some(v2) = StateV2::of(state) {
+        (2, postcard::to_stdvec(&v2))
+    } else if let Some(v3) = StateV3::of(state) {
+        (3, postcard::to_stdvec(&v3))
+    } else {
+        (VERSION, postcard::to_stdvec(state))
     };
     let body = body.map_err(std::io::Error::other)?;
     let mut head = Vec::with_capacity(HEADER_LEN);
@@ -187,6 +194,9 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
             .map_err(malformed),
         2 => postcard::from_bytes::<StateV2>(body)
             .map(StateV2::into_state)
+            .map_err(malformed),
+        3 => postcard::from_bytes::<StateV3>(body)
+            .map(StateV3::into_state)
             .map_err(malformed),
         _ => postcard::from_bytes(body).map_err(malformed),
     }

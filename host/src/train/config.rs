@@ -4,7 +4,7 @@
 //! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::learn::LearnConfig;
+use crate::learn::{LearnConfig, LearnerRules};
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
@@ -14,8 +14,8 @@ use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
     config::disc_sensors::ObstacleTargets, config::BroadPhase, config::SuccessSignal,
-    fields::source::FieldSource, scenario::ControllerChoice, scenario::PreparedScenario,
-    scenario::Scenario,
+    config::Walls, fields::source::FieldSource, scenario::ControllerChoice,
+    scenario::PreparedScenario, scenario::Scenario,
 };
 use std::path::{Path, PathBuf};
 
@@ -104,6 +104,14 @@ pub struct TrainConfig {
     /// (docs/training.md) [default: none, the initial Q-values].
     #[arg(long)]
     pub distil_oc: Option<u64>,
+    /// How the arena's border keeps the bodies in: clamp (put back inside,
+    /// no contact: the thesis author's program) or segments (walls the
+    /// bodies bounce off) [default: segments].
+    #[arg(long)]
+    pub walls: Option<Walls>,
+    /// The learner's rules (docs/training.md, "Learner rules and the border").
+    #[command(flatten)]
+    pub rules: LearnerRules,
 }
 
 /// When an episode's formation is checked (`[formation_check]`).
@@ -196,6 +204,8 @@ impl Default for TrainConfig {
             obstacle_discs: None,
             select: None,
             distil_oc: None,
+            walls: None,
+            rules: LearnerRules::default(),
         }
     }
 }
@@ -215,6 +225,12 @@ impl TrainConfig {
                 path.display()
             )
         })
+    }
+
+    /// How the run's border keeps the bodies in: `walls`, else the
+    /// arena's own (segments).
+    pub fn walls_in_effect(&self) -> Walls {
+        self.walls.unwrap_or_default()
     }
 
     /// The arena the run uses.
@@ -237,6 +253,7 @@ impl TrainConfig {
             arena: self.arena_choice().arena()?,
             sensors: self.sensors.setup()?,
             noise: self.noise,
+            walls: self.walls,
         })
     }
 
@@ -304,6 +321,7 @@ impl TrainConfig {
             bail!("obstacle_discs.radius = {r}: must be positive");
         }
         self.learn.validate()?;
+        self.rules.validate()?;
         if self.steps == 0 {
             bail!("steps = 0: must be positive");
         }

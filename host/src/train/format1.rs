@@ -14,11 +14,12 @@
 
 use super::config::{FormationCheck, OutputConfig, TrainConfig};
 use super::format2::{SimConfigV2, SimulationV2, StateV2, TrainConfigV2, WorldConfigV2, WorldV2};
+use super::format3::PhysicsConfigV3;
 use super::trainer::TrainingState;
 use crate::learn::{LearnConfig, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
-use sim::config::{EpisodeConfig, PhysicsConfig, SuccessSignal, Thresholds, WorldConfig};
+use sim::config::{EpisodeConfig, SuccessSignal, Thresholds, WorldConfig};
 use sim::fields::FieldSampling;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
@@ -118,7 +119,7 @@ impl WorldConfigV1 {
 #[derive(Serialize, Deserialize)]
 struct WorldV1 {
     config: WorldConfigV1,
-    physics: PhysicsConfig,
+    physics: PhysicsConfigV3,
     bodies: Vec<Body>,
     robots: Vec<Robot>,
     steps: u64,
@@ -128,7 +129,7 @@ struct WorldV1 {
 #[derive(Serialize, Deserialize)]
 struct SimConfigV1 {
     world: WorldConfigV1,
-    physics: PhysicsConfig,
+    physics: PhysicsConfigV3,
     sensors: DiscSensorConfig,
     thresholds: Thresholds,
     episode: EpisodeV1,

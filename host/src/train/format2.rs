@@ -13,14 +13,13 @@
 //! format 1 ([`super::format1`]).
 
 use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::format3::PhysicsConfigV3;
 use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, QLearner};
+use crate::learn::{LearnConfig, LearnerRules, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
-use sim::config::{
-    EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, WorldConfig,
-};
+use sim::config::{EpisodeConfig, SimConfig, SuccessSignal, Thresholds, Walls, WorldConfig};
 use sim::fields::{FieldFrame, FieldSampling};
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::sensor_choice::SensorChoice;
@@ -64,6 +63,8 @@ impl TrainConfigV2 {
     /// without noise, policy selection or distillation.
     pub fn of(c: &TrainConfig) -> Option<TrainConfigV2> {
         let plain = c.arena_choice() == ArenaChoice::Thesis
+            && c.walls_in_effect() == Walls::Segments
+            && c.rules == LearnerRules::default()
             && c.noise == 0.0
             && c.select.is_none()
             && c.distil_oc.is_none();
@@ -86,9 +87,10 @@ impl TrainConfigV2 {
 }
 
 impl From<TrainConfigV2> for TrainConfig {
-    /// The settings in the thesis' square, without noise.
+    /// The settings in the thesis' square, without noise, with wall
+    /// segments.
     fn from(c: TrainConfigV2) -> TrainConfig {
-        TrainConfig {
+        let mut config = TrainConfig {
             field: c.field,
             sensors: c.sensors,
             arena: Some(ArenaChoice::Thesis),
@@ -106,7 +108,14 @@ impl From<TrainConfigV2> for TrainConfig {
             obstacle_discs: c.obstacle_discs,
             select: None,
             distil_oc: None,
+            walls: None,
+            rules: LearnerRules::default(),
+        };
+        // format 2's runs had wall segments
+        if config.walls_in_effect() != Walls::Segments {
+            config.walls = Some(Walls::Segments);
         }
+        config
     }
 }
 
@@ -124,7 +133,7 @@ pub(super) struct SimulationV2 {
 #[derive(Serialize, Deserialize)]
 pub(super) struct SimConfigV2 {
     pub(super) world: WorldConfigV2,
-    pub(super) physics: PhysicsConfig,
+    pub(super) physics: PhysicsConfigV3,
     pub(super) sensors: DiscSensorConfig,
     pub(super) thresholds: Thresholds,
     pub(super) episode: EpisodeConfig,
@@ -190,7 +199,7 @@ impl WorldConfigV2 {
 #[derive(Serialize, Deserialize)]
 pub(super) struct WorldV2 {
     pub(super) config: WorldConfigV2,
-    pub(super) physics: PhysicsConfig,
+    pub(super) physics: PhysicsConfigV3,
     pub(super) bodies: Vec<Body>,
     pub(super) robots: Vec<Robot>,
     pub(super) steps: u64,
@@ -222,14 +231,14 @@ impl StateV2 {
             sim: SimulationV2 {
                 config: SimConfigV2 {
                     world: WorldConfigV2::of(&s.config.world)?,
-                    physics: s.config.physics.clone(),
+                    physics: PhysicsConfigV3::of(&s.config.physics)?,
                     sensors: s.config.sensors.clone(),
                     thresholds: s.config.thresholds.clone(),
                     episode: s.config.episode.clone(),
                 },
                 world: WorldV2 {
                     config: WorldConfigV2::of(&w.config)?,
-                    physics: w.physics.clone(),
+                    physics: PhysicsConfigV3::of(&w.physics)?,
                     bodies: w.bodies.clone(),
                     robots: w.robots.clone(),
                     steps: w.steps,
@@ -257,14 +266,14 @@ impl StateV2 {
             sim: SimulationState {
                 config: SimConfig {
                     world: s.config.world.into_config(),
-                    physics: s.config.physics,
+                    physics: s.config.physics.into_config(),
                     sensors: s.config.sensors,
                     thresholds: s.config.thresholds,
                     episode: s.config.episode,
                 },
                 world: World::from_state(WorldState {
                     config: w.config.into_config(),
-                    physics: w.physics,
+                    physics: w.physics.into_config(),
                     bodies: w.bodies,
                     robots: w.robots,
                     steps: w.steps,

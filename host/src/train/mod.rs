@@ -9,6 +9,7 @@ pub mod config;
 pub mod distil;
 pub mod format1;
 pub mod format2;
+pub mod format3;
 pub mod selection;
 pub mod trainer;
 

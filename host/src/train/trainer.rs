@@ -94,7 +94,8 @@ impl<S: SensorModel> Trainer<S> {
         let learner = match seed_table {
             Some(q) => QLearner::with_table(config.learn.clone(), q)?,
             None => QLearner::new(config.learn.clone())?,
-        };
+        }
+        .with_rules(config.rules);
         let field_crc = field_fingerprint(sim.field());
         let evaluation = evaluation_of(&config)?;
         let mut trainer = Trainer {
@@ -125,8 +126,8 @@ impl<S: SensorModel> Trainer<S> {
         }
         let sim = Simulation::resume(state.sim, field, sensors);
         let evaluation = evaluation_of(&state.config)?;
-        let (config, field_crc, learner, selected) =
-            (state.config, state.field_crc, state.learner, state.selected);
+        let learner = state.learner.with_rules(state.config.rules);
+        let (config, field_crc, selected) = (state.config, state.field_crc, state.selected);
         let trainer = Trainer {
             config,
             field_crc,

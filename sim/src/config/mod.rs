@@ -121,6 +121,48 @@ impl WorldConfig {
     }
 }
 
+/// How the arena's border keeps the bodies in.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Walls {
+    /// Bodies that cross the border are put back inside it, with no contact
+    /// and no impulse: the thesis author's program (its worlds of the
+    /// thesis' experiments have no wall bodies, only the world's bounds).
+    Clamp,
+    /// Four wall segments of [`PhysicsConfig::wall_radius`]: a body that
+    /// overlaps one is pushed out and bounces off it (an elastic contact,
+    /// as the reference model's text describes walls), then is clamped: a
+    /// screen arena's bezel, and so far the thesis' square.
+    #[default]
+    Segments,
+}
+
+impl Walls {
+    /// The choices by name.
+    pub const NAMES: &'static str = "clamp, segments";
+}
+
+impl std::str::FromStr for Walls {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Walls, String> {
+        match s {
+            "clamp" => Ok(Walls::Clamp),
+            "segments" => Ok(Walls::Segments),
+            _ => Err(format!("unknown walls {s:?}: expected {}", Walls::NAMES)),
+        }
+    }
+}
+
+impl std::fmt::Display for Walls {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Walls::Clamp => "clamp",
+            Walls::Segments => "segments",
+        })
+    }
+}
+
 /// The contact model's constants.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -133,16 +175,20 @@ pub struct PhysicsConfig {
     pub overlap_threshold: f64,
     /// Half-thickness of the four wall segments on the arena border.
     pub wall_radius: f64,
+    /// How the border keeps bodies in.
+    pub walls: Walls,
 }
 
 impl Default for PhysicsConfig {
-    /// The reference model: 0.4, 0.001, 0.1; walls of zero thickness.
+    /// The reference model: 0.4, 0.001, 0.1; wall segments of zero
+    /// thickness.
     fn default() -> PhysicsConfig {
         PhysicsConfig {
             deceleration: 0.4,
             stop_speed: 0.001,
             overlap_threshold: 0.1,
             wall_radius: 0.0,
+            walls: Walls::Segments,
         }
     }
 }

@@ -4,7 +4,8 @@
 //!
 //! Canonical order: bodies take turns in ascending index. A body that is
 //! awake (it moved this step or touched something last step) is checked
-//! against the four walls, then against every other body in ascending
+//! against the four walls (with [`Walls::Segments`]; with [`Walls::Clamp`]
+//! the border only clamps), then against every other body in ascending
 //! index, then clamped into the arena. A body that is asleep but was pushed
 //! earlier in this step gets only the wall check and the clamp. Contacts are
 //! recorded in that order and their impulses applied in it. The neighbour
@@ -20,7 +21,7 @@ pub mod grid;
 use crate::base::bitset::BitSet;
 use crate::base::rng::SimRng;
 use crate::base::vec2::Vec2;
-use crate::config::PhysicsConfig;
+use crate::config::{PhysicsConfig, Walls};
 use crate::physics::body::{Body, Robot};
 use crate::physics::broadphase::{Candidates, NeighbourIndex};
 use rand::RngExt;
@@ -187,7 +188,9 @@ impl StepContext<'_> {
         let mut cursor = 0;
         while let Some(i) = self.scratch.pending.next_from(cursor) {
             cursor = i + 1;
-            self.resolve_walls(i);
+            if self.config.walls == Walls::Segments {
+                self.resolve_walls(i);
+            }
             if self.scratch.awake.contains(i) {
                 self.resolve_circles(i);
             }

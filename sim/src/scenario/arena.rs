@@ -25,7 +25,7 @@
 
 use crate::base::vec2::Vec2;
 use crate::config::validate::{check, positive, ConfigError};
-use crate::config::SimConfig;
+use crate::config::{SimConfig, Walls};
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
 use serde::{Deserialize, Serialize};
@@ -228,6 +228,8 @@ impl ArenaSpec {
     /// change them after).
     pub fn apply(&self, config: &mut SimConfig, field: &ScalarField) {
         config.episode.stuck_limit = self.stuck_limit;
+        // The screen's bezel: robots and pucks bounce off it.
+        config.physics.walls = Walls::Segments;
         let world = &mut config.world;
         let size = self.size();
         let unit = self.unit_mm();

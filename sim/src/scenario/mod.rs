@@ -13,7 +13,7 @@ pub mod sensor_setup;
 use crate::config::actuation::ActuationNoise;
 use crate::config::validate::{self, ConfigError};
 use crate::config::BroadPhase;
-use crate::config::{SimConfig, Thresholds};
+use crate::config::{SimConfig, Thresholds, Walls};
 use crate::control::greedy::GreedyPolicy;
 use crate::control::orbital::{OrbitalConfig, OrbitalConstruction};
 use crate::control::policy_file::{self, PolicyFileError};
@@ -92,6 +92,9 @@ pub struct Scenario {
     /// default noise ([`RobotNoise::randomised`],
     /// [`ActuationNoise::randomised`]) times this; 0 for none.
     pub noise: f64,
+    /// How the border keeps the bodies in; `None` for the arena's own
+    /// ([`Walls`]: the thesis' square's default, a screen's bezel).
+    pub walls: Option<Walls>,
 }
 
 impl Default for Scenario {
@@ -108,6 +111,7 @@ impl Default for Scenario {
             arena: Arena::default(),
             sensors: SensorSetup::Disc,
             noise: 0.0,
+            walls: None,
         }
     }
 }
@@ -199,6 +203,9 @@ impl Scenario {
             c.world.pucks = pucks;
         }
         c.world.broad_phase = self.broad_phase;
+        if let Some(walls) = self.walls {
+            c.physics.walls = walls;
+        }
         if self.noise > 0.0 {
             c.world.actuation = ActuationNoise::randomised().scaled(self.noise);
         }
