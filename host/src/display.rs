@@ -10,6 +10,7 @@
 use crate::panel_file;
 use anyhow::{Context, Result};
 use serde::Serialize;
+use sim::base::ranges;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
 use std::net::{SocketAddr, TcpListener};
@@ -17,14 +18,6 @@ use tiny_http::{Header, Method, Request, Response, Server};
 
 /// The page, built in.
 const PAGE: &str = include_str!("display.html");
-
-/// The shortest hold of a calibration screen, ms: the robots need each
-/// screen steady for 7 control periods (140 ms) after the TV has settled.
-pub const MIN_HOLD_MS: u32 = 500;
-
-/// The longest hold, ms: white and black must both pass within the 60 s a
-/// robot waits after button B.
-pub const MAX_HOLD_MS: u32 = 20_000;
 
 /// What to show and where to listen.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,14 +55,7 @@ impl Display {
     /// field, the arena or the address.
     pub fn start(settings: &DisplaySettings) -> Result<Display> {
         let hold = settings.hold_ms;
-        anyhow::ensure!(
-            (MIN_HOLD_MS..=MAX_HOLD_MS).contains(&hold),
-            "--hold {} s is outside {} to {} s: the robots need each screen steady for 140 ms after the TV has \
-             settled, and white and black within the 60 s they wait",
-            f64::from(hold) / 1000.0,
-            f64::from(MIN_HOLD_MS) / 1000.0,
-            f64::from(MAX_HOLD_MS) / 1000.0
-        );
+        ranges::HOLD_S.check_as("hold_ms / 1000", f64::from(hold) / 1000.0)?;
         let arena = &settings.arena;
         arena
             .validate()

@@ -11,6 +11,7 @@ use cli::screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
 use cli::simulate::{BenchArgs, RenderArgs, RunArgs};
 use cli::{Cli, Command, FieldCommand, PolicyCommand};
 use host::run_summary::run_timed;
+use sim::base::ranges;
 use sim::render::RenderOptions;
 use std::io::Write;
 use std::path::Path;
@@ -60,6 +61,7 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn simulate(args: RunArgs) -> Result<()> {
+    ranges::RUN_STEPS.check_count("host run --steps", args.steps)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let summary = run_timed(&mut sim, &mut controller, args.steps);
     if args.json {
@@ -74,6 +76,9 @@ fn simulate(args: RunArgs) -> Result<()> {
 }
 
 fn render(args: RenderArgs) -> Result<()> {
+    ranges::RUN_STEPS.check_count("host render --steps", args.steps)?;
+    ranges::FRAME_EVERY.check_count("host render --every", args.every)?;
+    ranges::RENDER_SIZE.check_count("--size", u64::from(args.size))?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let options = RenderOptions {
         size: args.size,
@@ -99,6 +104,7 @@ fn render(args: RenderArgs) -> Result<()> {
 }
 
 fn bench(args: BenchArgs) -> Result<()> {
+    ranges::STEPS.check_count("host bench --steps", args.steps())?;
     println!("{}", host::bench::run(&args.variant()?, args.steps())?);
     Ok(())
 }
@@ -117,6 +123,9 @@ fn inspect_policy(file: &Path) -> Result<()> {
 
 fn replay(args: ReplayArgs) -> Result<()> {
     use host::robot::replay::{odometry, replay_files};
+    ranges::UNIT_MM.check_as("--mm-per-unit", args.mm_per_unit)?;
+    ranges::COUNTS_PER_MM.check(args.counts_per_mm)?;
+    ranges::TRACK_MM.check(args.track_mm)?;
     let settings = odometry::OdometrySettings {
         mm_per_unit: args.mm_per_unit,
         counts_per_mm: args.counts_per_mm,
@@ -275,6 +284,7 @@ fn monitor(args: MonitorArgs) -> Result<()> {
     let (Some(port), Some(out)) = (args.port, args.out) else {
         anyhow::bail!("--port and --out are required");
     };
+    ranges::BAUD.check_count("--baud", u64::from(args.baud))?;
     let mut log = host::robot::log_file::LogWriter::create(&out, args.append)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();

@@ -175,3 +175,113 @@ fn output_into_a_closed_pipe_ends_quietly_without_a_panic() {
     assert!(!out.status.success());
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// Runs `host` with `args`, expects exit code 1 (a refusal, not an abort
+/// or a hang), returns stderr.
+fn refused(args: &[&str]) -> String {
+    let out = host()
+        .args(args)
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+    stderr
+}
+
+#[test]
+fn implausible_settings_are_refused_naming_the_key_the_value_and_the_range() {
+    // Eval of no pucks is 1: every check would count as a formation
+    let e = refused(&["run", "--pucks", "0", "--steps", "2000"]);
+    assert!(
+        e.contains("pucks = 0: outside its plausible range [1, 100000]"),
+        "{e}"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let arena = |name: &str, text: &str| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path.display().to_string()
+    };
+    // 17 GB of broad-phase grid, 7.1 TB of observe's top-down image
+    let huge = arena("huge.toml", "screen_mm = [1e7, 1e7]\n");
+    let in_range = "arena.screen_mm[0] = 10000000: outside its plausible range [100, 10000] mm";
+    for args in [
+        vec!["run", "--arena", &huge, "--steps", "10"],
+        vec!["render", "--arena", &huge, "--out", "x.png"],
+        vec!["train", "--arena", &huge, "--steps", "10"],
+        vec![
+            "observe",
+            "--arena",
+            &huge,
+            "--photo",
+            "x.jpg",
+            "--corners",
+            "10,10,390,10,390,290,10,290",
+        ],
+    ] {
+        let e = refused(&args);
+        assert!(
+            e.contains(in_range) && e.contains("huge.toml"),
+            "{args:?}: {e}"
+        );
+    }
+    // a robot radius in metres: 108 GB in observe
+    let metres = arena("metres.toml", "robot_radius_mm = 0.065\n");
+    let e = refused(&["run", "--arena", &metres, "--steps", "10"]);
+    assert!(
+        e.contains("arena.robot_radius_mm = 0.065: outside its plausible range [5, 500] mm"),
+        "{e}"
+    );
+    // never ends: 1e300 times the thesis' step counts
+    let out = dir.path().join("experiment");
+    let e = refused(&[
+        "experiment",
+        "annulus",
+        "--scale",
+        "1e300",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("--scale 1e300: outside its plausible range [1e-6, 10]"),
+        "{e}"
+    );
+    let fast = arena("fast.toml", "forward_speed = 1e30\n");
+    let e = refused(&["run", "--arena", &fast, "--steps", "10"]);
+    assert!(e.contains("arena.forward_speed = 1e30: outside"), "{e}");
+
+    let robot = dir.path().join("robot.json");
+    std::fs::write(
+        &robot,
+        r#"{"field": {"mounts": [{"forward_mm": 1e300, "right_mm": 0}, {"forward_mm": 0, "right_mm": 0}, {"forward_mm": 0, "right_mm": 0}]}}"#,
+    )
+    .unwrap();
+    let sensors = format!("robot:{}", robot.display());
+    let e = refused(&["run", "--sensors", &sensors, "--steps", "10"]);
+    assert!(
+        e.contains("field.mounts[0].forward_mm")
+            && e.contains("= 1e300: outside its plausible range [-500, 500] mm"),
+        "{e}"
+    );
+    std::fs::write(&robot, r#"{"field": {"gamma": 1e300}}"#).unwrap();
+    let e = refused(&["run", "--sensors", &sensors, "--steps", "10"]);
+    assert!(
+        e.contains("field.gamma = 1e300: outside its plausible range [0.5, 4]"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_settings_error_says_invalid_simulation_settings_at_most_once() {
+    let e = refused(&["train", "--robots", "0", "--steps", "10"]);
+    assert!(e.contains("robots = 0: outside"), "{e}");
+    assert!(e.matches("invalid simulation settings").count() <= 1, "{e}");
+    let dir = tempfile::tempdir().unwrap();
+    let arena = dir.path().join("a.toml");
+    std::fs::write(&arena, "pucks = 0\n").unwrap();
+    let e = refused(&["train", "--arena", arena.to_str().unwrap(), "--steps", "10"]);
+    assert!(e.contains("arena.pucks = 0: outside"), "{e}");
+    assert!(e.matches("invalid simulation settings").count() <= 1, "{e}");
+}

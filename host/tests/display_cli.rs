@@ -372,6 +372,9 @@ fn bad_settings_are_refused_naming_the_input() {
     };
     let e = fails(&["display", "--hold", "0.1", "--port", "0"]);
     assert!(e.contains("--hold 0.1 s") && e.contains("140 ms"), "{e}");
+    // the value as given, not as milliseconds clamped to 32 bits
+    let e = fails(&["display", "--hold", "1e9", "--port", "0"]);
+    assert!(e.contains("--hold 1e9 s: outside"), "{e}");
     let e = fails(&["display", "--arena", "thesis", "--port", "0"]);
     assert!(
         e.contains("--arena thesis") && e.contains("screen arena"),

@@ -7,6 +7,7 @@ use clap::error::ErrorKind;
 use clap::{ArgMatches, Args, FromArgMatches};
 use host::display::DisplaySettings;
 use host::observe::ObserveSettings;
+use sim::base::ranges;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
 use std::net::{IpAddr, SocketAddr};
@@ -116,19 +117,14 @@ impl DisplayArgs {
             Bind::Socket(a) => a,
             Bind::Ip(ip) => SocketAddr::new(ip, self.port),
         };
-        let hold_ms = self.hold * 1000.0;
-        anyhow::ensure!(
-            hold_ms.is_finite() && hold_ms >= 0.0,
-            "--hold {}: give a number of seconds, {} to {}",
-            self.hold,
-            f64::from(host::display::MIN_HOLD_MS) / 1000.0,
-            f64::from(host::display::MAX_HOLD_MS) / 1000.0
-        );
+        // checked in seconds, as given, before it becomes milliseconds
+        ranges::HOLD_S.check(self.hold)?;
+        let hold_ms = (self.hold * 1000.0).round() as u32;
         Ok(DisplaySettings {
             arena: self.screen.arena.screen()?,
             field: self.screen.field,
             bind,
-            hold_ms: hold_ms.round().min(f64::from(u32::MAX)) as u32,
+            hold_ms,
         })
     }
 }

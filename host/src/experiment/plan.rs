@@ -14,6 +14,7 @@ use crate::train::format3::TrainConfigV3;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
+use sim::base::ranges;
 use sim::scenario::{orbital_innies, THESIS_ROBOTS};
 use std::path::PathBuf;
 
@@ -180,7 +181,9 @@ pub fn plans_of_format(
             let trial_hash = match &arm.policy {
                 // an unreadable file hashes as none: its trials fail naming it
                 Some(path) => {
-                    let blob = std::fs::read(path).map(|b| hash(&b)).ok();
+                    let blob = ranges::read_file(path, &ranges::POLICY_FILE)
+                        .map(|b| hash(&b))
+                        .ok();
                     hash(&(format, arm.controller, hashed(&config), blob))
                 }
                 None => hash(&(

@@ -21,6 +21,7 @@ use super::trial::{self, TrialResult};
 use crate::train::checkpoint;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
+use sim::base::ranges;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -157,14 +158,16 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
     })
 }
 
-/// Refuses options that cannot run: no trials, a bad scale, arms whose
-/// directories would collide.
+/// Refuses options that cannot run: trials, scale or threads outside their
+/// ranges ([`sim::base::ranges`]), arms whose directories would collide,
+/// and any trial's or pre-training's settings that cannot be simulated
+/// (each arm's field, arena and sensor files loaded once): all before the
+/// first step.
 fn check_options(spec: &ExperimentSpec, options: &RunOptions) -> Result<()> {
-    if options.trials == 0 {
-        bail!("--trials 0: at least one trial is needed");
-    }
-    if !(options.scale.is_finite() && options.scale > 0.0) {
-        bail!("--scale {}: must be a positive number", options.scale);
+    ranges::TRIALS.check_count("--trials", options.trials as u64)?;
+    ranges::SCALE.check(options.scale)?;
+    if let Some(threads) = options.threads {
+        ranges::THREADS.check_count("--threads", threads as u64)?;
     }
     let mut slugs = BTreeMap::new();
     for arm in &spec.arms {
@@ -174,6 +177,27 @@ fn check_options(spec: &ExperimentSpec, options: &RunOptions) -> Result<()> {
                 arm.name,
                 slug(&arm.name)
             );
+        }
+    }
+    check_settings(spec, options.scale, options.seed.unwrap_or(spec.seed))
+}
+
+/// Checks every trial's and pre-training's settings of `spec` at `scale`
+/// against the plausible ranges and builds each once (its field, arena and
+/// sensor files loaded), and reads every arm's policy file: what
+/// [`run`] does before its first step. Errors name the arm.
+pub fn check_settings(spec: &ExperimentSpec, scale: f64, seed: u64) -> Result<()> {
+    for plan in plans(spec, 1, scale, seed) {
+        let configs = std::iter::once(&plan.config).chain(plan.pretrain.iter().map(|p| &p.config));
+        for config in configs {
+            config
+                .validate()
+                .and_then(|()| config.prepare().map(drop))
+                .with_context(|| format!("arm {:?}", plan.arm))?;
+        }
+        if let Some(policy) = &plan.policy {
+            sim::control::policy_file::read(policy)
+                .with_context(|| format!("arm {:?}", plan.arm))?;
         }
     }
     Ok(())

@@ -10,6 +10,7 @@ use super::metric::Metric;
 use crate::train::TrainConfig;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
+use sim::base::ranges;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -306,7 +307,7 @@ impl ExperimentSpec {
                 names.join(", ")
             );
         }
-        let text = std::fs::read_to_string(path)
+        let text = ranges::read_text(path, &ranges::SETTINGS_FILE)
             .with_context(|| format!("cannot read experiment file {}", path.display()))?;
         let stem = path
             .file_stem()

@@ -72,10 +72,7 @@ impl Default for LearnerRules {
 impl LearnerRules {
     /// Checks ranges before a run; errors name the setting.
     pub fn validate(&self) -> Result<()> {
-        let t = self.tie_tolerance;
-        if !(t.is_finite() && t >= 0.0) {
-            bail!("rules.tie_tolerance = {t}: must be a finite number, not negative");
-        }
+        sim::base::ranges::TIE_TOLERANCE.check(self.tie_tolerance)?;
         Ok(())
     }
 }

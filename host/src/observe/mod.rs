@@ -24,7 +24,9 @@ use image::codecs::png::PngEncoder;
 use image::{Rgb, RgbImage};
 use pucks::ColourMatch;
 use serde::Serialize;
+use sim::base::ranges;
 use sim::base::vec2::Vec2;
+use sim::fields::source::read_image;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
 use sim::scenario::{Arena, Scenario};
@@ -136,13 +138,7 @@ pub fn observe(settings: &ObserveSettings) -> Result<Observation> {
         )
     })?;
     let photo_path = &settings.photo;
-    let photo = image::ImageReader::open(photo_path)
-        .with_context(|| format!("cannot open photo {}", photo_path.display()))?
-        .with_guessed_format()
-        .with_context(|| format!("cannot read photo {}", photo_path.display()))?
-        .decode()
-        .with_context(|| format!("cannot decode photo {}", photo_path.display()))?
-        .to_rgb8();
+    let photo = read_image(photo_path, "photo", &ranges::PHOTO_SIDE)?.to_rgb8();
     let to_photo = screen_map(arena, &settings.corners, photo.dimensions())?;
     let scale = pixels_per_unit(arena, &settings.corners);
     let top_down = resample(&photo, &to_photo, arena.size(), scale);

@@ -24,6 +24,7 @@
 
 use anyhow::{bail, Context, Result};
 use shared::{FirmwareIdentity, StateHasher};
+use sim::base::ranges;
 use std::ffi::OsStr;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -93,7 +94,7 @@ impl FlashPlan {
         let policy = policy
             .canonicalize()
             .with_context(|| format!("cannot resolve policy file {}", policy.display()))?;
-        let bytes = std::fs::read(&policy)
+        let bytes = ranges::read_file(&policy, &ranges::POLICY_FILE)
             .with_context(|| format!("cannot read policy file {}", policy.display()))?;
         let policy_crc = FirmwareIdentity::policy_crc_of(&bytes)
             .with_context(|| format!("policy file {} is too short", policy.display()))?;

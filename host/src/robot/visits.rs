@@ -11,6 +11,7 @@ use crate::learn::QTable;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, State, StateHasher};
+use sim::base::ranges;
 use std::path::Path;
 
 /// Training visit counts per state of one hasher.
@@ -67,7 +68,8 @@ impl TrainingVisits {
     /// Reads a training checkpoint's visit counts, or a visits file; errors
     /// name the file and the problem.
     pub fn read(path: &Path) -> Result<TrainingVisits> {
-        let bytes = std::fs::read(path)
+        // a checkpoint or a small JSON file
+        let bytes = ranges::read_file(path, &ranges::CHECKPOINT_FILE)
             .with_context(|| format!("cannot read visits file {}", path.display()))?;
         if bytes.starts_with(&crate::train::checkpoint::MAGIC) {
             let state = crate::train::checkpoint::decode(&bytes)

@@ -27,6 +27,7 @@ use super::format3::StateV3;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
+use sim::base::ranges;
 use std::fmt;
 use std::io::Write;
 use std::path::Path;
@@ -209,7 +210,7 @@ pub fn save(path: &Path, state: &TrainingState) -> Result<()> {
 
 /// Reads a checkpoint; errors name the file and what is wrong with it.
 pub fn load(path: &Path) -> Result<TrainingState> {
-    let bytes = std::fs::read(path)
+    let bytes = ranges::read_file(path, &ranges::CHECKPOINT_FILE)
         .with_context(|| format!("cannot read checkpoint {}", path.display()))?;
     decode(&bytes).with_context(|| format!("checkpoint file {}", path.display()))
 }

@@ -9,6 +9,7 @@ use crate::learn::QTable;
 use anyhow::{bail, Context, Result};
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use shared::PolicyBlob;
+use sim::base::ranges;
 use sim::scenario::sensor_setup::SelectedSensors;
 use std::fmt;
 use std::io::IsTerminal;
@@ -143,7 +144,9 @@ fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>,
 /// The Q-table `--init-from` names: a checkpoint's, or one acting like a
 /// policy blob. Its hasher and actions must be the run's.
 pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    // a checkpoint or a policy blob: no larger than the larger of the two
+    let bytes = ranges::read_file(path, &ranges::CHECKPOINT_FILE)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let learn = &config.learn;
     let (table, speeds) = if bytes.starts_with(&PolicyBlob::MAGIC) {
         let blob = sim::control::policy_file::decode(path, &bytes)?;

@@ -9,6 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
 use serde::{Deserialize, Serialize};
+use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
@@ -217,7 +218,7 @@ impl TrainConfig {
     /// Reads a TOML file; syntax errors and unknown keys name the file, the
     /// line and the column.
     pub fn from_file(path: &Path) -> Result<TrainConfig> {
-        let text = std::fs::read_to_string(path)
+        let text = ranges::read_text(path, &ranges::SETTINGS_FILE)
             .with_context(|| format!("cannot read config file {}", path.display()))?;
         toml::from_str(&text).with_context(|| {
             format!(
@@ -263,10 +264,8 @@ impl TrainConfig {
     /// every robot an outie. Errors name the offending setting.
     pub fn prepare(&self) -> Result<PreparedScenario> {
         self.validate()?;
-        let mut prepared = self
-            .scenario()?
-            .prepare()
-            .context("invalid simulation settings")?;
+        // the scenario's errors say what kind of setting is wrong
+        let mut prepared = self.scenario()?.prepare()?;
         let c = prepared.config_mut();
         if let Some(limit) = self.stuck_limit {
             c.episode.stuck_limit = limit;
@@ -308,26 +307,39 @@ impl TrainConfig {
         }
     }
 
-    /// Checks every setting before a run; errors name the setting.
+    /// Checks every setting before a run against its plausible range
+    /// ([`sim::base::ranges`]) and the rules between settings; errors name
+    /// the setting.
     pub fn validate(&self) -> Result<()> {
-        if self.formation_check.every == 0 {
-            bail!("formation_check.every = 0: must be positive");
+        ranges::STEPS.check_count("steps", self.steps)?;
+        if let Some(robots) = self.robots {
+            ranges::ROBOTS.check_count("robots", robots as u64)?;
         }
-        if let Some(r) = self
-            .obstacle_discs
-            .map(|d| d.radius)
-            .filter(|r| !(r.is_finite() && *r > 0.0))
-        {
-            bail!("obstacle_discs.radius = {r}: must be positive");
+        if let Some(pucks) = self.pucks {
+            ranges::PUCKS.check_count("pucks", pucks as u64)?;
+        }
+        ranges::NOISE.check(self.noise)?;
+        if let Some(limit) = self.stuck_limit {
+            ranges::STUCK_LIMIT.check_count("stuck_limit", limit)?;
+        }
+        ranges::CHECK_INTERVAL.check_count("formation_check.every", self.formation_check.every)?;
+        if let Some(discs) = self.obstacle_discs {
+            ranges::DISC_RADIUS.check_as("obstacle_discs.radius", discs.radius)?;
         }
         self.learn.validate()?;
         self.rules.validate()?;
-        if self.steps == 0 {
-            bail!("steps = 0: must be positive");
+        ranges::INITIAL_Q.check(self.learn.initial_q)?;
+        for a in &self.learn.actions {
+            ranges::ANGULAR_SPEED.check(f64::from(*a))?;
         }
-        if self.distil_oc == Some(0) {
-            bail!("distil_oc = 0: must be positive (or absent)");
+        if let Some(select) = self.select {
+            ranges::STEPS.check_count("select.every", select.every)?;
+            ranges::STEPS.check_count("select.steps", select.steps)?;
         }
+        if let Some(steps) = self.distil_oc {
+            ranges::STEPS.check_count("distil_oc", steps)?;
+        }
+        ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
             bail!(
                 "obstacle_discs: only the disc sensor model takes them (sensors = {:?})",

@@ -65,10 +65,8 @@ impl Trainer<SelectedSensors> {
             }
             (None, table) => table,
         };
-        let sim = config
-            .prepare()?
-            .simulation(config.seed)
-            .context("invalid simulation settings")?;
+        // the scenario's errors say what kind of setting is wrong
+        let sim = config.prepare()?.simulation(config.seed)?;
         Trainer::new(config, sim, seed_table)
     }
 

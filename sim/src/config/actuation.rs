@@ -11,6 +11,7 @@
 //! `forward_speed f p`.
 
 use crate::base::noise::{self, Purpose};
+use crate::base::ranges;
 use crate::config::validate::{check, ConfigError};
 use serde::{Deserialize, Serialize};
 
@@ -100,48 +101,26 @@ impl ActuationNoise {
         *self == ActuationNoise::NONE
     }
 
-    /// Checks every amount; the error names the setting.
+    /// Checks every amount against its range; the error names the setting.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let s = self.speed_spread;
-        check(
-            "world.actuation.speed_spread",
-            s,
-            (0.0..1.0).contains(&s),
-            "must be in [0, 1)",
-        )?;
+        ranges::SPEED_SPREAD.check(self.speed_spread)?;
+        ranges::TURN_BIAS.check(self.turn_bias)?;
         check(
             "world.actuation.turn_bias",
             self.turn_bias,
             self.turn_bias >= 0.0,
-            "must not be negative",
+            "must not be negative (biases are drawn in +- this)",
         )?;
-        let j = self.period_jitter;
-        check(
-            "world.actuation.period_jitter",
-            j,
-            (0.0..0.15).contains(&j),
-            "must be in [0, 0.15)",
-        )?;
-        let d = self.drop_period;
-        check(
-            "world.actuation.drop_period",
-            d,
-            (0.0..=1.0).contains(&d),
-            "must be in [0, 1]",
-        )?;
+        ranges::RELATIVE_NOISE.check_as("world.actuation.period_jitter", self.period_jitter)?;
+        ranges::PROBABILITY.check_as("world.actuation.drop_period", self.drop_period)?;
         for (i, r) in self.robots.iter().enumerate() {
-            let f = r.wheel_speed_factor;
-            check(
+            ranges::WHEEL_SPEED_FACTOR.check_as(
                 &format!("world.actuation.robots[{i}].wheel_speed_factor"),
-                f,
-                f > 0.0,
-                "must be positive",
+                r.wheel_speed_factor,
             )?;
-            check(
+            ranges::TURN_BIAS.check_as(
                 &format!("world.actuation.robots[{i}].turn_bias"),
                 r.turn_bias,
-                true,
-                "must be a finite number",
             )?;
         }
         Ok(())

@@ -4,7 +4,8 @@
 //! right (clockwise on screen, y down); distances and radii are in robot
 //! radii. Each right-side disc is mirrored (negated angle) on the left.
 
-use crate::config::validate::{check, positive, ConfigError};
+use crate::base::ranges;
+use crate::config::validate::ConfigError;
 use serde::{Deserialize, Serialize};
 
 /// A sensing disc on the robot's right; its mirror image is on the left.
@@ -29,19 +30,10 @@ impl SensorDisc {
     }
 
     fn validate(&self, name: &str) -> Result<(), ConfigError> {
-        check(
-            &format!("{name}.angle_deg"),
-            self.angle_deg,
-            true,
-            "must be a finite number",
-        )?;
-        check(
-            &format!("{name}.distance"),
-            self.distance,
-            self.distance >= 0.0,
-            "must not be negative",
-        )?;
-        positive(&format!("{name}.radius"), self.radius)
+        ranges::DISC_ANGLE.check_as(&format!("{name}.angle_deg"), self.angle_deg)?;
+        ranges::DISC_DISTANCE.check_as(&format!("{name}.distance"), self.distance)?;
+        ranges::DISC_RADIUS.check_as(&format!("{name}.radius"), self.radius)?;
+        Ok(())
     }
 }
 
@@ -108,18 +100,8 @@ impl DiscSensorConfig {
 
     /// Checks every angle, distance and radius.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check(
-            "sensors.field_angle_deg",
-            self.field_angle_deg,
-            true,
-            "must be a finite number",
-        )?;
-        check(
-            "sensors.field_distance",
-            self.field_distance,
-            self.field_distance >= 0.0,
-            "must not be negative",
-        )?;
+        ranges::DISC_ANGLE.check(self.field_angle_deg)?;
+        ranges::DISC_DISTANCE.check(self.field_distance)?;
         for (i, d) in self.outie_pucks.iter().enumerate() {
             d.validate(&format!("sensors.outie_pucks[{i}]"))?;
         }

@@ -11,10 +11,11 @@ pub mod actuation;
 pub mod disc_sensors;
 pub mod validate;
 
+use crate::base::ranges;
 use crate::base::vec2::Vec2;
 use crate::config::actuation::ActuationNoise;
 use crate::config::disc_sensors::DiscSensorConfig;
-use crate::config::validate::{check, positive, unit, ConfigError};
+use crate::config::validate::{check, positive, ConfigError};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling};
 use serde::{Deserialize, Serialize};
 
@@ -294,47 +295,42 @@ pub struct SimConfig {
 const PACKING_DENSITY: f64 = 0.9069;
 
 impl SimConfig {
-    /// Checks every setting; the error names the first bad one and its value.
+    /// Checks every setting against its plausible range
+    /// ([`crate::base::ranges`]) and the rules between settings; the
+    /// error names the first bad one and its value.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let w = &self.world;
-        positive("world.arena_width", w.arena_width)?;
-        positive("world.arena_height", w.arena_height)?;
-        positive("world.unit_mm", w.unit_mm)?;
-        check(
-            "world.robots",
-            w.robots as f64,
-            w.robots > 0,
-            "at least one robot is needed",
-        )?;
+        ranges::ROBOTS.check_count("world.robots", w.robots as u64)?;
+        ranges::PUCKS.check_count("world.pucks", w.pucks as u64)?;
         check(
             "world.innies",
             w.innies as f64,
             w.innies <= w.robots,
             "cannot exceed world.robots",
         )?;
-        positive("world.robot_radius", w.robot_radius)?;
+        positive("world.arena_width", w.arena_width)?;
+        positive("world.arena_height", w.arena_height)?;
+        ranges::ROBOT_RADIUS_UNITS.check(w.robot_radius)?;
+        let r = w.robot_radius;
+        ranges::ARENA_IN_ROBOT_RADII
+            .check_as("world.arena_width / world.robot_radius", w.arena_width / r)?;
+        ranges::ARENA_IN_ROBOT_RADII.check_as(
+            "world.arena_height / world.robot_radius",
+            w.arena_height / r,
+        )?;
+        ranges::UNIT_MM.check(w.unit_mm)?;
         positive("world.puck_radius", w.puck_radius)?;
+        ranges::PUCK_OVER_ROBOT_RADIUS.check(w.puck_radius / r)?;
         if let Some(mass) = w.puck_mass {
             positive("world.puck_mass", mass)?;
         }
-        check(
-            "world.forward_speed",
-            w.forward_speed,
-            w.forward_speed >= 0.0,
-            "must not be negative",
-        )?;
+        ranges::FORWARD_SPEED_RADII.check(w.forward_speed / r)?;
         let short_side = w.arena_width.min(w.arena_height);
         check(
             "world.puck_radius",
             w.puck_radius,
             8.0 * w.puck_radius < short_side,
             "pucks start at least 4 radii from the walls, so 8 x radius must be less than the arena's shorter side",
-        )?;
-        check(
-            "world.robot_radius",
-            w.robot_radius,
-            2.0 * w.robot_radius < short_side,
-            "a robot must fit in the arena",
         )?;
         if let Some(f) = &w.field_frame {
             positive("world.field_frame.width", f.width)?;
@@ -356,31 +352,20 @@ impl SimConfig {
         }
 
         let p = &self.physics;
-        unit("physics.deceleration", p.deceleration)?;
-        check(
-            "physics.stop_speed",
-            p.stop_speed,
-            p.stop_speed >= 0.0,
-            "must not be negative",
-        )?;
-        check(
-            "physics.overlap_threshold",
-            p.overlap_threshold,
-            p.overlap_threshold >= 0.0,
-            "must not be negative",
-        )?;
-        check(
-            "physics.wall_radius",
-            p.wall_radius,
-            p.wall_radius >= 0.0,
-            "must not be negative",
-        )?;
+        ranges::DECELERATION.check(p.deceleration)?;
+        for (key, value) in [
+            ("physics.stop_speed", p.stop_speed),
+            ("physics.overlap_threshold", p.overlap_threshold),
+            ("physics.wall_radius", p.wall_radius),
+        ] {
+            ranges::PHYSICS_LENGTH.check_as(key, value)?;
+        }
 
         self.sensors.validate()?;
 
         let t = &self.thresholds;
-        unit("thresholds.outie", t.outie)?;
-        unit("thresholds.innie", t.innie)?;
+        ranges::FRACTION.check_as("thresholds.outie", t.outie)?;
+        ranges::FRACTION.check_as("thresholds.innie", t.innie)?;
         check(
             "thresholds.innie",
             t.innie,
@@ -389,21 +374,11 @@ impl SimConfig {
         )?;
 
         let e = &self.episode;
-        unit("episode.success_eval", e.success_eval)?;
-        check(
-            "episode.check_interval",
-            e.check_interval as f64,
-            e.check_interval > 0,
-            "must be positive",
-        )?;
-        check(
-            "episode.stuck_limit",
-            e.stuck_limit as f64,
-            e.stuck_limit > 0,
-            "must be positive",
-        )?;
-        unit("episode.phi", e.phi)?;
-        unit("episode.nu", e.nu)?;
+        ranges::FRACTION.check_as("episode.success_eval", e.success_eval)?;
+        ranges::CHECK_INTERVAL.check_count("episode.check_interval", e.check_interval)?;
+        ranges::STUCK_LIMIT.check_count("episode.stuck_limit", e.stuck_limit)?;
+        ranges::FRACTION.check_as("episode.phi", e.phi)?;
+        ranges::FRACTION.check_as("episode.nu", e.nu)?;
         check(
             "episode.nu",
             e.nu,
@@ -427,10 +402,11 @@ mod tests {
     fn errors_name_the_offending_value() {
         let mut c = SimConfig::default();
         c.world.robot_radius = -2.0;
-        assert_eq!(
-            c.validate().unwrap_err().to_string(),
-            "world.robot_radius = -2: must be positive"
-        );
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("world.robot_radius = -2: outside its plausible range [0.1, 1000] units"));
 
         let mut c = SimConfig::default();
         c.world.robots = 0;
@@ -442,10 +418,11 @@ mod tests {
 
         let mut c = SimConfig::default();
         c.thresholds.outie = 1.5;
-        assert_eq!(
-            c.validate().unwrap_err().to_string(),
-            "thresholds.outie = 1.5: must be in [0, 1]"
-        );
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("thresholds.outie = 1.5: outside its plausible range [0, 1]"));
 
         let mut c = SimConfig::default();
         c.world.pucks = 10_000;

@@ -1,6 +1,7 @@
-//! Errors of settings that cannot be simulated, and the range checks every
-//! settings struct validates with.
+//! Errors of settings that cannot be simulated, and the checks of the rules
+//! between settings (each setting's own range is in [`crate::base::ranges`]).
 
+use crate::base::ranges::RangeError;
 use std::fmt;
 
 /// A setting that cannot be simulated, with the offending value.
@@ -15,6 +16,8 @@ pub enum ConfigError {
         /// What it must be.
         expected: &'static str,
     },
+    /// A number outside its plausible range ([`crate::base::ranges`]).
+    Implausible(RangeError),
     /// The bodies' total area exceeds what circles can fill in the arena.
     TooManyBodies {
         /// Robots plus pucks.
@@ -30,6 +33,7 @@ impl fmt::Display for ConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ConfigError::OutOfRange { name, value, expected } => write!(f, "{name} = {value}: {expected}"),
+            ConfigError::Implausible(e) => e.fmt(f),
             ConfigError::TooManyBodies { bodies, area, capacity } => write!(
                 f,
                 "{bodies} bodies cover {area:.0} square units, more than fit in the arena ({capacity:.0})"
@@ -39,6 +43,12 @@ impl fmt::Display for ConfigError {
 }
 
 impl std::error::Error for ConfigError {}
+
+impl From<RangeError> for ConfigError {
+    fn from(e: RangeError) -> ConfigError {
+        ConfigError::Implausible(e)
+    }
+}
 
 /// Checks that `value` satisfies `ok`, or names it.
 pub fn check(name: &str, value: f64, ok: bool, expected: &'static str) -> Result<(), ConfigError> {
@@ -56,14 +66,4 @@ pub fn check(name: &str, value: f64, ok: bool, expected: &'static str) -> Result
 /// Checks that `value` is a finite number greater than zero.
 pub fn positive(name: &str, value: f64) -> Result<(), ConfigError> {
     check(name, value, value > 0.0, "must be positive")
-}
-
-/// Checks that `value` is in [0, 1].
-pub fn unit(name: &str, value: f64) -> Result<(), ConfigError> {
-    check(
-        name,
-        value,
-        (0.0..=1.0).contains(&value),
-        "must be in [0, 1]",
-    )
 }

@@ -1,5 +1,6 @@
 //! Reading policy blob files (writing them is the trainer's).
 
+use crate::base::ranges;
 use shared::{BlobError, PolicyBlob};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -38,12 +39,14 @@ impl fmt::Display for PolicyFileError {
 
 impl std::error::Error for PolicyFileError {}
 
-/// Reads and decodes a policy blob file.
+/// Reads (no further than the largest blob, [`ranges::POLICY_FILE`]) and
+/// decodes a policy blob file.
 pub fn read(path: &Path) -> Result<PolicyBlob, PolicyFileError> {
-    let bytes = std::fs::read(path).map_err(|reason| PolicyFileError::Read {
-        path: path.to_path_buf(),
-        reason,
-    })?;
+    let bytes =
+        ranges::read_file(path, &ranges::POLICY_FILE).map_err(|reason| PolicyFileError::Read {
+            path: path.to_path_buf(),
+            reason,
+        })?;
     decode(path, &bytes)
 }
 

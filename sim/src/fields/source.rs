@@ -2,6 +2,7 @@
 //! thesis' own letter images (built in from `experiments/fields/`), or an
 //! image file (one cell per pixel, the mean of R, G and B over 255).
 
+use crate::base::ranges::{self, Range, RangeError};
 use crate::fields::letters::Letter;
 use crate::fields::ScalarField;
 use serde::{Deserialize, Serialize};
@@ -40,6 +41,8 @@ pub enum FieldError {
     },
     /// The image decodes to no pixels.
     EmptyImage(PathBuf),
+    /// The image file cannot be read, or is too large.
+    ImageFile(ImageFileError),
     /// `thesis:` followed by a letter the thesis has no image of.
     NoThesisImage(String),
 }
@@ -60,6 +63,7 @@ impl fmt::Display for FieldError {
             FieldError::EmptyImage(path) => {
                 write!(f, "field image {} has no pixels", path.display())
             }
+            FieldError::ImageFile(e) => e.fmt(f),
             FieldError::NoThesisImage(l) => {
                 write!(
                     f,
@@ -151,18 +155,77 @@ fn thesis_image(letter: Letter) -> Option<&'static [u8]> {
     })
 }
 
-/// An image file's field.
-fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
-    let err = |reason| FieldError::Image {
+/// An image file that cannot be used, naming what it is for, the file and
+/// the problem.
+#[derive(Debug)]
+pub struct ImageFileError {
+    /// What the image is (`field image`, `photo`).
+    pub what: &'static str,
+    /// The file.
+    pub path: PathBuf,
+    /// What is wrong.
+    pub problem: ImageProblem,
+}
+
+/// Why an image file cannot be used.
+#[derive(Debug)]
+pub enum ImageProblem {
+    /// It cannot be read or decoded (or is larger than
+    /// [`ranges::IMAGE_FILE`]).
+    Read(image::ImageError),
+    /// Its width or height is outside its range.
+    Size(RangeError),
+}
+
+impl fmt::Display for ImageFileError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (what, path) = (self.what, self.path.display());
+        match &self.problem {
+            ImageProblem::Read(reason) => write!(f, "cannot load {what} {path}: {reason}"),
+            ImageProblem::Size(error) => write!(f, "{what} {path}: {error}"),
+        }
+    }
+}
+
+impl std::error::Error for ImageFileError {}
+
+/// Reads and decodes the image file at `path`: no further than
+/// [`ranges::IMAGE_FILE`]'s size, its width and height checked against
+/// `sides` (keys `<what> width`, `<what> height`) before its pixels are
+/// decoded, so that a small file of huge dimensions costs nothing.
+pub fn read_image(
+    path: &Path,
+    what: &'static str,
+    sides: &'static Range,
+) -> Result<image::DynamicImage, ImageFileError> {
+    let fail = |problem| ImageFileError {
+        what,
         path: path.to_path_buf(),
-        reason,
+        problem,
     };
-    let img = image::ImageReader::open(path)
-        .map_err(|e| err(image::ImageError::IoError(e)))?
-        .with_guessed_format()
-        .map_err(|e| err(image::ImageError::IoError(e)))?
-        .decode()
-        .map_err(err)?;
+    let unreadable = |e| fail(ImageProblem::Read(image::ImageError::IoError(e)));
+    let bytes = ranges::read_file(path, &ranges::IMAGE_FILE).map_err(unreadable)?;
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(&bytes))
+            .with_guessed_format()
+            .map_err(unreadable)
+    };
+    let (width, height) = reader()?
+        .into_dimensions()
+        .map_err(|e| fail(ImageProblem::Read(e)))?;
+    for (side, value) in [("width", width), ("height", height)] {
+        sides
+            .check_count(&format!("{what} {side}"), u64::from(value))
+            .map_err(|e| fail(ImageProblem::Size(e)))?;
+    }
+    reader()?.decode().map_err(|e| fail(ImageProblem::Read(e)))
+}
+
+/// An image file's field ([`read_image`] with
+/// [`ranges::FIELD_IMAGE_SIDE`]).
+fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
+    let img = read_image(path, "field image", &ranges::FIELD_IMAGE_SIDE)
+        .map_err(FieldError::ImageFile)?;
     field_of(img, path)
 }
 
@@ -233,5 +296,55 @@ mod tests {
         assert_eq!((f.width(), f.height()), (2, 1));
         assert_eq!(f.cell(0, 0), 1.0);
         assert!((f.cell(1, 0) - 1.0 / 3.0).abs() < 1e-6);
+    }
+
+    /// CRC-32 of a PNG chunk (type and data).
+    fn png_crc(bytes: &[u8]) -> u32 {
+        let mut crc = !0u32;
+        for b in bytes {
+            crc ^= u32::from(*b);
+            for _ in 0..8 {
+                crc = if crc & 1 == 1 {
+                    (crc >> 1) ^ 0xEDB8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    }
+
+    #[test]
+    fn a_field_image_of_huge_dimensions_is_refused_before_its_pixels_are_decoded() {
+        // A 1 x 1 PNG whose header says 20,000 x 20,000: decoding it would
+        // take 1.2 GB before finding its data short.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("huge.png");
+        image::GrayImage::new(1, 1).save(&path).unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        // signature (8), IHDR length (4), "IHDR" (4), width, height, ...
+        bytes[16..20].copy_from_slice(&20_000u32.to_be_bytes());
+        bytes[20..24].copy_from_slice(&20_000u32.to_be_bytes());
+        let crc = png_crc(&bytes[12..29]);
+        bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+        std::fs::write(&path, &bytes).unwrap();
+        let e = FieldSource::Image(path).load().unwrap_err();
+        assert!(
+            matches!(
+                e,
+                FieldError::ImageFile(ImageFileError {
+                    problem: ImageProblem::Size(_),
+                    ..
+                })
+            ),
+            "{e}"
+        );
+        let e = e.to_string();
+        assert!(
+            e.contains("huge.png")
+                && e.contains("field image width = 20000")
+                && e.contains("[1, 4096]"),
+            "{e}"
+        );
     }
 }

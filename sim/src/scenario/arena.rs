@@ -23,8 +23,9 @@
 //! pre-compensated so that the light is `v ^ LIGHT_GAMMA`, the curve the
 //! robots' calibration assumes ([`crate::scenario::panel`], `docs/display.md`).
 
+use crate::base::ranges;
 use crate::base::vec2::Vec2;
-use crate::config::validate::{check, positive, ConfigError};
+use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, Walls};
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling, ScalarField};
@@ -126,40 +127,32 @@ impl ArenaSpec {
         Vec2::new(self.screen_mm[0], self.screen_mm[1]) * (1.0 / self.unit_mm())
     }
 
-    /// Checks every setting; the error names the first bad one.
+    /// Checks every setting against its plausible range
+    /// ([`crate::base::ranges`]); the error names the first bad one. Run
+    /// before anything of the arena's size is allocated: a screen of
+    /// 10 km, or a robot radius given in metres, is refused here.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        positive("arena.screen_mm[0]", self.screen_mm[0])?;
-        positive("arena.screen_mm[1]", self.screen_mm[1])?;
+        for (i, mm) in self.screen_mm.iter().enumerate() {
+            ranges::SCREEN_MM.check_as(&format!("arena.screen_mm[{i}]"), *mm)?;
+        }
         for (i, px) in self.screen_px.iter().enumerate() {
-            check(
-                &format!("arena.screen_px[{i}]"),
-                f64::from(*px),
-                (1..=16384).contains(px),
-                "must be 1 to 16384",
+            ranges::SCREEN_PX.check_count(&format!("arena.screen_px[{i}]"), u64::from(*px))?;
+        }
+        ranges::GAMMA.check(self.display_gamma)?;
+        ranges::BODY_RADIUS_MM.check(self.robot_radius_mm)?;
+        ranges::BODY_RADIUS_MM.check_as("arena.puck_radius_mm", self.puck_radius_mm)?;
+        for (i, mm) in self.screen_mm.iter().enumerate() {
+            ranges::ARENA_IN_ROBOT_RADII.check_as(
+                &format!("arena.screen_mm[{i}] / arena.robot_radius_mm"),
+                mm / self.robot_radius_mm,
             )?;
         }
-        positive("arena.display_gamma", self.display_gamma)?;
-        positive("arena.robot_radius_mm", self.robot_radius_mm)?;
-        positive("arena.puck_radius_mm", self.puck_radius_mm)?;
-        positive("arena.puck_mass_ratio", self.puck_mass_ratio)?;
-        check(
-            "arena.robots",
-            self.robots as f64,
-            self.robots > 0,
-            "at least one robot is needed",
-        )?;
-        check(
-            "arena.forward_speed",
-            self.forward_speed,
-            self.forward_speed >= 0.0,
-            "must not be negative",
-        )?;
-        check(
-            "arena.stuck_limit",
-            self.stuck_limit as f64,
-            self.stuck_limit > 0,
-            "must be positive",
-        )
+        ranges::PUCK_MASS_RATIO.check(self.puck_mass_ratio)?;
+        ranges::ROBOTS.check_count("arena.robots", self.robots as u64)?;
+        ranges::PUCKS.check_count("arena.pucks", self.pucks as u64)?;
+        ranges::FORWARD_SPEED.check(self.forward_speed)?;
+        ranges::STUCK_LIMIT.check_count("arena.stuck_limit", self.stuck_limit)?;
+        Ok(())
     }
 
     /// Cells of the annulus generated for this screen: 64 across, as many

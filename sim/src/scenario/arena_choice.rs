@@ -5,6 +5,7 @@
 //! Without one, runs with the robot's senses use `tv75` and the others the
 //! thesis' square.
 
+use crate::base::ranges;
 use crate::scenario::arena::ArenaSpec;
 use crate::scenario::{Arena, ScenarioError};
 use serde::{Deserialize, Serialize};
@@ -62,8 +63,8 @@ pub fn read_arena(path: &Path) -> Result<ArenaSpec, ScenarioError> {
         path: path.to_path_buf(),
         problem,
     };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| problem(format!("cannot be read: {e}")))?;
+    let text = ranges::read_text(path, &ranges::SETTINGS_FILE)
+        .map_err(|e| problem(format!("cannot be read: {e}")))?;
     let spec: ArenaSpec =
         toml::from_str(&text).map_err(|e| problem(format!("is not valid: {e}")))?;
     spec.validate().map_err(|e| problem(e.to_string()))?;

@@ -10,8 +10,9 @@ pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;
 
+use crate::base::ranges;
 use crate::config::actuation::ActuationNoise;
-use crate::config::validate::{self, ConfigError};
+use crate::config::validate::ConfigError;
 use crate::config::BroadPhase;
 use crate::config::{SimConfig, Thresholds, Walls};
 use crate::control::greedy::GreedyPolicy;
@@ -245,12 +246,17 @@ impl Scenario {
         if let Arena::Screen(spec) = &self.arena {
             spec.validate()?;
         }
-        validate::check(
-            "noise",
-            self.noise,
-            (0.0..=5.0).contains(&self.noise),
-            "must be from 0 to 5 (times the default noise)",
-        )?;
+        ranges::NOISE.check(self.noise).map_err(ConfigError::from)?;
+        if let Some(robots) = self.robots {
+            ranges::ROBOTS
+                .check_count("world.robots", robots as u64)
+                .map_err(ConfigError::from)?;
+        }
+        if let Some(pucks) = self.pucks {
+            ranges::PUCKS
+                .check_count("world.pucks", pucks as u64)
+                .map_err(ConfigError::from)?;
+        }
         let sensors = if self.noise > 0.0 {
             self.sensors
                 .with_noise(&RobotNoise::randomised().scaled(self.noise))

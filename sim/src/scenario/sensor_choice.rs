@@ -7,6 +7,7 @@
 //! bits each of its own model (`mix:robot+disc+disc`), or
 //! `mix:FIELD+OBJECTS` with one model for both kinds of bits.
 
+use crate::base::ranges;
 use crate::config::SimConfig;
 use crate::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::scenario::ScenarioError;
@@ -89,8 +90,8 @@ pub fn read_robot_config(path: &Path) -> Result<RobotSensorConfig, ScenarioError
         path: path.to_path_buf(),
         problem,
     };
-    let text =
-        std::fs::read_to_string(path).map_err(|e| problem(format!("cannot be read: {e}")))?;
+    let text = ranges::read_text(path, &ranges::SETTINGS_FILE)
+        .map_err(|e| problem(format!("cannot be read: {e}")))?;
     let config: RobotSensorConfig =
         serde_json::from_str(&text).map_err(|e| problem(format!("is not valid: {e}")))?;
     config.validate().map_err(|e| problem(e.to_string()))?;

@@ -27,6 +27,7 @@
 //! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
 //! identical inputs identically.
 
+use crate::base::ranges;
 use crate::base::rng::SimRng;
 use crate::base::rounding;
 use crate::base::vec2::Vec2;
@@ -153,40 +154,24 @@ impl PhotoSensorConfig {
     /// Checks every position, time and the gamma; each sensor's bright and
     /// dark times must differ by at least one tick, or no calibration exists.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check(
-            "field.gamma",
-            self.gamma,
-            self.gamma > 0.0,
-            "must be positive",
-        )?;
+        ranges::GAMMA.check_as("field.gamma", self.gamma)?;
         let latency = self.poll_latency_us;
-        check(
-            "field.poll_latency_us",
-            latency,
-            latency >= 0.0,
-            "must not be negative",
-        )?;
+        ranges::POLL_LATENCY_US.check(latency)?;
         for (i, name) in NAMES.iter().enumerate() {
             let m = self.mounts[i];
-            check(
+            ranges::MOUNT_MM.check_as(
                 &format!("field.mounts[{i}].forward_mm ({name})"),
                 m.forward_mm,
-                true,
-                "must be a finite number",
             )?;
-            check(
-                &format!("field.mounts[{i}].right_mm ({name})"),
-                m.right_mm,
-                true,
-                "must be a finite number",
-            )?;
+            ranges::MOUNT_MM
+                .check_as(&format!("field.mounts[{i}].right_mm ({name})"), m.right_mm)?;
             let r = self.response[i];
-            check(
+            ranges::DISCHARGE_US.check_as(
                 &format!("field.response[{i}].bright_us ({name})"),
                 r.bright_us,
-                r.bright_us > 0.0,
-                "must be positive",
             )?;
+            ranges::DISCHARGE_US
+                .check_as(&format!("field.response[{i}].dark_us ({name})"), r.dark_us)?;
             check(
                 &format!("field.response[{i}].dark_us ({name})"),
                 r.dark_us,

@@ -34,8 +34,9 @@
 //! Block fields follow the Pixy: `width = right - left`, `x = left + width / 2`
 //! (integer), likewise for y, with inclusive pixel bounds.
 
+use crate::base::ranges;
 use crate::base::vec2::Vec2;
-use crate::config::validate::{check, positive, ConfigError};
+use crate::config::validate::{check, ConfigError};
 use crate::physics::grid::Neighbour;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -106,26 +107,13 @@ impl Default for PixyCameraConfig {
 }
 
 impl PixyCameraConfig {
-    /// Checks the pose, field of view, heights and range.
+    /// Checks the pose, field of view, heights, range and blob settings.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        check(
-            "camera.forward_mm",
-            self.forward_mm,
-            true,
-            "must be a finite number",
-        )?;
-        positive("camera.height_mm", self.height_mm)?;
-        for (name, fov) in [
-            ("camera.fov_h_deg", self.fov_h_deg),
-            ("camera.fov_v_deg", self.fov_v_deg),
-        ] {
-            check(
-                name,
-                fov,
-                fov > 0.0 && fov < 180.0,
-                "must be between 0 and 180 degrees",
-            )?;
-        }
+        ranges::MOUNT_MM.check_as("camera.forward_mm", self.forward_mm)?;
+        ranges::HEIGHT_MM.check(self.height_mm)?;
+        ranges::FOV_DEG.check(self.fov_h_deg)?;
+        ranges::FOV_DEG.check_as("camera.fov_v_deg", self.fov_v_deg)?;
+        ranges::TILT_DEG.check(self.tilt_deg)?;
         let half = self.fov_v_deg / 2.0;
         check(
             "camera.tilt_deg",
@@ -133,16 +121,18 @@ impl PixyCameraConfig {
             self.tilt_deg + half < 90.0 && self.tilt_deg - half > -90.0,
             "with half the vertical field of view must stay within +-90 degrees",
         )?;
-        positive("camera.puck_height_mm", self.puck_height_mm)?;
-        positive("camera.robot_height_mm", self.robot_height_mm)?;
-        positive("camera.max_range_mm", self.max_range_mm)?;
-        let l = f64::from(self.latency_frames);
-        check(
-            "camera.latency_frames",
-            l,
-            self.latency_frames <= 1,
-            "must be 0 or 1",
-        )
+        ranges::HEIGHT_MM.check_as("camera.puck_height_mm", self.puck_height_mm)?;
+        ranges::HEIGHT_MM.check_as("camera.robot_height_mm", self.robot_height_mm)?;
+        ranges::CAMERA_RANGE_MM.check(self.max_range_mm)?;
+        ranges::MIN_AREA_PX.check_count("camera.min_area", u64::from(self.min_area))?;
+        ranges::IMAGE_PX.check_count("camera.merge_distance", u64::from(self.merge_distance))?;
+        ranges::BLOCKS_PER_SIGNATURE.check_count(
+            "camera.max_blocks_per_signature",
+            u64::from(self.max_blocks_per_signature),
+        )?;
+        ranges::LATENCY_FRAMES
+            .check_count("camera.latency_frames", u64::from(self.latency_frames))?;
+        Ok(())
     }
 }
 

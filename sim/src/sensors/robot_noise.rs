@@ -7,10 +7,11 @@
 //! and the robot.
 
 use crate::base::noise::{self, Purpose};
+use crate::base::ranges;
 use crate::base::rng::SimRng;
 use crate::base::rounding::round_half_away;
 use crate::base::vec2::Vec2;
-use crate::config::validate::{check, ConfigError};
+use crate::config::validate::ConfigError;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::PixyBlock;
@@ -87,33 +88,15 @@ impl RobotNoise {
 
     /// Checks every amount; the error names the setting.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let j = self.rc_jitter;
-        check(
-            "noise.rc_jitter",
-            j,
-            (0.0..0.15).contains(&j),
-            "must be in [0, 0.15)",
-        )?;
-        let b = self.brightness;
-        check(
-            "noise.brightness",
-            b,
-            (0.0..0.15).contains(&b),
-            "must be in [0, 0.15)",
-        )?;
-        let p = self.block_jitter_px;
-        check("noise.block_jitter_px", p, p >= 0.0, "must not be negative")?;
+        ranges::RELATIVE_NOISE.check(self.rc_jitter)?;
+        ranges::RELATIVE_NOISE.check_as("noise.brightness", self.brightness)?;
+        ranges::IMAGE_PX.check_as("noise.block_jitter_px", self.block_jitter_px)?;
         for (name, value) in [
             ("noise.block_miss", self.block_miss),
             ("noise.spurious_block", self.spurious_block),
             ("noise.frame_drop", self.frame_drop),
         ] {
-            check(
-                name,
-                value,
-                (0.0..=1.0).contains(&value),
-                "must be in [0, 1]",
-            )?;
+            ranges::PROBABILITY.check_as(name, value)?;
         }
         Ok(())
     }

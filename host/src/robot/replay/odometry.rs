@@ -25,6 +25,7 @@
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use shared::{LogFrame, RobotProfile};
+use sim::base::ranges;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -212,7 +213,7 @@ pub fn merge_into_file(path: &Path, robots: &[RobotMotion]) -> Result<FitFile> {
             LogFrame::VERSION
         );
     }
-    let mut file = match std::fs::read(path) {
+    let mut file = match ranges::read_file(path, &ranges::SETTINGS_FILE) {
         Ok(bytes) => serde_json::from_slice::<FitFile>(&bytes).with_context(|| {
             format!(
                 "{} exists but is not a fit file ({{\"robots\": [...]}}); nothing was written",
