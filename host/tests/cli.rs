@@ -285,3 +285,29 @@ fn a_settings_error_says_invalid_simulation_settings_at_most_once() {
     assert!(e.contains("arena.pucks = 0: outside"), "{e}");
     assert!(e.matches("invalid simulation settings").count() <= 1, "{e}");
 }
+
+#[test]
+fn an_output_file_is_written_only_into_a_folder_that_exists_and_never_over_a_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let export = |out: &str| {
+        host()
+            .current_dir(dir.path())
+            .args(["field", "export", "--arena", "tv75", "--out", out])
+            .output()
+            .unwrap()
+    };
+    let out = export("no/such/x.png");
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(
+        e.contains("cannot write no/such/x.png: the folder no/such does not exist"),
+        "{e}"
+    );
+    assert!(!dir.path().join("no").exists(), "the folder was created");
+    std::fs::create_dir(dir.path().join("folder")).unwrap();
+    let out = export("folder");
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert_eq!(e.matches("folder").count(), 2, "said once: {e}");
+    assert!(e.contains("cannot write folder: it is a folder"), "{e}");
+}

@@ -211,3 +211,19 @@ fn bad_inputs_are_refused_with_a_clear_error() {
     let e = fails(d, &["train", "--resume", "/no/such.ckpt"]);
     assert!(e.contains("/no/such.ckpt"), "{e}");
 }
+
+#[test]
+fn an_output_folder_that_cannot_be_written_is_refused_before_the_first_step() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("file"), b"a file, not a folder").unwrap();
+    // a billion steps: without the check they would all run first
+    let out = host()
+        .current_dir(dir.path())
+        .args(["train", "--steps", "1000000000", "--out", "file/out"])
+        .timeout(std::time::Duration::from_secs(60))
+        .output()
+        .unwrap();
+    let e = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert!(e.contains("cannot create folder file/out"), "{e}");
+}

@@ -37,6 +37,7 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<MergeReport> {
         || Path::new("out/experiments").join(&spec.name),
         Path::to_path_buf,
     );
+    crate::atomic::create_dirs(&out)?;
     let mut shard_dirs = vec![Path::new(""); run.shard.count];
     for (dir, m) in &manifests {
         shard_dirs[m.shard.index] = dir;
@@ -63,7 +64,11 @@ pub fn merge(dirs: &[PathBuf], out: Option<&Path>) -> Result<MergeReport> {
         let from = trial_path(dir, plan);
         let bytes =
             std::fs::read(&from).with_context(|| format!("cannot read {}", from.display()))?;
-        crate::atomic::write(&trial_path(&out, plan), &bytes)?;
+        let to = trial_path(&out, plan);
+        if let Some(arm) = to.parent() {
+            crate::atomic::create_dirs(arm)?;
+        }
+        crate::atomic::write(&to, &bytes)?;
         results.push(result);
     }
 
@@ -111,6 +116,9 @@ fn join_pretrained(shard_dirs: &[&Path], out: &Path) -> Result<usize> {
                 }
             }
         }
+    }
+    if !tables.is_empty() {
+        crate::atomic::create_dirs(&out.join("pretrained"))?;
     }
     for (name, (_, bytes)) in &tables {
         crate::atomic::write(&out.join("pretrained").join(name), bytes)?;

@@ -128,6 +128,7 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
         )),
         dir.display()
     ));
+    crate::atomic::check_writable(&dir)?;
     let workers = Workers::new(options.threads)?;
     // a shard's manifest first, so that merge can name an unfinished shard
     let manifest = match options.shard {
@@ -290,6 +291,7 @@ fn run_pretrainings(
     workers.run(&|| {
         todo.par_iter().try_for_each(|p| {
             let t = trial::pretrain(&p.config)?;
+            crate::atomic::create_dirs(&dir.join("pretrained"))?;
             checkpoint::save(&pretrained_path(dir, p), &t.state())?;
             let k = count.fetch_add(1, Ordering::Relaxed) + 1;
             log(&format!(
@@ -363,9 +365,12 @@ fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
     Ok(result)
 }
 
-/// Writes a trial's result file atomically.
+/// Writes a trial's result file atomically, creating its arm's folder.
 fn write_result(path: &Path, result: &TrialResult) -> Result<()> {
     let json = serde_json::to_vec_pretty(result).context("cannot encode a trial result")?;
+    if let Some(arm) = path.parent() {
+        crate::atomic::create_dirs(arm)?;
+    }
     crate::atomic::write(path, &json)
 }
 

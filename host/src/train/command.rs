@@ -99,6 +99,8 @@ pub fn train(args: &TrainRequest) -> Result<TrainReport> {
         *trainer.output_mut() = config.output;
     }
     trainer.config().validate()?;
+    // a resumed run's output folder may be another than its checkpoint's
+    crate::atomic::check_writable(&trainer.config().output.dir)?;
     run(&mut trainer, steps)
 }
 
@@ -113,6 +115,8 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
         config.noise = 1.0;
     }
     config.validate()?;
+    // before any step (a distillation or a pre-evaluation included)
+    crate::atomic::check_writable(&config.output.dir)?;
     let seed_table = args
         .init_from
         .as_deref()
