@@ -17,9 +17,10 @@
 //! (`cat /dev/ttyUSB0 > x.bin`): the robot's frames split at `0x00`, with no
 //! host times.
 
-use super::frame_splitter::{Chunk, FrameSplitter};
+use super::frame_splitter::{Chunk, ChunkEnd, FrameSplitter, MAX_CHUNK};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_16_IBM_3740};
+use sim::base::ranges;
 use std::fmt;
 use std::fs::{File, OpenOptions};
 use std::io::{Read, Write};
@@ -35,6 +36,11 @@ pub const VERSION: u8 = 1;
 pub const HEADER_LEN: usize = MAGIC.len() + 1;
 /// Bytes of a record payload around the frame: host time and CRC.
 const RECORD_OVERHEAD: usize = 8 + 2;
+/// Longest record (without its terminator): the record of the longest
+/// chunk the monitor keeps ([`MAX_CHUNK`]). Reading splits at this limit,
+/// so every record the monitor writes reads back whole, and only a
+/// damaged file has a longer one.
+pub const MAX_RECORD_LEN: usize = cobs::max_encoding_length(RECORD_OVERHEAD + MAX_CHUNK);
 /// Records are forced to the disk at most this often (a process crash
 /// loses nothing already written; a power cut at most this much).
 const SYNC_EVERY: Duration = Duration::from_secs(1);
@@ -180,6 +186,9 @@ pub enum RecordError {
     BadCobs,
     /// Too short for a host time, a frame byte and a CRC.
     TooShort(usize),
+    /// Longer than any record the monitor writes ([`MAX_RECORD_LEN`]): no
+    /// terminator where there should be one (damaged).
+    TooLong,
     /// The record's CRC does not match: damaged on disk.
     CrcMismatch {
         /// CRC in the record.
@@ -197,6 +206,10 @@ impl fmt::Display for RecordError {
             }
             RecordError::BadCobs => f.write_str("record is not valid COBS"),
             RecordError::TooShort(n) => write!(f, "record of {n} bytes is too short"),
+            RecordError::TooLong => write!(
+                f,
+                "record has no terminator within {MAX_RECORD_LEN} bytes, the longest the monitor writes"
+            ),
             RecordError::CrcMismatch { stored, computed } => {
                 write!(
                     f,
@@ -271,7 +284,7 @@ pub fn parse(bytes: &[u8]) -> Result<Recording> {
         });
     }
     check_header(bytes)?;
-    let mut splitter = FrameSplitter::at_offset(HEADER_LEN as u64);
+    let mut splitter = FrameSplitter::with_limit(HEADER_LEN as u64, MAX_RECORD_LEN);
     let mut chunks = splitter.push(&bytes[HEADER_LEN..]);
     chunks.extend(splitter.finish());
     Ok(Recording {
@@ -302,6 +315,8 @@ fn decode_record(chunk: &Chunk) -> Entry {
         frame,
     };
     match checked {
+        // a piece of a run longer than any record the monitor writes
+        _ if chunk.end == ChunkEnd::Cut => entry(None, Err(RecordError::TooLong)),
         Ok(n) => {
             let mut time = [0u8; 8];
             time.copy_from_slice(&payload[..8]);
@@ -310,15 +325,15 @@ fn decode_record(chunk: &Chunk) -> Entry {
                 Ok(payload[8..n - 2].to_vec()),
             )
         }
-        Err(_) if !chunk.terminated => entry(None, Err(RecordError::Truncated)),
+        Err(_) if chunk.end == ChunkEnd::StreamEnd => entry(None, Err(RecordError::Truncated)),
         Err(e) => entry(None, Err(e)),
     }
 }
 
 /// Reads and splits a recorded log or raw capture; errors name the file.
 pub fn read(path: &Path) -> Result<Recording> {
-    let bytes =
-        std::fs::read(path).with_context(|| format!("cannot read log file {}", path.display()))?;
+    let bytes = ranges::read_file(path, &ranges::LOG_FILE)
+        .with_context(|| format!("cannot read log file {}", path.display()))?;
     parse(&bytes).with_context(|| format!("log file {}", path.display()))
 }
 
@@ -355,6 +370,41 @@ mod tests {
             rec.entries[1].offset,
             (HEADER_LEN + encode_record(FRAMES[0].0, FRAMES[0].1).len()) as u64
         );
+    }
+
+    #[test]
+    fn the_longest_chunk_the_monitor_records_reads_back_as_one_record() {
+        // the monitor's limit (MAX_CHUNK) and the reader's (MAX_RECORD_LEN)
+        // are one rule: before, this record read back as two damaged
+        // entries, one of them "ends before its terminator"
+        let longest = vec![0x55u8; MAX_CHUNK];
+        let bytes = file_of(&[(1, &longest), (2, &[1, 2])]);
+        let rec = parse(&bytes).unwrap();
+        assert_eq!(rec.entries.len(), 2);
+        assert_eq!(rec.entries[0].frame.as_deref(), Ok(&longest[..]));
+        assert_eq!(rec.entries[1].frame.as_deref(), Ok(&[1u8, 2][..]));
+    }
+
+    #[test]
+    fn a_damaged_run_longer_than_any_record_is_named_as_such() {
+        let mut bytes = file_of(&[(1, &[3, 1])]);
+        bytes.extend(vec![0x55u8; MAX_RECORD_LEN + 10]);
+        bytes.push(0);
+        bytes.extend(encode_record(2, &[4, 5]));
+        let rec = parse(&bytes).unwrap();
+        let frames: Vec<_> = rec.entries.iter().map(|e| e.frame.clone()).collect();
+        assert_eq!(
+            frames,
+            [
+                Ok(vec![3, 1]),
+                Err(RecordError::TooLong),
+                Err(RecordError::TooLong),
+                Ok(vec![4, 5])
+            ]
+        );
+        assert!(RecordError::TooLong
+            .to_string()
+            .contains("no terminator within"));
     }
 
     #[test]

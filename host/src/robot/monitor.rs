@@ -7,7 +7,7 @@
 //! flag, so tests run it over a pseudo-terminal or an in-memory stream and
 //! stop it after a number of frames instead of racing a timer.
 
-use super::frame_splitter::FrameSplitter;
+use super::frame_splitter::{ChunkEnd, FrameSplitter};
 use super::log_file::{host_time_us, LogWriter};
 use anyhow::{Context, Result};
 use shared::{Faults, LogFrame, RunMode};
@@ -113,8 +113,9 @@ pub struct LiveStatus {
     pub frames: u64,
     /// Recorded frames that do not decode (corrupt, another format version).
     pub decode_errors: u64,
-    /// Bytes dropped when (re)connecting: the partial frame the robot was
-    /// sending when the monitor started listening.
+    /// Bytes dropped when (re)connecting (the partial frame the robot was
+    /// sending when the monitor started listening) and runs longer than
+    /// any frame ([`super::frame_splitter::MAX_CHUNK`]: noise, not recorded).
     pub skipped_bytes: u64,
     /// Decoded frames with any fault flag.
     pub fault_frames: u64,
@@ -180,7 +181,7 @@ impl fmt::Display for LiveStatus {
         if self.skipped_bytes > 0 {
             write!(
                 f,
-                " | skipped {} bytes of partial frames",
+                " | skipped {} bytes of partial frames and noise",
                 self.skipped_bytes
             )?;
         }
@@ -254,6 +255,11 @@ pub fn run(
                 }
             };
             for chunk in splitter.push(&buf[..n]) {
+                if chunk.end == ChunkEnd::Cut {
+                    // longer than any frame: noise, neither recorded nor a frame
+                    status.skipped_bytes += chunk.bytes.len() as u64;
+                    continue;
+                }
                 let decoded = LogFrame::decode(&chunk.bytes);
                 if !synced && decoded.is_err() {
                     status.skipped_bytes += chunk.bytes.len() as u64;
@@ -369,6 +375,7 @@ impl<W: Write> StatusPrinter<W> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::robot::frame_splitter::MAX_CHUNK;
     use crate::robot::log_file;
     use shared::{ActionId, LogFrame};
     use std::collections::VecDeque;
@@ -430,6 +437,31 @@ mod tests {
         }
     }
 
+    /// Monitors `streams` (each ending in an unplugging) into a new log
+    /// until `max_frames` are recorded; returns the status, the log read
+    /// back and how often the port was opened.
+    fn monitor(
+        streams: Vec<Vec<u8>>,
+        max_frames: u64,
+        observer: &mut dyn FnMut(MonitorEvent<'_>),
+    ) -> (LiveStatus, log_file::Recording, usize) {
+        let mut opener = Unplugging {
+            streams: VecDeque::from(streams),
+            fail_next: false,
+            opens: 0,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("run.log");
+        let mut log = LogWriter::create(&path, false).unwrap();
+        let options = MonitorOptions {
+            max_frames: Some(max_frames),
+            reopen_interval: Duration::ZERO,
+        };
+        let stop = AtomicBool::new(false);
+        let status = run(&mut opener, &mut log, &options, &stop, observer).unwrap();
+        (status, log_file::read(&path).unwrap(), opener.opens)
+    }
+
     #[test]
     fn records_across_unplugging_and_drops_only_the_partial_first_frame() {
         let first: Vec<u8> = [
@@ -447,30 +479,16 @@ mod tests {
             &frame(10, 3)[..4],
         ]
         .concat();
-        let mut opener = Unplugging {
-            streams: VecDeque::from([first, second]),
-            fail_next: false,
-            opens: 0,
-        };
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("run.log");
-        let mut log = LogWriter::create(&path, false).unwrap();
-        let options = MonitorOptions {
-            max_frames: Some(5),
-            reopen_interval: Duration::ZERO,
-        };
         let mut events = Vec::new();
-        let stop = AtomicBool::new(false);
-        let status = run(&mut opener, &mut log, &options, &stop, &mut |e| {
+        let (status, rec, opens) = monitor(vec![first, second], 5, &mut |e| {
             events.push(match e {
                 MonitorEvent::Connected => "connected",
                 MonitorEvent::Frame(_) => "frame",
                 MonitorEvent::OpenFailed(_) => "open failed",
                 MonitorEvent::Lost(_) => "lost",
             })
-        })
-        .unwrap();
-        assert_eq!(opener.opens, 2);
+        });
+        assert_eq!(opens, 2);
         assert_eq!(
             events,
             [
@@ -494,7 +512,6 @@ mod tests {
         );
         assert_eq!(status.skipped_bytes, (frame(1, 0).len() - 4 + 5) as u64);
         assert_eq!(status.actions, [0, 2, 1, 1]);
-        let rec = log_file::read(&path).unwrap();
         let ticks: Vec<Option<u32>> = rec
             .entries
             .iter()
@@ -515,6 +532,31 @@ mod tests {
                 && line.contains("actions 0:0% 1:50% 2:25% 3:25%"),
             "{line}"
         );
+    }
+
+    #[test]
+    fn noise_longer_than_any_frame_is_neither_recorded_nor_counted_as_frames() {
+        // 1,040 bytes of noise (a wrong baud rate) between two frames
+        let stream: Vec<u8> = [
+            &frame(1, 0)[..],
+            &frame(2, 1),
+            &vec![0x55; MAX_CHUNK + 16],
+            &[0],
+            &frame(3, 1),
+            &frame(4, 2),
+        ]
+        .concat();
+        let (status, rec, _) = monitor(vec![stream], 3, &mut |_| {});
+        // frame 1 is the first chunk, kept since it decodes; --frames 3
+        // ends after frames 2 and 3, the noise not among them
+        assert_eq!((status.frames, status.decode_errors), (3, 0));
+        assert_eq!(status.skipped_bytes, (MAX_CHUNK + 16) as u64);
+        let ticks: Vec<u32> = rec
+            .entries
+            .iter()
+            .map(|e| LogFrame::decode(e.frame.as_ref().unwrap()).unwrap().tick)
+            .collect();
+        assert_eq!(ticks, [1, 2, 3]);
     }
 
     #[test]
