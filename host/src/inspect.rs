@@ -21,8 +21,9 @@ pub fn render(blob: &PolicyBlob) -> String {
         a.angular_speeds(),
         a.forward_speed()
     );
-    let _ = writeln!(out, "field      {}", p.field);
-    let _ = writeln!(out, "name       {}", p.name);
+    // the blob's own strings are untrusted: a line break would forge a line
+    let _ = writeln!(out, "field      {}", escaped(&p.field));
+    let _ = writeln!(out, "name       {}", escaped(&p.name));
     let _ = writeln!(out, "trained    {} steps, seed {}", p.trainer_steps, p.seed);
     let mut histogram = [0usize; 4];
     for (_, action) in blob.table().entries() {
@@ -71,4 +72,57 @@ pub fn render(blob: &PolicyBlob) -> String {
         );
     }
     out
+}
+
+/// `s` as it is safe to print on a terminal: control characters (line
+/// breaks, terminal escape sequences) and the invisible direction marks
+/// and overrides written as Rust escapes (`\n`, `\u{1b}`, `\u{202e}`),
+/// a backslash doubled so that an escape cannot be forged; the rest as is.
+pub fn escaped(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        let bidi = matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+        if c == '\\' || c.is_control() {
+            out.extend(c.escape_default());
+        } else if bidi {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shared::{ActionTable, PolicyTable, Provenance};
+
+    #[test]
+    fn a_blobs_strings_are_printed_escaped_and_cannot_forge_a_line() {
+        let provenance = Provenance::new(
+            "annulus\nhasher     FAKE",
+            "\u{1b}[2J\u{202e}evil\\n",
+            10,
+            1,
+        )
+        .unwrap();
+        let table = PolicyTable::new(StateHasher::Original);
+        let blob = PolicyBlob::new(ActionTable::default(), table, provenance).unwrap();
+        let text = render(&blob);
+        assert_eq!(
+            text.lines().filter(|l| l.starts_with("hasher")).count(),
+            1,
+            "{text}"
+        );
+        assert!(!text.contains(['\u{1b}', '\u{202e}']), "{text}");
+        assert!(
+            text.contains("field      annulus\\nhasher     FAKE\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("name       \\u{1b}[2J\\u{202e}evil\\\\n\n"),
+            "{text}"
+        );
+    }
 }
