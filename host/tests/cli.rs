@@ -311,3 +311,23 @@ fn an_output_file_is_written_only_into_a_folder_that_exists_and_never_over_a_fol
     assert_eq!(e.matches("folder").count(), 2, "said once: {e}");
     assert!(e.contains("cannot write folder: it is a folder"), "{e}");
 }
+
+#[cfg(unix)]
+#[test]
+fn a_file_larger_than_its_format_allows_is_refused_without_being_read_whole() {
+    let policy = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../policies/oc-heuristic.policy"
+    );
+    for args in [
+        vec!["policy", "inspect", "/dev/zero"],
+        vec!["replay", "--log", "/dev/zero", "--policy", policy],
+        vec!["train", "--config", "/dev/zero", "--steps", "10"],
+    ] {
+        let e = refused(&args);
+        assert!(
+            e.contains("/dev/zero") && e.contains("larger than"),
+            "{args:?}: {e}"
+        );
+    }
+}
