@@ -3,43 +3,20 @@
 use shared::{PolicyBlob, StateHasher};
 use std::fmt::Write;
 
-/// The blob's header, then one line per state with its decoded inputs and action.
+/// The blob's header ([`summary`]), then one line per state with its
+/// decoded inputs (the role too, for a hasher that has the role bit) and
+/// action.
 pub fn render(blob: &PolicyBlob) -> String {
-    let mut out = String::new();
-    let p = blob.provenance();
+    let mut out = summary(blob);
     let a = blob.actions();
-    let _ = writeln!(out, "format     QPOL v{}", PolicyBlob::VERSION);
-    let _ = writeln!(
-        out,
-        "hasher     {} ({} states)",
-        blob.hasher(),
-        blob.hasher().num_states()
-    );
-    let _ = writeln!(
-        out,
-        "actions    {:?} rad/step, forward {} units/step",
-        a.angular_speeds(),
-        a.forward_speed()
-    );
-    // the blob's own strings are untrusted: a line break would forge a line
-    let _ = writeln!(out, "field      {}", escaped(&p.field));
-    let _ = writeln!(out, "name       {}", escaped(&p.name));
-    let _ = writeln!(out, "trained    {} steps, seed {}", p.trainer_steps, p.seed);
-    let mut histogram = [0usize; 4];
-    for (_, action) in blob.table().entries() {
-        histogram[action.index()] += 1;
-    }
-    let _ = writeln!(
-        out,
-        "histogram  {:?} states per action",
-        &histogram[..a.len()]
-    );
     let _ = writeln!(out);
     let obstacle = blob.hasher() == StateHasher::OriginalObstacle;
+    let role = blob.hasher().has_role_bit();
     let _ = writeln!(
         out,
-        "state  puckL puckR  L<M R<M  mid-bin{}  action  omega",
-        if obstacle { "  obsL obsR" } else { "" }
+        "state  puckL puckR  L<M R<M  mid-bin{}{}  action  omega",
+        if obstacle { "  obsL obsR" } else { "" },
+        if role { "  role " } else { "" }
     );
     for (state, action) in blob.table().entries() {
         let Some(i) = blob.hasher().unpack(state) else {
@@ -64,6 +41,9 @@ pub fn render(blob: &PolicyBlob) -> String {
                 flag(i.obstacle_right)
             );
         }
+        if role {
+            let _ = write!(out, "  {}", role_name(i.innie));
+        }
         let _ = writeln!(
             out,
             "  {:>6}  {:+.3}",
@@ -72,6 +52,65 @@ pub fn render(blob: &PolicyBlob) -> String {
         );
     }
     out
+}
+
+/// The blob's header: format, hasher, actions, provenance, and how many
+/// states choose each action (for a hasher with the role bit, also per
+/// role): `host policy inspect --summary`.
+pub fn summary(blob: &PolicyBlob) -> String {
+    let mut out = String::new();
+    let p = blob.provenance();
+    let a = blob.actions();
+    let _ = writeln!(out, "format     QPOL v{}", PolicyBlob::VERSION);
+    let _ = writeln!(
+        out,
+        "hasher     {} ({} states)",
+        blob.hasher(),
+        blob.hasher().num_states()
+    );
+    let _ = writeln!(
+        out,
+        "actions    {:?} rad/step, forward {} units/step",
+        a.angular_speeds(),
+        a.forward_speed()
+    );
+    // the blob's own strings are untrusted: a line break would forge a line
+    let _ = writeln!(out, "field      {}", escaped(&p.field));
+    let _ = writeln!(out, "name       {}", escaped(&p.name));
+    let _ = writeln!(out, "trained    {} steps, seed {}", p.trainer_steps, p.seed);
+    // [all, outies, innies]
+    let mut histogram = [[0usize; 4]; 3];
+    for (state, action) in blob.table().entries() {
+        histogram[0][action.index()] += 1;
+        if let Some(i) = blob.hasher().unpack(state) {
+            histogram[1 + usize::from(i.innie)][action.index()] += 1;
+        }
+    }
+    let _ = writeln!(
+        out,
+        "histogram  {:?} states per action",
+        &histogram[0][..a.len()]
+    );
+    if blob.hasher().has_role_bit() {
+        for innie in [false, true] {
+            let _ = writeln!(
+                out,
+                "  {:<8} {:?}",
+                format!("{}s", role_name(innie)),
+                &histogram[1 + usize::from(innie)][..a.len()]
+            );
+        }
+    }
+    out
+}
+
+/// A role as the table shows it.
+fn role_name(innie: bool) -> &'static str {
+    if innie {
+        "innie"
+    } else {
+        "outie"
+    }
 }
 
 /// `s` as it is safe to print on a terminal: control characters (line
@@ -124,5 +163,34 @@ mod tests {
             text.contains("name       \\u{1b}[2J\\u{202e}evil\\\\n\n"),
             "{text}"
         );
+    }
+
+    #[test]
+    fn the_summary_is_the_header_and_a_role_table_shows_each_states_role() {
+        let provenance = Provenance::new("annulus", "role", 10, 1).unwrap();
+        let mut table = PolicyTable::new(StateHasher::OriginalRole);
+        // an innie's state: bit 8 set
+        table.set(shared::State(256), shared::ActionId(2));
+        let blob = PolicyBlob::new(ActionTable::default(), table, provenance).unwrap();
+        let short = summary(&blob);
+        let full = render(&blob);
+        assert!(full.starts_with(&short), "{full}");
+        assert!(!short.contains("state  puckL"), "{short}");
+        assert!(
+            short.contains("histogram  [511, 0, 1, 0]")
+                && short.contains("  outies   [256, 0, 0, 0]")
+                && short.contains("  innies   [255, 0, 1, 0]"),
+            "{short}"
+        );
+        assert!(full.contains("  role   action  omega"), "{full}");
+        let rows: Vec<&str> = full.lines().filter(|l| l.starts_with("  256 ")).collect();
+        assert_eq!(rows.len(), 1, "{full}");
+        assert!(
+            rows[0].contains("innie") && rows[0].contains("-0.150"),
+            "{full}"
+        );
+        assert!(full
+            .lines()
+            .any(|l| l.starts_with("  255 ") && l.contains("outie")));
     }
 }

@@ -50,7 +50,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench(args),
         Command::Train(args) => train(args),
         Command::Experiment(args) => experiment(args),
-        Command::Policy(PolicyCommand::Inspect { file }) => inspect_policy(&file),
+        Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
         Command::Monitor(args) => monitor(args),
         Command::Replay(args) => replay(args),
         Command::Flash(args) => flash(args),
@@ -115,9 +115,13 @@ fn train(args: TrainArgs) -> Result<()> {
     Ok(())
 }
 
-fn inspect_policy(file: &Path) -> Result<()> {
+fn inspect_policy(file: &Path, summary: bool) -> Result<()> {
     let blob = sim::control::policy_file::read(file)?;
-    print!("{}", host::inspect::render(&blob));
+    if summary {
+        print!("{}", host::inspect::summary(&blob));
+    } else {
+        print!("{}", host::inspect::render(&blob));
+    }
     Ok(())
 }
 

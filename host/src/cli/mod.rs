@@ -78,10 +78,15 @@ pub enum FieldCommand {
 
 #[derive(Subcommand)]
 pub enum PolicyCommand {
-    /// Print a blob's header and its state -> action table.
+    /// Print a blob's header and its state -> action table (a column for
+    /// the role, for a hasher with the role bit).
     Inspect {
         /// The policy blob file.
         file: PathBuf,
+        /// Only the header: hasher, actions, provenance and how many states
+        /// choose each action (per role, for a hasher with the role bit).
+        #[arg(long)]
+        summary: bool,
     },
 }
 
