@@ -1,6 +1,8 @@
 """Fixtures: the repository, and the `host` binary the Python results are
-compared with (``ZUMO_SWARM_HOST``, else the workspace's debug build,
-built if missing)."""
+compared with (``ZUMO_SWARM_HOST``, as ``scripts/test`` sets it to the
+binary its ``cargo test`` built; else the workspace's debug build, brought
+up to date by ``cargo build -p host`` first, which after a ``cargo test``
+rebuilds it with other features and takes minutes)."""
 
 from __future__ import annotations
 
