@@ -140,6 +140,10 @@ impl PyBatch {
                 "num_worlds = {num_worlds}: must be a whole number of at least 1"
             )));
         }
+        // before any world is allocated
+        sim::base::ranges::WORLDS
+            .check_count("num_worlds", num_worlds as u64)
+            .map_err(|e| value_error(e.to_string()))?;
         let autoreset = match autoreset.as_str() {
             "off" => Autoreset::Off,
             "next-step" => Autoreset::NextStep,
@@ -152,7 +156,12 @@ impl PyBatch {
         };
         let threads = match threads {
             None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            Some(t) if t >= 1 => t as usize,
+            Some(t) if t >= 1 => {
+                sim::base::ranges::THREADS
+                    .check_count("threads", t as u64)
+                    .map_err(|e| value_error(e.to_string()))?;
+                t as usize
+            }
             Some(t) => {
                 return Err(value_error(format!(
                     "threads = {t}: must be a whole number of at least 1"

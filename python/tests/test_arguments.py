@@ -59,6 +59,9 @@ def test_bad_vector_env_arguments_are_named():
         zumo_swarm.vector_env(0)
     with pytest.raises(ValueError, match="threads = 0"):
         zumo_swarm.vector_env(2, threads=0)
+    # refused before a million worlds are allocated
+    with pytest.raises(ValueError, match=r"num_worlds = 1000000: outside its plausible range \[1, 4096\]"):
+        zumo_swarm.vector_env(10**6)
     with pytest.raises(ValueError, match="autoreset_mode = 'sometimes'"):
         zumo_swarm.vector_env(2, autoreset_mode="sometimes")
     env = zumo_swarm.vector_env(2, robots=2, pucks=5)
