@@ -309,13 +309,13 @@ impl EnvArgs {
                 .into())
             }
         };
-        if !(self.forward_speed.is_finite() && self.forward_speed >= 0.0) {
-            return Err(ArgumentError::new(
-                "forward_speed",
-                self.forward_speed,
-                "must be a finite number, not negative",
-            )
-            .into());
+        let forward = &sim::base::ranges::FORWARD_SPEED;
+        if let Err(e) = forward.check(f64::from(self.forward_speed)) {
+            // the f32 as written (its shortest decimal form), not widened
+            let written = self.forward_speed.to_string().parse().unwrap_or(e.value);
+            let value = sim::base::ranges::number(written);
+            let problem = format!("outside its plausible range {forward} ({})", forward.why);
+            return Err(ArgumentError::new("forward_speed", value, problem).into());
         }
         let actions = ActionTable::new(&self.actions, self.forward_speed).map_err(|e| {
             ArgumentError::new("actions", format!("{:?}", self.actions), e.to_string())

@@ -38,6 +38,7 @@ BAD_SETTINGS = [
     ({"actions": [0.3]}, ValueError, r"actions = \[0.3\]: action count 1 is out of range"),
     ({"actions": [0.1, float("nan")]}, ValueError, r"actions = .*not a finite number"),
     ({"forward_speed": -2.0}, ValueError, r"forward_speed = -2"),
+    ({"forward_speed": 1e30}, ValueError, r"forward_speed = 1e30: outside its plausible range \[0, 10\] units per step"),
     ({"render_mode": "human"}, ValueError, r"render_mode = 'human'"),
     ({"render_mode": "rgb_array", "render_size": 5}, ValueError, r"render_size = 5: must be a whole number of pixels"),
     ({"robots": "eight"}, TypeError, r"robots"),
