@@ -123,6 +123,8 @@ fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkp
             radius: 2.0,
             sees: sim::config::disc_sensors::ObstacleTargets::AnyBody,
         }),
+        // the border formats 1 to 3 knew
+        walls: Some(sim::config::Walls::Segments),
         ..small(11)
     };
     assert_eq!(
@@ -168,7 +170,7 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
     };
     for changed in [
         TrainConfig {
-            walls: Some(sim::config::Walls::Clamp),
+            walls: Some(sim::config::Walls::Segments),
             ..small(13)
         },
         TrainConfig {
@@ -422,10 +424,15 @@ fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_
     };
     let selecting = TrainConfig {
         select: Some(select),
+        // the border formats 1 to 3 knew
+        walls: Some(sim::config::Walls::Segments),
         ..small(21)
     };
     let mut with = trainer(selecting.clone());
-    let mut without = trainer(small(21));
+    let mut without = trainer(TrainConfig {
+        select: None,
+        ..selecting.clone()
+    });
     with.run(2400);
     without.run(2400);
     assert_eq!(

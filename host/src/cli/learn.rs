@@ -90,7 +90,7 @@ pub enum ExperimentAction {
 /// `host experiment NAME`'s options.
 #[derive(Clone, Debug, Args)]
 pub struct ExperimentRunArgs {
-    /// annulus, transfer, letters, letters-generated, state-bits, obstacle,
+    /// annulus, transfer, letters, letters-ablation, letters-generated, state-bits, obstacle,
     /// collisions (the files of experiments/, built in), or the path of a
     /// TOML file.
     #[arg(required = true)]

@@ -14,6 +14,9 @@ pub enum Value {
         ci: MeanCi,
         /// Trials that have the figure.
         n: usize,
+        /// Trials in all (a first formation is missing from a trial that
+        /// never formed).
+        of: usize,
     },
     /// A figure derived from means (steps per formation, ratios).
     Derived(f64),
@@ -22,15 +25,20 @@ pub enum Value {
 }
 
 impl Value {
-    /// As a table cell: `mean ± half-width`, or `–`.
+    /// As a table cell: `mean ± half-width`, or `–`; a mean over fewer
+    /// than all trials says over how many (`(9 of 10 trials)`).
     pub fn cell(self) -> String {
-        match self {
-            Value::Mean { ci, n } if n > 1 => {
+        let mean = match self {
+            Value::Mean { ci, n, .. } if n > 1 => {
                 format!("{} ± {}", number(ci.mean), number(ci.half_width))
             }
             Value::Mean { ci, .. } => number(ci.mean),
-            Value::Derived(v) if v.is_finite() => number(v),
-            _ => "–".into(),
+            Value::Derived(v) if v.is_finite() => return number(v),
+            _ => return "–".into(),
+        };
+        match self {
+            Value::Mean { n, of, .. } if n < of => format!("{mean} ({n} of {of} trials)"),
+            _ => mean,
         }
     }
 }
@@ -57,6 +65,7 @@ pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialRe
             Value::Mean {
                 ci: MeanCi::of(&values),
                 n: values.len(),
+                of: trials.len(),
             }
         }
     };
@@ -81,5 +90,21 @@ pub fn value(metric: Metric, trials: &[TrialResult], reference: Option<&[TrialRe
         }
         Metric::StatesVisited => mean_of(&|t| t.states_visited.map(|v| v as f64)),
         Metric::StepsPerSecond => mean_of(&|t| Some(t.steps_per_second)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_mean_over_fewer_than_all_trials_says_over_how_many() {
+        let ci = MeanCi::of(&[100.0, 200.0]);
+        assert_eq!(
+            Value::Mean { ci, n: 2, of: 3 }.cell(),
+            "150.0 ± 635.3 (2 of 3 trials)"
+        );
+        assert_eq!(Value::Mean { ci, n: 2, of: 2 }.cell(), "150.0 ± 635.3");
+        assert_eq!(Value::Missing.cell(), "–");
     }
 }

@@ -38,6 +38,7 @@ pub const DOCUMENTS: [Document; 2] = [
             "annulus",
             "transfer",
             "letters",
+            "letters-ablation",
             "letters-generated",
             "state-bits",
             "obstacle",

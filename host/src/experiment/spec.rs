@@ -16,13 +16,17 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 11] = [
+pub const BUILT_IN: [(&str, &str); 12] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
         include_str!("../../../experiments/transfer.toml"),
     ),
     ("letters", include_str!("../../../experiments/letters.toml")),
+    (
+        "letters-ablation",
+        include_str!("../../../experiments/letters-ablation.toml"),
+    ),
     (
         "letters-generated",
         include_str!("../../../experiments/letters-generated.toml"),
@@ -166,6 +170,10 @@ pub struct ArmSpec {
     pub policy: Option<PathBuf>,
     /// The thesis' values of this arm, by metric.
     pub thesis: BTreeMap<Metric, f64>,
+    /// Per-trial values of the thesis author's own program for this arm
+    /// (its published result files), by metric: the side-by-side that
+    /// `docs/reproduction.md` tests ours against.
+    pub author: BTreeMap<Metric, Vec<f64>>,
 }
 
 /// What a chart shows.
@@ -276,13 +284,15 @@ struct ArmKeys {
     policy: Option<PathBuf>,
     #[serde(default)]
     thesis: BTreeMap<Metric, f64>,
+    #[serde(default)]
+    author: BTreeMap<Metric, Vec<f64>>,
 }
 
 fn default_controller() -> ArmController {
     ArmController::Learn
 }
 
-const ARM_KEYS: [&str; 7] = [
+const ARM_KEYS: [&str; 8] = [
     "name",
     "row",
     "column",
@@ -290,6 +300,7 @@ const ARM_KEYS: [&str; 7] = [
     "pretrain",
     "policy",
     "thesis",
+    "author",
 ];
 
 impl ExperimentSpec {
@@ -460,6 +471,7 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
         pretrain: keys.pretrain,
         policy: keys.policy,
         thesis: keys.thesis,
+        author: keys.author,
     })
 }
 

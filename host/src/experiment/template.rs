@@ -27,7 +27,12 @@
 //!   file; for `A / B` A's formations ratio, or the ratio of the two arms'
 //!   figures), `over_thesis` (the mean over the thesis' figure), `verdict`
 //!   or `verdict X` (the thesis' figure, or X, against our trials: in our
-//!   95 % interval, within their range, or outside it);
+//!   95 % interval, within their range, or outside it), `author` (the mean
+//!   of the author's own trials, the arm's `author` values in the
+//!   experiment file), `over_author`, `author_p` (the two-sided p-value of
+//!   an exact permutation test of the difference of means, ours against
+//!   the author's trials), `p` (for `A / B`: the same test, A's trials
+//!   against B's);
 //! - a fifth part `OP X` checks the number: rendering fails when it does
 //!   not hold, since the prose around it says it does.
 //!
@@ -38,7 +43,7 @@ use super::outputs;
 use super::published::Published;
 use super::spec::ExperimentSpec;
 use super::trial::{TrialResult, BLOCK_STEPS};
-use crate::report::stats::{median, Line, MeanCi};
+use crate::report::stats::{median, permutation_p, Line, MeanCi};
 use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -331,6 +336,24 @@ fn thesis(spec: &ExperimentSpec, a: &str, b: Option<&str>, q: Quantity) -> Resul
     }
 }
 
+/// The per-trial values of the author's own program for `q` of arm `a`.
+fn author<'a>(spec: &'a ExperimentSpec, a: &str, q: Quantity) -> Result<&'a [f64]> {
+    let m = q
+        .metric()
+        .ok_or_else(|| anyhow!("the author's files give no such figure"))?;
+    let arm = spec
+        .arm(a)
+        .ok_or_else(|| anyhow!("{} has no arm {a:?}", spec.name))?;
+    match arm.author.get(&m) {
+        Some(values) if !values.is_empty() => Ok(values),
+        _ => bail!(
+            "{}: arm {a:?} has no author's trials for {}",
+            spec.name,
+            m.label()
+        ),
+    }
+}
+
 fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<Stat> {
     let spec = &source.spec;
     let q = Quantity::parse(quantity)?;
@@ -359,6 +382,11 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             },
         ));
     }
+    if stat == "author" {
+        let values = author(spec, a, q)?;
+        let mean = values.iter().sum::<f64>() / values.len() as f64;
+        return Ok(Stat::number(mean, prose(mean)));
+    }
     let trials = of_arm(a);
     if trials.is_empty() {
         return Ok(Stat::text(NOT_RUN));
@@ -379,6 +407,11 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
         let reference: Vec<f64> = of_arm(b).iter().filter_map(|r| q.of(r)).collect();
         if reference.is_empty() {
             return Ok(Stat::text(NOT_RUN));
+        }
+        if stat == "p" {
+            let p = permutation_p(&values, &reference)
+                .ok_or_else(|| anyhow!("too many trials for an exact permutation test"))?;
+            return Ok(Stat::number(p, show_p(p)));
         }
         let mean = reference.iter().sum::<f64>() / reference.len() as f64;
         values.iter_mut().for_each(|v| *v /= mean);
@@ -418,6 +451,20 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             let v = ci.mean / thesis(spec, a, b, q)?;
             Ok(Stat::number(v, format!("{v:.2}")))
         }
+        "over_author" | "author_p" if b.is_some() => {
+            bail!("{stat} compares one arm with the author's trials, not a ratio")
+        }
+        "over_author" => {
+            let theirs = author(spec, a, q)?;
+            let v = ci.mean / (theirs.iter().sum::<f64>() / theirs.len() as f64);
+            Ok(Stat::number(v, format!("{v:.2}")))
+        }
+        "p" => bail!("p compares two arms' trials: A / B"),
+        "author_p" => {
+            let p = permutation_p(&values, author(spec, a, q)?)
+                .ok_or_else(|| anyhow!("too many trials for an exact permutation test"))?;
+            Ok(Stat::number(p, show_p(p)))
+        }
         _ => {
             if let Some(cond) = stat.strip_prefix("count") {
                 let (op, x) = comparison(cond.trim())?;
@@ -433,8 +480,17 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
                 };
                 return Ok(Stat::text(&verdict(&values, figure)));
             }
-            bail!("unknown statistic {stat:?}: expected mean, median, min, max, ci, mean±ci, n, ratio, percent, times, over_thesis, count OP X, thesis or verdict")
+            bail!("unknown statistic {stat:?}: expected mean, median, min, max, ci, mean±ci, n, ratio, percent, times, over_thesis, count OP X, thesis, verdict, author, over_author, author_p or p")
         }
+    }
+}
+
+/// A p-value: three decimals, or "< 0.001".
+fn show_p(p: f64) -> String {
+    if p < 0.001 {
+        "< 0.001".into()
+    } else {
+        format!("{p:.3}")
     }
 }
 
@@ -546,7 +602,7 @@ mod tests {
 
     /// One experiment with two arms whose trials formed `a` and `b` shapes.
     fn sources(a: &[u64], b: &[u64]) -> Vec<Source> {
-        let text = "title = \"t\"\n[[arms]]\nname = \"A\"\nthesis = { formations = 10 }\n[[arms]]\nname = \"B\"\n";
+        let text = "title = \"t\"\n[[arms]]\nname = \"A\"\nthesis = { formations = 10 }\nauthor = { formations = [9, 10, 11] }\n[[arms]]\nname = \"B\"\n";
         let spec = ExperimentSpec::parse("x", text).unwrap();
         let trial = |arm: &str, i: usize, formations: u64| TrialResult {
             format: 2,
@@ -617,6 +673,23 @@ mod tests {
             NOT_RUN,
             "no trials: nothing to check"
         );
+    }
+
+    /// Of the 10 splits of {8, 12, 13, 4, 6} into 3 and 2, two have means
+    /// at least the observed 11 - 5 apart: the observed one and
+    /// {4, 6, 8} | {12, 13}.
+    #[test]
+    fn arms_are_tested_against_each_other_and_against_the_authors_trials() {
+        let s = sources(&[8, 12, 13], &[4, 6]);
+        let r = |t: &str| render(t, &s).unwrap();
+        assert_eq!(r("{{x | A / B | formations | p}}"), "0.200");
+        assert_eq!(r("{{x | A | formations | author}}"), "10");
+        assert_eq!(r("{{x | A | formations | over_author}}"), "1.10");
+        // {8, 12, 13} against {9, 10, 11}: 14 of the 20 splits are as far apart
+        assert_eq!(r("{{x | A | formations | author_p}}"), "0.700");
+        let e = |t: &str| format!("{:#}", render(t, &s).unwrap_err());
+        assert!(e("{{x | A | formations | p}}").contains("A / B"));
+        assert!(e("{{x | B | formations | author}}").contains("no author's trials"));
     }
 
     /// Trials of 1,000 steps with formations every 10 steps: 30 of them

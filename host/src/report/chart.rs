@@ -73,6 +73,16 @@ pub enum Spread {
     MinMax,
 }
 
+impl Spread {
+    /// The legend's entry for the shaded band.
+    pub fn legend(self) -> &'static str {
+        match self {
+            Spread::Ci95 => "shaded: 95 % interval of the mean",
+            Spread::MinMax => "shaded: the least to the greatest trial",
+        }
+    }
+}
+
 /// Mean over trials with a band (95 % confidence or min to max), one line
 /// per arm (like the thesis' Figure 15).
 pub fn mean_with_band(
@@ -128,6 +138,11 @@ pub fn mean_with_band(
                     PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                 });
         }
+        let grey = BLACK.mix(0.2);
+        chart
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+            .label(spread.legend())
+            .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], grey.filled()));
         legend(&mut chart)
     })
 }
@@ -225,8 +240,9 @@ fn frame<'a, 'b>(
     x_max: f64,
     y_max: f64,
 ) -> Result<Chart<'a, 'b>> {
+    let (width, _) = root.dim_in_pixel();
     let mut chart = ChartBuilder::on(root)
-        .caption(labels.title, (FONT, 24))
+        .caption(labels.title, (FONT, title_size(labels.title, width)))
         .margin(16)
         .x_label_area_size(48)
         .y_label_area_size(72)
@@ -237,6 +253,7 @@ fn frame<'a, 'b>(
         .y_desc(labels.y)
         .label_style((FONT, 14))
         .x_label_formatter(&|x| format_count(*x))
+        .y_label_formatter(&|y| format_axis(*y))
         .draw()?;
     Ok(chart)
 }
@@ -253,6 +270,22 @@ where
         .border_style(BLACK)
         .draw()?;
     Ok(())
+}
+
+/// The largest font size, up to 24 pixels, at which `title` fits in
+/// `width` pixels (DejaVu Sans' glyphs average under 0.6 of the size).
+fn title_size(title: &str, width: u32) -> f64 {
+    let chars = title.chars().count().max(1) as f64;
+    (f64::from(width) * 0.92 / (0.6 * chars)).clamp(10.0, 24.0)
+}
+
+/// A y axis number: whole numbers without decimals, others with two.
+fn format_axis(y: f64) -> String {
+    if (y - y.round()).abs() < 1e-9 {
+        format!("{y:.0}")
+    } else {
+        format!("{y:.2}")
+    }
 }
 
 fn format_count(x: f64) -> String {
@@ -293,6 +326,16 @@ fn render(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn axis_numbers_have_no_spurious_decimals_and_titles_fit_the_width() {
+        assert_eq!(format_axis(1000.0), "1000");
+        assert_eq!(format_axis(0.25), "0.25");
+        let long = "Transfer, the author's settings: formations over time by swarm size (cf. thesis Figure 16)";
+        let size = title_size(long, WIDTH);
+        assert!(size < 24.0 && long.chars().count() as f64 * 0.6 * size <= f64::from(WIDTH));
+        assert_eq!(title_size("Short", WIDTH), 24.0);
+    }
 
     #[test]
     fn charts_render_to_png_files() {

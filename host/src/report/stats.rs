@@ -100,6 +100,50 @@ impl Line {
     }
 }
 
+/// The most splits [`permutation_p`] enumerates.
+pub const MAX_PERMUTATIONS: u64 = 5_000_000;
+
+/// The two-sided p-value of an exact permutation test of the difference of
+/// the means of `a` and `b`: the share of all ways to split the pooled
+/// values into groups of their sizes whose difference of means is at least
+/// as far from zero as the observed one. `None` if a group is empty or
+/// there are more than [`MAX_PERMUTATIONS`] splits.
+pub fn permutation_p(a: &[f64], b: &[f64]) -> Option<f64> {
+    let (n, total) = (a.len(), a.len() + b.len());
+    if a.is_empty() || b.is_empty() || binomial(total as u64, n as u64)? > MAX_PERMUTATIONS {
+        return None;
+    }
+    let pooled: Vec<f64> = a.iter().chain(b).copied().collect();
+    let sum: f64 = pooled.iter().sum();
+    let difference = |sum_a: f64| sum_a / n as f64 - (sum - sum_a) / (total - n) as f64;
+    // a tolerance so that splits equal to the observed one count as equal
+    let observed = difference(a.iter().sum()).abs() * (1.0 - 1e-12);
+    let (mut extreme, mut splits) = (0u64, 0u64);
+    let mut visit = |sum_a: f64| {
+        splits += 1;
+        if difference(sum_a).abs() >= observed {
+            extreme += 1;
+        }
+    };
+    choose(&pooled, n, 0.0, &mut visit);
+    Some(extreme as f64 / splits as f64)
+}
+
+/// Calls `visit` with the sum of every choice of `k` of `values`.
+fn choose(values: &[f64], k: usize, sum: f64, visit: &mut impl FnMut(f64)) {
+    if k == 0 {
+        visit(sum);
+    } else if values.len() >= k {
+        choose(&values[1..], k - 1, sum + values[0], visit);
+        choose(&values[1..], k, sum, visit);
+    }
+}
+
+/// `n` choose `k`, if it fits in a u64.
+fn binomial(n: u64, k: u64) -> Option<u64> {
+    (0..k.min(n - k)).try_fold(1u64, |c, i| Some(c.checked_mul(n - i)? / (i + 1)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +172,20 @@ mod tests {
         let line = Line::fit(&pts).unwrap();
         assert!((line.slope - 3.0).abs() < 1e-12 && (line.intercept + 2.0).abs() < 1e-12);
         assert_eq!(Line::fit(&[(1.0, 1.0), (1.0, 2.0)]), None);
+    }
+    #[test]
+    fn a_permutation_test_counts_every_split_as_extreme_as_the_observed_one() {
+        // splits of {1, 2, 3, 4} into two pairs: differences of means
+        // +-2 ({1,2}|{3,4}), +-1 ({1,3}|{2,4}), 0 ({1,4}|{2,3}), each twice
+        assert_eq!(permutation_p(&[1.0, 2.0], &[3.0, 4.0]), Some(2.0 / 6.0));
+        assert_eq!(permutation_p(&[1.0, 3.0], &[2.0, 4.0]), Some(4.0 / 6.0));
+        assert_eq!(permutation_p(&[1.0, 4.0], &[2.0, 3.0]), Some(1.0));
+        // ten against ten far apart: only the two extreme splits of 184,756
+        let low: Vec<f64> = (0..10).map(f64::from).collect();
+        let high: Vec<f64> = (100..110).map(f64::from).collect();
+        let p = permutation_p(&low, &high).unwrap();
+        assert!((p - 2.0 / 184_756.0).abs() < 1e-15, "{p}");
+        assert_eq!(permutation_p(&[], &[1.0]), None);
+        assert_eq!(permutation_p(&[0.0; 20], &[0.0; 20]), None);
     }
 }

@@ -107,7 +107,8 @@ pub struct TrainConfig {
     pub distil_oc: Option<u64>,
     /// How the arena's border keeps the bodies in: clamp (put back inside,
     /// no contact: the thesis author's program) or segments (walls the
-    /// bodies bounce off) [default: segments].
+    /// bodies bounce off) [default: clamp in the thesis' square, segments
+    /// on a screen].
     #[arg(long)]
     pub walls: Option<Walls>,
     /// The learner's rules (docs/training.md, "Learner rules and the border").
@@ -229,9 +230,12 @@ impl TrainConfig {
     }
 
     /// How the run's border keeps the bodies in: `walls`, else the
-    /// arena's own (segments).
+    /// arena's own (the thesis' square clamps, a screen has its bezel).
     pub fn walls_in_effect(&self) -> Walls {
-        self.walls.unwrap_or_default()
+        self.walls.unwrap_or(match self.arena_choice() {
+            ArenaChoice::Thesis => Walls::Clamp,
+            ArenaChoice::Named(_) | ArenaChoice::File(_) => Walls::Segments,
+        })
     }
 
     /// The arena the run uses.

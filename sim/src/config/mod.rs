@@ -128,13 +128,14 @@ impl WorldConfig {
 pub enum Walls {
     /// Bodies that cross the border are put back inside it, with no contact
     /// and no impulse: the thesis author's program (its worlds of the
-    /// thesis' experiments have no wall bodies, only the world's bounds).
+    /// thesis' experiments have no wall bodies, only the world's bounds),
+    /// and so the thesis' square.
+    #[default]
     Clamp,
     /// Four wall segments of [`PhysicsConfig::wall_radius`]: a body that
     /// overlaps one is pushed out and bounces off it (an elastic contact,
     /// as the reference model's text describes walls), then is clamped: a
-    /// screen arena's bezel, and so far the thesis' square.
-    #[default]
+    /// screen arena's bezel.
     Segments,
 }
 
@@ -181,15 +182,15 @@ pub struct PhysicsConfig {
 }
 
 impl Default for PhysicsConfig {
-    /// The reference model: 0.4, 0.001, 0.1; wall segments of zero
-    /// thickness.
+    /// The reference model: 0.4, 0.001, 0.1; a clamping border (wall
+    /// segments, where chosen, of zero thickness).
     fn default() -> PhysicsConfig {
         PhysicsConfig {
             deceleration: 0.4,
             stop_speed: 0.001,
             overlap_threshold: 0.1,
             wall_radius: 0.0,
-            walls: Walls::Segments,
+            walls: Walls::Clamp,
         }
     }
 }
