@@ -72,3 +72,22 @@ fn the_summary_judges_first_formations_by_the_mean_it_shows_for_every_system() {
         assert!(row.contains(system), "no verdict for {system}: {row}");
     }
 }
+
+/// Rows 2 and 3 of the collisions table run the code's obstacle discs and
+/// test success on Eval: its column does not claim the text's settings
+/// without saying which it does not follow.
+#[test]
+fn the_collisions_table_says_where_its_text_column_follows_the_code() {
+    let table = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction/collisions/table.md"),
+    )
+    .unwrap();
+    assert!(!table.contains("| text: "), "a bare text column");
+    assert!(table.contains("| text*: Formations"), "{table}");
+    assert!(
+        table.contains("Text*: the text's settings but for")
+            && table.contains("radius r/4")
+            && table.contains("tested on Eval"),
+        "the caption explains the asterisk"
+    );
+}
