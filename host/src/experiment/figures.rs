@@ -28,17 +28,21 @@ impl Value {
     /// As a table cell: `mean ± half-width`, or `–`; a mean over fewer
     /// than all trials says over how many (`(9 of 10 trials)`).
     pub fn cell(self) -> String {
-        let mean = match self {
-            Value::Mean { ci, n, .. } if n > 1 => {
-                format!("{} ± {}", number(ci.mean), number(ci.half_width))
-            }
-            Value::Mean { ci, .. } => number(ci.mean),
-            Value::Derived(v) if v.is_finite() => return number(v),
-            _ => return "–".into(),
-        };
         match self {
-            Value::Mean { n, of, .. } if n < of => format!("{mean} ({n} of {of} trials)"),
-            _ => mean,
+            Value::Mean { ci, n, of } => {
+                let mean = if n > 1 {
+                    format!("{} ± {}", number(ci.mean), number(ci.half_width))
+                } else {
+                    number(ci.mean)
+                };
+                if n < of {
+                    format!("{mean} ({n} of {of} trials)")
+                } else {
+                    mean
+                }
+            }
+            Value::Derived(v) if v.is_finite() => number(v),
+            _ => "–".into(),
         }
     }
 }

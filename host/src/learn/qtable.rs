@@ -153,14 +153,8 @@ impl QTable {
     /// The Q-learning update Q(s,a) += alpha (r + gamma max_a' Q(s',a') - Q(s,a)).
     #[inline]
     pub fn update(&mut self, s: State, a: ActionId, reward: f64, next: State, params: QParams) {
-        let next_best = self
-            .row(next)
-            .iter()
-            .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        let i = s.index() * self.actions + a.index();
-        self.values[i] += params.alpha * (reward + params.gamma * next_best - self.values[i]);
-        self.visits[i] += 1;
+        let error = self.td_error(s, a, reward, next, params);
+        self.apply(s, a, error, params);
     }
 
     /// The TD error r + gamma max_a' Q(s',a') - Q(s,a), without updating.
