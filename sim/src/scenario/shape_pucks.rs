@@ -1,0 +1,50 @@
+//! How many pucks each shape gets on the TV (`tv75`): the most, up to the
+//! arena's 12, for which an arrangement with every puck's centre on the
+//! shape reaches the success Eval; never fewer than 6 (issue 31, item 1).
+//! Fixed here before any training, the same for orbital construction and
+//! every policy. `sim/tests/shape_pucks.rs` places each count (and one
+//! more) and checks it; `docs/policy-search.md` gives the table.
+
+use crate::fields::source::FieldSource;
+
+/// The shapes of the TV's report and their puck counts, in the report's
+/// order: the annulus, the thesis' T, L, V, X and Z (its images), our I.
+pub const TV_SHAPE_PUCKS: [(&str, usize); 7] = [
+    ("annulus", 12),
+    ("thesis:T", 12),
+    ("thesis:L", 12),
+    ("thesis:V", 12),
+    ("thesis:X", 12),
+    ("thesis:Z", 12),
+    ("letter:I", 11),
+];
+
+/// The puck count of `field` on the TV, if it is one of the report's
+/// shapes ([`TV_SHAPE_PUCKS`]).
+pub fn tv_pucks(field: &FieldSource) -> Option<usize> {
+    tv_shapes()
+        .find(|(shape, _)| shape == field)
+        .map(|(_, pucks)| pucks)
+}
+
+/// The report's shapes as field sources, with their counts.
+pub fn tv_shapes() -> impl Iterator<Item = (FieldSource, usize)> {
+    TV_SHAPE_PUCKS
+        .iter()
+        .filter_map(|&(name, pucks)| Some((name.parse().ok()?, pucks)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fields::letters::Letter;
+
+    #[test]
+    fn every_shape_of_the_report_has_its_count_and_others_none() {
+        assert_eq!(tv_shapes().count(), TV_SHAPE_PUCKS.len());
+        assert_eq!(tv_pucks(&FieldSource::Letter(Letter::I)), Some(11));
+        assert_eq!(tv_pucks(&FieldSource::Thesis(Letter::T)), Some(12));
+        assert_eq!(tv_pucks(&FieldSource::Letter(Letter::T)), None);
+        assert!(TV_SHAPE_PUCKS.iter().all(|&(_, n)| (6..=12).contains(&n)));
+    }
+}
