@@ -16,4 +16,5 @@ pub mod render;
 pub mod report;
 pub mod robot;
 pub mod run_summary;
+pub mod search;
 pub mod train;

@@ -5,7 +5,7 @@ mod cli;
 
 use anyhow::{Context, Result};
 use clap::Parser;
-use cli::learn::{ExperimentAction, ExperimentArgs, TrainArgs};
+use cli::learn::{ExperimentAction, ExperimentArgs, SearchArgs, TrainArgs};
 use cli::robot::{FlashArgs, MonitorArgs, ReplayArgs};
 use cli::screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
 use cli::simulate::{BenchArgs, RenderArgs, RunArgs};
@@ -49,6 +49,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Render(args) => render(args),
         Command::Bench(args) => bench(args),
         Command::Train(args) => train(args),
+        Command::Search(args) => search(args),
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
         Command::Monitor(args) => monitor(args),
@@ -111,6 +112,12 @@ fn bench(args: BenchArgs) -> Result<()> {
 
 fn train(args: TrainArgs) -> Result<()> {
     let report = host::train::train(&args.request())?;
+    println!("{report}");
+    Ok(())
+}
+
+fn search(args: SearchArgs) -> Result<()> {
+    let report = host::search::search(&args.request())?;
     println!("{report}");
     Ok(())
 }

@@ -3,6 +3,7 @@
 use clap::{Args, Subcommand};
 use host::experiment::shard::Shard;
 use host::experiment::RunOptions;
+use host::search::{SearchConfig, SearchRequest};
 use host::train::{TrainFlags, TrainRequest};
 use std::path::PathBuf;
 
@@ -37,6 +38,34 @@ impl TrainArgs {
             randomise: self.randomise,
             resume: self.resume,
             init_from: self.init_from,
+        }
+    }
+}
+
+/// `host search`'s options.
+#[derive(Clone, Debug, Args)]
+pub struct SearchArgs {
+    /// TOML file of a training config: the world searched in (docs/training.md);
+    /// flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The world's settings: every field of a training config (the learner's
+    /// hasher and actions, the field, sensors, arena, counts, noise, seed,
+    /// --out and --name).
+    #[command(flatten)]
+    pub flags: TrainFlags,
+    /// The search's settings.
+    #[command(flatten)]
+    pub search: SearchConfig,
+}
+
+impl SearchArgs {
+    /// The request these flags make.
+    pub fn request(self) -> SearchRequest {
+        SearchRequest {
+            config: self.config,
+            flags: self.flags,
+            search: self.search,
         }
     }
 }

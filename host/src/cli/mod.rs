@@ -9,7 +9,7 @@ pub mod screen;
 pub mod simulate;
 
 use clap::{Parser, Subcommand};
-use learn::{ExperimentArgs, TrainArgs};
+use learn::{ExperimentArgs, SearchArgs, TrainArgs};
 use robot::{FlashArgs, MonitorArgs, ReplayArgs};
 use screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
 use simulate::{BenchArgs, RenderArgs, RunArgs};
@@ -41,6 +41,11 @@ pub enum Command {
     /// coverage. With no arguments: annulus, 8 robots, 250 pucks, Original
     /// hasher, 2,000,000 steps, into out/.
     Train(TrainArgs),
+    /// Search the policy table directly (cross-entropy method, docs/policy-search.md):
+    /// candidates scored by their formations on common worlds, the result
+    /// kept only if it forms more on validation worlds; writes
+    /// <out>/<name>.policy and <out>/<name>.search.json.
+    Search(SearchArgs),
     /// Run one of the thesis' experiments (trials in parallel, resumable)
     /// and write CSV, JSON, a markdown table beside the thesis' numbers and
     /// PNG figures into --out.

@@ -1,0 +1,331 @@
+//! `host search`: the cross-entropy search over a run's table, with
+//! elitism on validation worlds, writing the result's policy blob and a
+//! JSON log of the generations (both atomically).
+//!
+//! Each generation: candidate 0 is the best table so far (the result),
+//! the rest are drawn from the distribution; all are scored on the
+//! generation's fitness worlds (the same seeds for every candidate); the
+//! distribution moves towards the `elites` best; the best candidate other
+//! than the result is scored on the validation worlds, and becomes the
+//! result only if it forms more there than the result did. So the result
+//! never forms fewer than the start table on the validation worlds.
+
+use super::cem::{random_table, Categorical};
+use super::config::{SearchConfig, Start, DEFAULT_DISTIL_STEPS};
+use super::fitness::{fitness_seeds, validation_seeds, Scorer};
+use crate::experiment::plan::mix;
+use crate::train::command::seed_table;
+use crate::train::config::field_label;
+use crate::train::distil::distil_orbital;
+use crate::train::{TrainConfig, TrainFlags};
+use anyhow::{Context, Result};
+use rand::SeedableRng;
+use serde::{Deserialize, Serialize};
+use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
+use sim::base::rng::SimRng;
+use sim::scenario::shape_pucks::tv_pucks;
+use std::path::PathBuf;
+
+/// Mixed into the seed for drawing candidates.
+const SAMPLE_STREAM: u64 = 0x5A3B_1E00_0000_0001;
+/// Mixed into the seed for the random start table.
+const RANDOM_START_STREAM: u64 = 0x4A4D_0000_0000_0001;
+
+/// What `host search` is asked to do.
+#[derive(Clone, Debug)]
+pub struct SearchRequest {
+    /// TOML file of a training config: the world searched in; the flags win.
+    pub config: Option<PathBuf>,
+    /// The world's settings given one by one.
+    pub flags: TrainFlags,
+    /// The search's settings.
+    pub search: SearchConfig,
+}
+
+/// One generation of the log.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Generation {
+    /// 0 for the first.
+    pub generation: u64,
+    /// Every candidate's formations on the fitness worlds (candidate 0:
+    /// the result so far).
+    pub fitness: Vec<u64>,
+    /// The fitness worlds' seeds.
+    pub fitness_seeds: Vec<u64>,
+    /// The challenger (the best candidate other than the result).
+    pub challenger: usize,
+    /// Its formations on the validation worlds.
+    pub challenger_validation: u64,
+    /// The result's formations on the validation worlds after this
+    /// generation.
+    pub result_validation: u64,
+    /// Whether the challenger became the result.
+    pub replaced: bool,
+    /// Mean entropy of the distribution after the update, bits per state.
+    pub entropy: f64,
+    /// Steps simulated so far (fitness and validation).
+    pub steps: u64,
+}
+
+/// The JSON log: the settings, the start, every generation, the result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SearchLog {
+    /// The world's settings.
+    pub world: TrainConfig,
+    /// The search's settings.
+    pub search: SearchConfig,
+    /// The validation worlds' seeds.
+    pub validation_seeds: Vec<u64>,
+    /// The start table's formations on them.
+    pub start_validation: u64,
+    /// Steps of orbital construction distilled for the start (not counted
+    /// in `steps`).
+    pub distil_steps: u64,
+    /// The generations.
+    pub generations: Vec<Generation>,
+    /// The result's formations on the validation worlds.
+    pub result_validation: u64,
+    /// Steps simulated (fitness and validation).
+    pub steps: u64,
+    /// The result's packed table ([`PolicyTable::packed`]).
+    pub result: Vec<u8>,
+}
+
+/// What a search did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SearchReport {
+    /// The log also written as JSON.
+    pub log: SearchLog,
+    /// The policy blob written.
+    pub policy: PathBuf,
+    /// The JSON log written.
+    pub log_file: PathBuf,
+}
+
+impl std::fmt::Display for SearchReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let l = &self.log;
+        writeln!(f, "generations          {}", l.generations.len())?;
+        writeln!(f, "steps simulated      {}", l.steps)?;
+        writeln!(
+            f,
+            "validation           start {}, result {} formations ({} worlds of {} steps)",
+            l.start_validation,
+            l.result_validation,
+            l.validation_seeds.len(),
+            l.search.validation_steps
+        )?;
+        writeln!(f, "policy               {}", self.policy.display())?;
+        write!(f, "log                  {}", self.log_file.display())
+    }
+}
+
+/// The world's settings: the file, then the flags; on a screen the shape's
+/// puck count ([`tv_pucks`]) unless `--pucks` is given.
+fn world(request: &SearchRequest) -> Result<TrainConfig> {
+    let mut config = match &request.config {
+        Some(path) => TrainConfig::from_file(path)?,
+        None => TrainConfig::default(),
+    };
+    request.flags.apply(&mut config)?;
+    if config.pucks.is_none() && config.arena_choice().screen().is_ok() {
+        config.pucks = tv_pucks(&config.field);
+    }
+    config.validate()?;
+    Ok(config)
+}
+
+/// The start table and the steps distilled for it.
+fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, u64)> {
+    let (hasher, actions) = (config.learn.hasher.0, config.learn.actions.len());
+    Ok(match start {
+        Start::Orbital => {
+            let steps = config.distil_oc.unwrap_or(DEFAULT_DISTIL_STEPS);
+            (distil_orbital(config, steps)?, steps)
+        }
+        Start::Random => {
+            let mut rng = SimRng::seed_from_u64(mix(config.seed ^ RANDOM_START_STREAM));
+            (random_table(hasher, actions, &mut rng), 0)
+        }
+        Start::File(path) => (seed_table(path, config)?.greedy_policy(), 0),
+    })
+}
+
+/// Runs `host search`.
+pub fn search(request: &SearchRequest) -> Result<SearchReport> {
+    let config = world(request)?;
+    let settings = &request.search;
+    let actions_count = config.learn.actions.len();
+    settings.validate(actions_count)?;
+    crate::atomic::check_writable(&config.output.dir)?;
+    let prepared = config.prepare()?;
+    let forward = prepared.config().world.forward_speed as f32;
+    let actions = ActionTable::new(&config.learn.actions, forward)
+        .context("the run's actions are not a valid action table")?;
+    let scorer = Scorer::new(prepared, actions.clone(), settings.threads)?;
+    let (start, distil_steps) = start_table(&config, &settings.start)?;
+    let log = run(&config, settings, &scorer, start, distil_steps)?;
+    let name = config.name();
+    let policy = config.output.dir.join(format!("{name}.policy"));
+    let log_file = config.output.dir.join(format!("{name}.search.json"));
+    let table = PolicyTable::from_packed(config.learn.hasher.0, &log.result)
+        .context("the result does not fit the run's hasher")?;
+    let provenance = Provenance::new(&field_label(&config.field), &name, log.steps, config.seed)?;
+    crate::policy_file::write(&policy, &PolicyBlob::new(actions, table, provenance)?)?;
+    let json = serde_json::to_vec_pretty(&log).context("cannot encode the search log")?;
+    crate::atomic::write(&log_file, &json)?;
+    Ok(SearchReport {
+        log,
+        policy,
+        log_file,
+    })
+}
+
+/// The search from `start`: every generation, then the log.
+pub fn run(
+    config: &TrainConfig,
+    settings: &SearchConfig,
+    scorer: &Scorer,
+    start: PolicyTable,
+    distil_steps: u64,
+) -> Result<SearchLog> {
+    let actions = config.learn.actions.len();
+    let validation = validation_seeds(config.seed, settings.validation_seeds);
+    let validation_cost = settings.validation_steps * validation.len() as u64;
+    let fitness_cost = settings.fitness_steps * settings.fitness_seeds as u64;
+    let start_validation = scorer.score(
+        std::slice::from_ref(&start),
+        &validation,
+        settings.validation_steps,
+    )?[0];
+    let mut steps = validation_cost;
+    let mut distribution = Categorical::around(&start, actions, settings.keep);
+    let (mut result, mut result_validation) = (start, start_validation);
+    let mut generations = Vec::new();
+    for g in 0..settings.generations {
+        let mut rng = SimRng::seed_from_u64(mix(mix(config.seed ^ SAMPLE_STREAM) ^ g));
+        let candidates: Vec<PolicyTable> = std::iter::once(result.clone())
+            .chain((1..settings.population).map(|_| distribution.sample(&mut rng)))
+            .collect();
+        let seeds = fitness_seeds(config.seed, g, settings.fitness_seeds);
+        let fitness = scorer.score(&candidates, &seeds, settings.fitness_steps)?;
+        steps += fitness_cost * candidates.len() as u64;
+        // best first; equal scores keep the candidates' order
+        let mut ranked: Vec<usize> = (0..candidates.len()).collect();
+        ranked.sort_by_key(|&i| std::cmp::Reverse(fitness[i]));
+        let elites: Vec<&PolicyTable> = ranked[..settings.elites]
+            .iter()
+            .map(|&i| &candidates[i])
+            .collect();
+        distribution.update(&elites, settings.rate, settings.floor);
+        let challenger = ranked.iter().copied().find(|&i| i != 0).unwrap_or(1);
+        let challenger_validation = scorer.score(
+            std::slice::from_ref(&candidates[challenger]),
+            &validation,
+            settings.validation_steps,
+        )?[0];
+        steps += validation_cost;
+        let replaced = challenger_validation > result_validation;
+        if replaced {
+            result = candidates[challenger].clone();
+            result_validation = challenger_validation;
+        }
+        generations.push(Generation {
+            generation: g,
+            fitness,
+            fitness_seeds: seeds,
+            challenger,
+            challenger_validation,
+            result_validation,
+            replaced,
+            entropy: distribution.mean_entropy(),
+            steps,
+        });
+    }
+    Ok(SearchLog {
+        world: config.clone(),
+        search: settings.clone(),
+        validation_seeds: validation,
+        start_validation,
+        distil_steps,
+        generations,
+        result_validation,
+        steps,
+        result: result.packed().to_vec(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small search on the TV with the robot's senses and noise.
+    fn small(threads: usize, start: Start) -> SearchLog {
+        let flags = TrainFlags::parse([
+            "--sensors",
+            "robot",
+            "--noise",
+            "1",
+            "--seed",
+            "3",
+            "--distil-oc",
+            "20000",
+        ])
+        .unwrap();
+        let request = SearchRequest {
+            config: None,
+            flags,
+            search: SearchConfig {
+                start,
+                generations: 3,
+                population: 4,
+                elites: 2,
+                fitness_seeds: 2,
+                fitness_steps: 8000,
+                validation_seeds: 2,
+                validation_steps: 8000,
+                keep: 0.8,
+                rate: 0.5,
+                floor: 0.01,
+                threads,
+            },
+        };
+        let config = world(&request).unwrap();
+        assert_eq!(config.pucks, Some(12), "the annulus' count on the TV");
+        let prepared = config.prepare().unwrap();
+        let forward = prepared.config().world.forward_speed as f32;
+        let actions = ActionTable::new(&config.learn.actions, forward).unwrap();
+        let scorer = Scorer::new(prepared, actions, threads).unwrap();
+        let (table, distilled) = start_table(&config, &request.search.start).unwrap();
+        run(&config, &request.search, &scorer, table, distilled).unwrap()
+    }
+
+    #[test]
+    fn a_search_gives_the_same_result_on_one_thread_and_on_two() {
+        let one = small(1, Start::Orbital);
+        let mut two = small(2, Start::Orbital);
+        assert_eq!(two.search.threads, 2);
+        two.search.threads = 1;
+        assert_eq!(one, two);
+        assert_eq!(one.generations.len(), 3);
+        assert!(one
+            .generations
+            .iter()
+            .any(|g| g.fitness.iter().any(|&f| f > 0)));
+    }
+
+    #[test]
+    fn the_result_never_forms_fewer_than_the_start_on_the_validation_worlds() {
+        for start in [Start::Orbital, Start::Random] {
+            let log = small(2, start);
+            assert!(log.result_validation >= log.start_validation);
+            let mut best = log.start_validation;
+            for g in &log.generations {
+                assert_eq!(g.replaced, g.challenger_validation > best);
+                best = best.max(g.challenger_validation);
+                assert_eq!(g.result_validation, best, "the best validated so far");
+            }
+            assert_eq!(log.result_validation, best);
+        }
+    }
+}

@@ -1,0 +1,143 @@
+//! The search's own settings (`host search`); the world it searches in is
+//! a training config's ([`crate::train::TrainConfig`]: field, sensors,
+//! arena, counts, noise, hasher, seed, output).
+
+use anyhow::{bail, Result};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// Where the search starts.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum Start {
+    /// Orbital construction distilled into a table on a world of the run's
+    /// settings (`oc`; the run's `--distil-oc` steps, else
+    /// [`DEFAULT_DISTIL_STEPS`]).
+    Orbital,
+    /// A table of uniformly random actions drawn from the run's seed
+    /// (`random`).
+    Random,
+    /// A policy blob's table or a checkpoint's greedy table (a path).
+    File(PathBuf),
+}
+
+/// Steps of orbital construction distilled for `--start oc` without
+/// `--distil-oc`.
+pub const DEFAULT_DISTIL_STEPS: u64 = 2_000_000;
+
+impl std::str::FromStr for Start {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Start, String> {
+        match s {
+            "oc" => Ok(Start::Orbital),
+            "random" => Ok(Start::Random),
+            "" => Err("empty start: expected oc, random or a policy or checkpoint file".into()),
+            path => Ok(Start::File(PathBuf::from(path))),
+        }
+    }
+}
+
+impl std::fmt::Display for Start {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Start::Orbital => f.write_str("oc"),
+            Start::Random => f.write_str("random"),
+            Start::File(p) => write!(f, "{}", p.display()),
+        }
+    }
+}
+
+sim::text_form!(Start);
+
+/// The cross-entropy search's settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
+pub struct SearchConfig {
+    /// The table the search starts from: oc (orbital construction
+    /// distilled), random, or a policy blob or checkpoint file.
+    #[arg(long, default_value = "oc")]
+    pub start: Start,
+    /// Generations.
+    #[arg(long, default_value_t = 20)]
+    pub generations: u64,
+    /// Candidates per generation, the best table so far among them.
+    #[arg(long, default_value_t = 16)]
+    pub population: usize,
+    /// Candidates whose actions the distribution moves towards.
+    #[arg(long, default_value_t = 4)]
+    pub elites: usize,
+    /// Worlds (seeds) each candidate is scored on per generation, the same
+    /// for every candidate of a generation.
+    #[arg(long, default_value_t = 2)]
+    pub fitness_seeds: usize,
+    /// Steps per fitness world.
+    #[arg(long, default_value_t = 50_000)]
+    pub fitness_steps: u64,
+    /// Validation worlds, disjoint from every fitness world: a generation's
+    /// best candidate replaces the result only if it forms more there.
+    #[arg(long, default_value_t = 4)]
+    pub validation_seeds: usize,
+    /// Steps per validation world.
+    #[arg(long, default_value_t = 50_000)]
+    pub validation_steps: u64,
+    /// Probability of the start table's action in every state at the start.
+    #[arg(long, default_value_t = 0.9)]
+    pub keep: f64,
+    /// Fraction by which each generation moves the distribution towards
+    /// the elites' actions.
+    #[arg(long, default_value_t = 0.5)]
+    pub rate: f64,
+    /// Least probability of any action in any state.
+    #[arg(long, default_value_t = 0.01)]
+    pub floor: f64,
+    /// Threads scoring candidates (0: one per core); the result is the same
+    /// for any number.
+    #[arg(long, default_value_t = 0)]
+    pub threads: usize,
+}
+
+impl SearchConfig {
+    /// Checks the settings; errors name the setting.
+    pub fn validate(&self, actions: usize) -> Result<()> {
+        let positive = [
+            ("generations", self.generations),
+            ("population", self.population as u64),
+            ("elites", self.elites as u64),
+            ("fitness-seeds", self.fitness_seeds as u64),
+            ("fitness-steps", self.fitness_steps),
+            ("validation-seeds", self.validation_seeds as u64),
+            ("validation-steps", self.validation_steps),
+        ];
+        for (name, value) in positive {
+            if value == 0 {
+                bail!("--{name} = 0: must be at least 1");
+            }
+        }
+        if self.population < 2 {
+            bail!(
+                "--population = {}: must be at least 2 (the best table so far and a new one)",
+                self.population
+            );
+        }
+        if self.elites > self.population {
+            bail!(
+                "--elites = {}: cannot exceed --population = {}",
+                self.elites,
+                self.population
+            );
+        }
+        for (name, value) in [("keep", self.keep), ("rate", self.rate)] {
+            if !(0.0..=1.0).contains(&value) {
+                bail!("--{name} = {value}: must be in [0, 1]");
+            }
+        }
+        let most = 1.0 / actions as f64;
+        if !(0.0..=most).contains(&self.floor) {
+            bail!(
+                "--floor = {}: must be in [0, {most}] with {actions} actions",
+                self.floor
+            );
+        }
+        Ok(())
+    }
+}
