@@ -196,6 +196,36 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
 }
 
 #[test]
+fn decaying_exploration_is_the_same_per_seed_and_resumes_exactly_from_a_format_5_checkpoint() {
+    let decaying = TrainConfig {
+        learn: host::learn::LearnConfig {
+            epsilon: 0.3,
+            ..Default::default()
+        },
+        epsilon_decay: Some(2000),
+        ..small(17)
+    };
+    // resumed mid-period (1,500) and across the end of the decay (2,000)
+    assert_eq!(resumes_exactly(decaying.clone(), 1500, 2600), 5);
+    let run = |config: TrainConfig| {
+        let mut t = trainer(config);
+        t.run(3000);
+        (t.learner().table().clone(), t.learner().exploration())
+    };
+    let (table, epsilon) = run(decaying.clone());
+    assert_eq!(epsilon, 0.0, "no exploration after the decay");
+    assert_eq!(run(decaying.clone()).0, table, "same seed, same table");
+    let constant = TrainConfig {
+        epsilon_decay: None,
+        ..decaying.clone()
+    };
+    assert_ne!(run(constant).0, table, "the decay changes the run");
+    assert_eq!(decaying.exploration_at(0), 0.3);
+    assert!((decaying.exploration_at(1999) - 0.3 * 0.5).abs() < 1e-12);
+    assert_eq!(decaying.exploration_at(5000), 0.0);
+}
+
+#[test]
 fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_byte() {
     // the published pre-trained tables of docs/reproduction were written by earlier builds
     let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");

@@ -11,6 +11,7 @@ use super::spec::{ArmController, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
 use crate::train::format2::TrainConfigV2;
 use crate::train::format3::TrainConfigV3;
+use crate::train::format4::TrainConfigV4;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
@@ -86,8 +87,8 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to the field's
 /// default counts as unset (the same run either way), and settings that use
-/// nothing newer than format 1, 2 or 3 are hashed in its layout
-/// ([`TrainConfigV1`], [`TrainConfigV2`], [`TrainConfigV3`]), so that trials
+/// nothing newer than format 1, 2, 3 or 4 are hashed in its layout
+/// ([`TrainConfigV1`] to [`TrainConfigV4`]), so that trials
 /// run before the newer settings existed keep their hashes. (Those formats'
 /// runs had wall segments: a run in the thesis' square that clamps at its
 /// border, the default since, is of the newest layout and hashes anew.) Settings with the robot's
@@ -100,6 +101,7 @@ enum Hashed {
     V1(TrainConfigV1),
     V2(TrainConfigV2),
     V3(TrainConfigV3),
+    V4(TrainConfigV4),
     Current(TrainConfig),
     /// Settings with the robot's senses, and the version of their model.
     RobotSenses {
@@ -121,6 +123,8 @@ fn hashed(config: &TrainConfig) -> Hashed {
         Hashed::V2(v2)
     } else if let Some(v3) = TrainConfigV3::of(&c) {
         Hashed::V3(v3)
+    } else if let Some(v4) = TrainConfigV4::of(&c) {
+        Hashed::V4(v4)
     } else {
         Hashed::Current(c)
     };

@@ -207,6 +207,12 @@ pub struct QLearner {
     /// Batched updates' TD errors of the step in flight.
     #[serde(skip)]
     errors: Vec<f64>,
+    /// The exploration probability of a decaying schedule, set by the
+    /// trainer from the run's step count ([`QLearner::set_exploration`]);
+    /// `None` for the config's `epsilon`. Derived, so not part of a
+    /// checkpoint.
+    #[serde(skip)]
+    exploration: Option<f64>,
 }
 
 impl QLearner {
@@ -221,6 +227,7 @@ impl QLearner {
             last_signal: 0.0,
             rules: LearnerRules::default(),
             errors: Vec::new(),
+            exploration: None,
         })
     }
 
@@ -248,6 +255,17 @@ impl QLearner {
         self
     }
 
+    /// Explores with probability `epsilon` instead of the config's (a
+    /// decaying schedule's value at the current step).
+    pub fn set_exploration(&mut self, epsilon: f64) {
+        self.exploration = Some(epsilon);
+    }
+
+    /// The exploration probability in effect.
+    pub fn exploration(&self) -> f64 {
+        self.exploration.unwrap_or(self.config.epsilon)
+    }
+
     /// The rules.
     pub fn rules(&self) -> LearnerRules {
         self.rules
@@ -273,6 +291,7 @@ impl QLearner {
 impl Controller for QLearner {
     fn decide(&mut self, perception: &Perception<'_>, turns: &mut [f32], rng: &mut SimRng) {
         let hasher = self.q.hasher();
+        let epsilon = self.exploration();
         self.chosen.clear();
         for ((reading, turn), robot) in perception
             .readings
@@ -281,9 +300,7 @@ impl Controller for QLearner {
             .zip(perception.robots)
         {
             let state = hasher.hash_as(reading, robot.kind.role());
-            let action = self
-                .q
-                .select(state, self.config.epsilon, self.rules.tie_tolerance, rng);
+            let action = self.q.select(state, epsilon, self.rules.tie_tolerance, rng);
             *turn = self.config.actions[action.index()];
             self.chosen.push((state, action));
         }

@@ -7,12 +7,13 @@
 //! generation's fitness worlds (the same seeds for every candidate); the
 //! distribution moves towards the `elites` best; the best candidate other
 //! than the result is scored on the validation worlds, and becomes the
-//! result only if it forms more there than the result did. So the result
-//! never forms fewer than the start table on the validation worlds.
+//! result only if it forms more there than the result did (or as many, at
+//! a higher mean Eval). So the result never forms fewer than the start
+//! table on the validation worlds. Scores: [`Score`].
 
 use super::cem::{random_table, Categorical};
 use super::config::{SearchConfig, Start, DEFAULT_DISTIL_STEPS};
-use super::fitness::{fitness_seeds, validation_seeds, Scorer};
+use super::fitness::{fitness_seeds, validation_seeds, Score, Scorer};
 use crate::experiment::plan::mix;
 use crate::train::command::seed_table;
 use crate::train::config::field_label;
@@ -47,18 +48,17 @@ pub struct SearchRequest {
 pub struct Generation {
     /// 0 for the first.
     pub generation: u64,
-    /// Every candidate's formations on the fitness worlds (candidate 0:
-    /// the result so far).
-    pub fitness: Vec<u64>,
+    /// Every candidate's score on the fitness worlds (candidate 0: the
+    /// result so far).
+    pub fitness: Vec<Score>,
     /// The fitness worlds' seeds.
     pub fitness_seeds: Vec<u64>,
     /// The challenger (the best candidate other than the result).
     pub challenger: usize,
-    /// Its formations on the validation worlds.
-    pub challenger_validation: u64,
-    /// The result's formations on the validation worlds after this
-    /// generation.
-    pub result_validation: u64,
+    /// Its score on the validation worlds.
+    pub challenger_validation: Score,
+    /// The result's score on the validation worlds after this generation.
+    pub result_validation: Score,
     /// Whether the challenger became the result.
     pub replaced: bool,
     /// Mean entropy of the distribution after the update, bits per state.
@@ -76,15 +76,15 @@ pub struct SearchLog {
     pub search: SearchConfig,
     /// The validation worlds' seeds.
     pub validation_seeds: Vec<u64>,
-    /// The start table's formations on them.
-    pub start_validation: u64,
+    /// The start table's score on them.
+    pub start_validation: Score,
     /// Steps of orbital construction distilled for the start (not counted
     /// in `steps`).
     pub distil_steps: u64,
     /// The generations.
     pub generations: Vec<Generation>,
-    /// The result's formations on the validation worlds.
-    pub result_validation: u64,
+    /// The result's score on the validation worlds.
+    pub result_validation: Score,
     /// Steps simulated (fitness and validation).
     pub steps: u64,
     /// The result's packed table ([`PolicyTable::packed`]).
@@ -109,9 +109,11 @@ impl std::fmt::Display for SearchReport {
         writeln!(f, "steps simulated      {}", l.steps)?;
         writeln!(
             f,
-            "validation           start {}, result {} formations ({} worlds of {} steps)",
-            l.start_validation,
-            l.result_validation,
+            "validation           start {} formations (mean Eval {:.4}), result {} ({:.4}) on {} worlds of {} steps",
+            l.start_validation.formations,
+            l.start_validation.eval,
+            l.result_validation.formations,
+            l.result_validation.eval,
             l.validation_seeds.len(),
             l.search.validation_steps
         )?;
@@ -212,7 +214,7 @@ pub fn run(
         steps += fitness_cost * candidates.len() as u64;
         // best first; equal scores keep the candidates' order
         let mut ranked: Vec<usize> = (0..candidates.len()).collect();
-        ranked.sort_by_key(|&i| std::cmp::Reverse(fitness[i]));
+        ranked.sort_by(|&a, &b| Score::best_first(&fitness[a], &fitness[b]));
         let elites: Vec<&PolicyTable> = ranked[..settings.elites]
             .iter()
             .map(|&i| &candidates[i])
@@ -225,7 +227,7 @@ pub fn run(
             settings.validation_steps,
         )?[0];
         steps += validation_cost;
-        let replaced = challenger_validation > result_validation;
+        let replaced = challenger_validation.beats(&result_validation);
         if replaced {
             result = candidates[challenger].clone();
             result_validation = challenger_validation;
@@ -311,18 +313,20 @@ mod tests {
         assert!(one
             .generations
             .iter()
-            .any(|g| g.fitness.iter().any(|&f| f > 0)));
+            .any(|g| g.fitness.iter().any(|f| f.formations > 0)));
     }
 
     #[test]
     fn the_result_never_forms_fewer_than_the_start_on_the_validation_worlds() {
         for start in [Start::Orbital, Start::Random] {
             let log = small(2, start);
-            assert!(log.result_validation >= log.start_validation);
+            assert!(log.result_validation.formations >= log.start_validation.formations);
             let mut best = log.start_validation;
             for g in &log.generations {
-                assert_eq!(g.replaced, g.challenger_validation > best);
-                best = best.max(g.challenger_validation);
+                assert_eq!(g.replaced, g.challenger_validation.beats(&best));
+                if g.replaced {
+                    best = g.challenger_validation;
+                }
                 assert_eq!(g.result_validation, best, "the best validated so far");
             }
             assert_eq!(log.result_validation, best);

@@ -1,5 +1,7 @@
 //! Scoring tables: the formations a greedy table makes driving fresh worlds
-//! of a run's settings, one world per seed, every candidate on the same
+//! of a run's settings, and their mean Eval at the formation checks (which
+//! orders tables that form equally many, as on a letter where few form
+//! any), one world per seed, every candidate on the same
 //! seeds (common random numbers), the (table, seed) pairs spread over a
 //! thread pool and gathered in order, so that the scores do not depend on
 //! the number of threads.
@@ -7,6 +9,7 @@
 use crate::experiment::plan::mix;
 use anyhow::{Context, Result};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
 use sim::control::greedy::GreedyPolicy;
 use sim::scenario::PreparedScenario;
@@ -32,6 +35,30 @@ pub fn validation_seeds(seed: u64, count: usize) -> Vec<u64> {
         .collect()
 }
 
+/// A table's score on a set of worlds: more formations is better, and of
+/// equal formations a higher mean Eval.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Score {
+    /// Formations, summed over the worlds.
+    pub formations: u64,
+    /// Mean Eval at the formation checks, averaged over the worlds.
+    pub eval: f64,
+}
+
+impl Score {
+    /// Whether this score is better than `other`.
+    pub fn beats(&self, other: &Score) -> bool {
+        (self.formations, self.eval) > (other.formations, other.eval)
+    }
+
+    /// Best first: by formations, then mean Eval.
+    pub fn best_first(a: &Score, b: &Score) -> std::cmp::Ordering {
+        (b.formations, b.eval)
+            .partial_cmp(&(a.formations, a.eval))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    }
+}
+
 /// Builds worlds of one run's settings and drives them with tables.
 pub struct Scorer {
     prepared: PreparedScenario,
@@ -54,25 +81,28 @@ impl Scorer {
         })
     }
 
-    /// Each table's formations summed over `seeds`, `steps` steps per
-    /// world; in the order of `tables`.
-    pub fn score(&self, tables: &[PolicyTable], seeds: &[u64], steps: u64) -> Result<Vec<u64>> {
+    /// Each table's score over `seeds`, `steps` steps per world; in the
+    /// order of `tables`.
+    pub fn score(&self, tables: &[PolicyTable], seeds: &[u64], steps: u64) -> Result<Vec<Score>> {
         let jobs: Vec<(usize, u64)> = (0..tables.len())
             .flat_map(|t| seeds.iter().map(move |&s| (t, s)))
             .collect();
-        let counts: Vec<u64> = self.pool.install(|| {
+        let worlds: Vec<Score> = self.pool.install(|| {
             jobs.par_iter()
-                .map(|&(t, seed)| self.formations(&tables[t], seed, steps))
-                .collect::<Result<Vec<u64>>>()
+                .map(|&(t, seed)| self.world(&tables[t], seed, steps))
+                .collect::<Result<Vec<Score>>>()
         })?;
-        Ok(counts
+        Ok(worlds
             .chunks(seeds.len().max(1))
-            .map(|c| c.iter().sum())
+            .map(|c| Score {
+                formations: c.iter().map(|s| s.formations).sum(),
+                eval: c.iter().map(|s| s.eval).sum::<f64>() / c.len() as f64,
+            })
             .collect())
     }
 
-    /// Formations of `table` in the world of `seed` after `steps` steps.
-    fn formations(&self, table: &PolicyTable, seed: u64, steps: u64) -> Result<u64> {
+    /// The score of `table` in the world of `seed` after `steps` steps.
+    fn world(&self, table: &PolicyTable, seed: u64, steps: u64) -> Result<Score> {
         let provenance = Provenance::new("search", "candidate", 0, seed)?;
         let blob = PolicyBlob::new(self.actions.clone(), table.clone(), provenance)?;
         let mut sim = self
@@ -80,7 +110,10 @@ impl Scorer {
             .simulation(seed)
             .context("cannot build a search world")?;
         sim.run(&mut GreedyPolicy::new(blob), steps);
-        Ok(sim.totals().formations)
+        Ok(Score {
+            formations: sim.totals().formations,
+            eval: sim.totals().mean_eval(),
+        })
     }
 }
 

@@ -25,6 +25,10 @@ use std::path::{Path, PathBuf};
 /// (see docs/training.md for the measurement).
 pub const DEFAULT_STEPS: u64 = 2_000_000;
 
+/// Steps over which a decaying exploration probability stays constant
+/// ([`TrainConfig::exploration_at`]).
+pub const DECAY_PERIOD: u64 = 1000;
+
 /// Steps between checkpoints by default.
 pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
 
@@ -114,6 +118,11 @@ pub struct TrainConfig {
     /// The learner's rules (docs/training.md, "Learner rules and the border").
     #[command(flatten)]
     pub rules: LearnerRules,
+    /// Decaying exploration: the exploration probability falls linearly
+    /// from --epsilon at step 0 to 0 at this step (in steps of
+    /// 1,000) and stays 0 [default: none, --epsilon throughout].
+    #[arg(long)]
+    pub epsilon_decay: Option<u64>,
 }
 
 /// When an episode's formation is checked (`[formation_check]`).
@@ -208,6 +217,7 @@ impl Default for TrainConfig {
             distil_oc: None,
             walls: None,
             rules: LearnerRules::default(),
+            epsilon_decay: None,
         }
     }
 }
@@ -299,6 +309,21 @@ impl TrainConfig {
             .unwrap_or_else(|| orbital_innies(&self.field, robots))
     }
 
+    /// The exploration probability at training step `step`: `--epsilon`,
+    /// or with [`TrainConfig::epsilon_decay`] its linear decay, evaluated
+    /// at the last multiple of [`DECAY_PERIOD`] (so that a run holds it
+    /// constant over whole periods, and a resumed run gets what the
+    /// straight run had).
+    pub fn exploration_at(&self, step: u64) -> f64 {
+        match self.epsilon_decay {
+            Some(end) => {
+                let at = step - step % DECAY_PERIOD;
+                self.learn.epsilon * (1.0 - at as f64 / end as f64).max(0.0)
+            }
+            None => self.learn.epsilon,
+        }
+    }
+
     /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
     pub fn name(&self) -> String {
         match &self.output.name {
@@ -342,6 +367,9 @@ impl TrainConfig {
         }
         if let Some(steps) = self.distil_oc {
             ranges::STEPS.check_count("distil_oc", steps)?;
+        }
+        if let Some(steps) = self.epsilon_decay {
+            ranges::STEPS.check_count("epsilon_decay", steps)?;
         }
         ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {

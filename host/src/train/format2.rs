@@ -65,6 +65,7 @@ impl TrainConfigV2 {
         let plain = c.arena_choice() == ArenaChoice::Thesis
             && c.walls_in_effect() == Walls::Segments
             && c.rules == LearnerRules::default()
+            && c.epsilon_decay.is_none()
             && c.noise == 0.0
             && c.select.is_none()
             && c.distil_oc.is_none();
@@ -110,6 +111,7 @@ impl From<TrainConfigV2> for TrainConfig {
             distil_oc: None,
             walls: None,
             rules: LearnerRules::default(),
+            epsilon_decay: None,
         };
         // format 2's runs had wall segments
         if config.walls_in_effect() != Walls::Segments {

@@ -65,7 +65,9 @@ impl TrainConfigV3 {
     /// The settings in format 3, if the run's border is wall segments and
     /// its learner keeps the default rules.
     pub fn of(c: &TrainConfig) -> Option<TrainConfigV3> {
-        let plain = c.walls_in_effect() == Walls::Segments && c.rules == LearnerRules::default();
+        let plain = c.walls_in_effect() == Walls::Segments
+            && c.rules == LearnerRules::default()
+            && c.epsilon_decay.is_none();
         plain.then(|| TrainConfigV3 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),
@@ -112,6 +114,7 @@ impl From<TrainConfigV3> for TrainConfig {
             distil_oc: c.distil_oc,
             walls: None,
             rules: LearnerRules::default(),
+            epsilon_decay: None,
         };
         if config.walls_in_effect() != Walls::Segments {
             config.walls = Some(Walls::Segments);

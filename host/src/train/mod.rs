@@ -10,6 +10,7 @@ pub mod distil;
 pub mod format1;
 pub mod format2;
 pub mod format3;
+pub mod format4;
 pub mod selection;
 pub mod trainer;
 

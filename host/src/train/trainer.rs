@@ -1,7 +1,7 @@
 //! A training run: a [`Simulation`] driven by a [`QLearner`], with any
 //! sensor model, and its complete state for checkpoints.
 
-use super::config::{field_label, TrainConfig};
+use super::config::{field_label, TrainConfig, DECAY_PERIOD};
 use super::distil::distil_orbital;
 use super::selection::{Evaluation, Selected};
 use crate::learn::{QLearner, QTable};
@@ -138,8 +138,18 @@ impl<S: SensorModel> Trainer<S> {
         Ok(trainer)
     }
 
+    /// With decaying exploration: sets the learner's exploration for the
+    /// current step.
+    fn explore_as_scheduled(&mut self) {
+        if self.config.epsilon_decay.is_some() {
+            let epsilon = self.config.exploration_at(self.totals().steps);
+            self.learner.set_exploration(epsilon);
+        }
+    }
+
     /// One step of simulation and learning (and an evaluation when due).
     pub fn step(&mut self) -> Option<EpisodeEnd> {
+        self.explore_as_scheduled();
         let end = self.sim.step(&mut self.learner);
         self.evaluate_if_due();
         end
@@ -148,10 +158,15 @@ impl<S: SensorModel> Trainer<S> {
     /// Runs `steps` steps.
     pub fn run(&mut self, mut steps: u64) {
         while steps > 0 {
-            let chunk = match &self.evaluation {
-                Some(e) => e.steps_to_next(self.totals().steps).min(steps),
+            let step = self.totals().steps;
+            let mut chunk = match &self.evaluation {
+                Some(e) => e.steps_to_next(step).min(steps),
                 None => steps,
             };
+            if self.config.epsilon_decay.is_some() {
+                chunk = chunk.min(DECAY_PERIOD - step % DECAY_PERIOD);
+            }
+            self.explore_as_scheduled();
             self.sim.run(&mut self.learner, chunk);
             self.evaluate_if_due();
             steps -= chunk;
