@@ -134,3 +134,15 @@ fn every_shape_of_the_report_is_checked_above() {
         ["annulus", "thesis:T", "thesis:L", "thesis:V", "thesis:X", "thesis:Z", "letter:I"]
     );
 }
+
+#[test]
+fn the_policy_search_page_gives_every_count() {
+    let page = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/policy-search.md"),
+    )
+    .unwrap();
+    for (field, pucks) in tv_shapes() {
+        let row = format!("| {field} | {pucks} |");
+        assert!(page.contains(&row), "docs/policy-search.md lacks {row}");
+    }
+}

@@ -1,0 +1,130 @@
+#!/usr/bin/env python3
+"""Publishes issue 31's measurements (scripts/policy-search): reads the
+report runs (OUT/evaluate.jsonl) and the searches' logs (OUT/*.search.json),
+writes RESULTS (JSON) and renders the tables of DOC between its
+`<!-- results:begin -->` and `<!-- results:end -->` lines from RESULTS.
+
+    policy-search-publish.py OUT RESULTS DOC     publish and render
+    policy-search-publish.py --check RESULTS DOC fail if DOC's tables are not RESULTS'
+"""
+import glob
+import json
+import os
+import sys
+
+BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
+# how the report names each controller
+NAMES = {
+    "oc": "orbital construction",
+    "-oc.policy": "search from distilled OC",
+    "annulus-random.policy": "search from random",
+    "annulus-from-q.policy": "search from Q-learning's table",
+    "annulus-q.policy": "Q-learning (distilled start, selection)",
+    "annulus-q-decay.policy": "Q-learning, decaying exploration",
+    "annulus-q-optimistic.policy": "Q-learning, optimistic start (Q 5)",
+}
+
+
+def name_of(controller):
+    if controller == "oc":
+        return NAMES["oc"]
+    base = os.path.basename(controller)
+    return NAMES.get(base) or NAMES["-oc.policy"]
+
+
+def publish(out, results_path):
+    runs = [json.loads(l) for l in open(os.path.join(out, "evaluate.jsonl")) if l.strip()]
+    shapes = {}
+    for r in runs:
+        shape = shapes.setdefault(r["field"], {})
+        c = shape.setdefault(name_of(r["controller"]), {"policy": r["controller"], "seeds": [], "formations": []})
+        c["seeds"].append(r["seed"])
+        c["formations"].append(r["formations"])
+        c["steps_per_seed"] = r["steps"]
+    for shape in shapes.values():
+        for c in shape.values():
+            c["per_million"] = round(sum(c["formations"]) * 1e6 / (c["steps_per_seed"] * len(c["formations"])), 1)
+    searches = []
+    for path in sorted(glob.glob(os.path.join(out, "*.search.json"))):
+        log = json.load(open(path))
+
+        def f(s):
+            return s["formations"] if isinstance(s, dict) else s
+
+        searches.append({
+            "name": os.path.basename(path)[: -len(".search.json")],
+            "field": log["world"]["field"],
+            "hasher": log["world"]["learn"]["hasher"],
+            "start": log["search"]["start"],
+            "generations": len(log["generations"]),
+            "steps": log["steps"],
+            "validation_worlds": len(log["validation_seeds"]),
+            "validation_steps": log["search"]["validation_steps"],
+            "start_validation": f(log["start_validation"]),
+            "result_validation": f(log["result_validation"]),
+        })
+    results = {"command": "scripts/policy-search", "shapes": shapes, "searches": searches}
+    with open(results_path + ".tmp", "w") as fh:
+        json.dump(results, fh, indent=1, sort_keys=True)
+        fh.write("\n")
+    os.replace(results_path + ".tmp", results_path)
+
+
+def tables(results):
+    lines = ["| shape | controller | formations per million steps | / OC |", "|---|---|---:|---:|"]
+    for field, shape in results["shapes"].items():
+        oc = shape.get(NAMES["oc"], {}).get("per_million")
+        for name, c in sorted(shape.items(), key=lambda kv: (kv[0] != NAMES["oc"], kv[0])):
+            ratio = f"{c['per_million'] / oc:.2f}" if oc else "-"
+            lines.append(f"| {field} | {name} | {c['per_million']:,.1f} | {ratio} |")
+    lines += ["", "| target | figure | measured | met |", "|---|---|---:|---|"]
+    annulus = results["shapes"].get("annulus", {})
+    oc = annulus.get(NAMES["oc"], {}).get("per_million")
+    learned = [(n, c["per_million"]) for n, c in annulus.items() if n != NAMES["oc"]]
+    if oc and learned:
+        n, best = max(learned, key=lambda nc: nc[1])
+        lines.append(f"| annulus: a learned policy >= 1.15x OC | best ({n}) / OC | {best / oc:.3f} | {'yes' if best >= 1.15 * oc else 'no'} |")
+    for field, shape in results["shapes"].items():
+        if field == "annulus":
+            continue
+        oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
+        found = shape.get(NAMES["-oc.policy"], {}).get("per_million")
+        if found is None:
+            continue
+        need = 50.0
+        if oc >= 20:
+            need = max(need, oc)
+        if field == "thesis:L":
+            need = max(need, 1.5 * oc)
+        lines.append(f"| {field}: >= {need:,.1f} per million | search / million steps | {found:,.1f} | {'yes' if found >= need else 'no'} |")
+    lines += ["", "| search | field | hasher | start | generations | steps | validation: start | validation: result | result / start |",
+              "|---|---|---|---|---:|---:|---:|---:|---:|"]
+    for s in results["searches"]:
+        ratio = f"{s['result_validation'] / s['start_validation']:.2f}" if s["start_validation"] else "-"
+        lines.append(
+            f"| {s['name']} | {s['field']} | {s['hasher']} | {s['start']} | {s['generations']} | {s['steps']:,} "
+            f"| {s['start_validation']} | {s['result_validation']} | {ratio} |")
+    return "\n".join(lines)
+
+
+def render(results_path, doc_path, check):
+    results = json.load(open(results_path))
+    doc = open(doc_path).read()
+    head, rest = doc.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    new = head + BEGIN + "\n" + tables(results) + "\n" + END + tail
+    if check:
+        if new != doc:
+            sys.exit(f"{doc_path}: its tables are not what {results_path} gives; run scripts/policy-search publish")
+        return
+    with open(doc_path + ".tmp", "w") as fh:
+        fh.write(new)
+    os.replace(doc_path + ".tmp", doc_path)
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "--check":
+        render(sys.argv[2], sys.argv[3], True)
+    else:
+        publish(sys.argv[1], sys.argv[2])
+        render(sys.argv[2], sys.argv[3], False)
