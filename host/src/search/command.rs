@@ -164,7 +164,7 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
     let forward = prepared.config().world.forward_speed as f32;
     let actions = ActionTable::new(&config.learn.actions, forward)
         .context("the run's actions are not a valid action table")?;
-    let scorer = Scorer::new(prepared, actions.clone(), settings.threads)?;
+    let scorer = Scorer::new(prepared, actions, settings.threads)?;
     let (start, distil_steps) = start_table(&config, &settings.start)?;
     let log = run(&config, settings, &scorer, start, distil_steps)?;
     let name = config.name();

@@ -104,7 +104,7 @@ impl Scorer {
     /// The score of `table` in the world of `seed` after `steps` steps.
     fn world(&self, table: &PolicyTable, seed: u64, steps: u64) -> Result<Score> {
         let provenance = Provenance::new("search", "candidate", 0, seed)?;
-        let blob = PolicyBlob::new(self.actions.clone(), table.clone(), provenance)?;
+        let blob = PolicyBlob::new(self.actions, table.clone(), provenance)?;
         let mut sim = self
             .prepared
             .simulation(seed)
