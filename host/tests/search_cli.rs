@@ -1,0 +1,94 @@
+//! `host search` end to end: a tiny search writes its blob and log, and bad
+//! inputs are refused with an error naming them.
+
+use assert_cmd::Command;
+
+fn host() -> Command {
+    Command::cargo_bin("host").unwrap()
+}
+
+#[test]
+fn a_small_search_writes_a_policy_that_host_run_drives_and_a_json_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = host()
+        .current_dir(dir.path())
+        .args([
+            "search",
+            "--sensors",
+            "robot",
+            "--noise",
+            "1",
+            "--start",
+            "random",
+            "--generations",
+            "1",
+            "--population",
+            "2",
+            "--elites",
+            "1",
+            "--fitness-seeds",
+            "1",
+            "--fitness-steps",
+            "500",
+            "--validation-seeds",
+            "1",
+            "--validation-steps",
+            "500",
+            "--out",
+            "s",
+            "--name",
+            "tiny",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("s/tiny.search.json")).unwrap())
+            .unwrap();
+    assert_eq!(log["generations"].as_array().unwrap().len(), 1);
+    assert_eq!(log["world"]["pucks"], 12, "the annulus' count on the TV");
+    let run = host()
+        .current_dir(dir.path())
+        .args([
+            "run",
+            "--sensors",
+            "robot",
+            "--steps",
+            "200",
+            "--controller",
+            "policy:s/tiny.policy",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+#[test]
+fn bad_search_settings_are_refused_naming_them() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, says) in [
+        (vec!["--population", "1"], "--population = 1"),
+        (vec!["--elites", "20"], "--elites = 20"),
+        (vec!["--floor", "0.5"], "--floor = 0.5"),
+        (vec!["--start", "missing.policy"], "missing.policy"),
+    ] {
+        let out = host()
+            .current_dir(dir.path())
+            .arg("search")
+            .args(&args)
+            .args(["--out", "s"])
+            .output()
+            .unwrap();
+        assert!(!out.status.success(), "{args:?} succeeded");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains(says), "{args:?}: {e}");
+    }
+}
