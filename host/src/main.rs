@@ -83,6 +83,7 @@ fn render(args: RenderArgs) -> Result<()> {
     let options = RenderOptions {
         size: args.size,
         footprints: args.footprints,
+        band: args.band,
     };
     if let Some(path) = &args.gif {
         host::render::animate(
@@ -181,7 +182,7 @@ fn flash(args: FlashArgs) -> Result<()> {
 
 fn export_field(args: FieldExportArgs) -> Result<()> {
     let arena = args.screen.arena.screen()?;
-    let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
+    let (w, h) = host::panel_file::export(&arena, &args.screen.field, args.band, &args.out)?;
     println!(
         "wrote {} ({w} x {h}: {} on {})",
         args.out.display(),

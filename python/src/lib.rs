@@ -407,14 +407,16 @@ impl PyBatch {
     }
 
     /// World `world` drawn as `host render` draws it: an RGB array of
-    /// `size` x `size` pixels (field grey, pucks red, robots blue).
-    #[pyo3(signature = (world = 0, size = 800, footprints = false))]
+    /// `size` x `size` pixels (field grey, pucks red, robots blue; with
+    /// `band` the target band outlined in cyan).
+    #[pyo3(signature = (world = 0, size = 800, footprints = false, band = false))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         world: usize,
         size: u32,
         footprints: bool,
+        band: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let world = self.world_index(world)?;
         if !(16..=4096).contains(&size) {
@@ -424,7 +426,11 @@ impl PyBatch {
         }
         let image = sim::render::draw(
             self.batch.worlds()[world].sim(),
-            RenderOptions { size, footprints },
+            RenderOptions {
+                size,
+                footprints,
+                band,
+            },
         );
         let (w, h) = (image.width() as usize, image.height() as usize);
         Ok(PyArray1::from_vec(py, image.into_raw())

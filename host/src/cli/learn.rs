@@ -98,7 +98,8 @@ pub struct ExperimentRunArgs {
     /// Trials per arm.
     #[arg(long, default_value_t = 10)]
     pub trials: usize,
-    /// Fraction of the thesis' step counts, for quick runs (e.g. 0.001).
+    /// Fraction of the thesis' step counts, for quick runs (0.05: about a
+    /// minute for the annulus, long enough for its arms to form shapes).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
     /// Output directory [default: out/experiments/<name>, with --shard
