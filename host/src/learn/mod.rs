@@ -6,4 +6,4 @@ pub mod learner;
 pub mod qtable;
 
 pub use learner::{LearnConfig, LearnerRules, QLearner, StateHasherName, Updates};
-pub use qtable::{QParams, QTable};
+pub use qtable::{QParams, QTable, TableSummary};

@@ -16,6 +16,26 @@ pub struct QTable {
     visits: Vec<u64>,
 }
 
+/// A learned table at a glance: what the robots did and what the table
+/// learned, the figures a side-by-side with the thesis author's program
+/// compares (`docs/reproduction.md`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableSummary {
+    /// Each action's share of all updates (of the actions taken), by id.
+    pub action_shares: Vec<f64>,
+    /// The values of every action of the visited states at
+    /// [`TableSummary::PERCENTILES`] (the sorted value at index `floor(p (n
+    /// - 1))`); none before the first update.
+    pub value_percentiles: Option<[f64; 7]>,
+    /// Visited states whose greatest value two or more actions share.
+    pub tied_states: usize,
+}
+
+impl TableSummary {
+    /// Minimum, 10th, 25th, 50th, 75th, 90th percentile, maximum.
+    pub const PERCENTILES: [f64; 7] = [0.0, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0];
+}
+
 /// How much a policy's action is preferred in [`QTable::from_policy`]:
 /// enough to win every greedy choice until learning says otherwise.
 pub const POLICY_PREFERENCE: f64 = 1.0;
@@ -84,6 +104,49 @@ impl QTable {
             .chunks(self.actions)
             .filter(|row| row.iter().any(|&v| v > 0))
             .count()
+    }
+
+    /// The table at a glance ([`TableSummary`]).
+    pub fn summary(&self) -> TableSummary {
+        let total: u64 = self.visits.iter().sum();
+        let mut taken = vec![0u64; self.actions];
+        for row in self.visits.chunks(self.actions) {
+            for (sum, &v) in taken.iter_mut().zip(row) {
+                *sum += v;
+            }
+        }
+        let visited = || {
+            self.values
+                .chunks(self.actions)
+                .zip(self.visits.chunks(self.actions))
+                .filter(|(_, visits)| visits.iter().any(|&v| v > 0))
+                .map(|(values, _)| values)
+        };
+        let mut values: Vec<f64> = visited().flatten().copied().collect();
+        values.sort_by(f64::total_cmp);
+        let tied_states = visited()
+            .filter(|row| {
+                let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                row.iter().filter(|&&v| v == best).count() > 1
+            })
+            .count();
+        TableSummary {
+            action_shares: taken
+                .iter()
+                .map(|&n| {
+                    if total > 0 {
+                        n as f64 / total as f64
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            value_percentiles: (!values.is_empty()).then(|| {
+                TableSummary::PERCENTILES
+                    .map(|p| values[(p * (values.len() - 1) as f64).floor() as usize])
+            }),
+            tied_states,
+        }
     }
 
     /// An action with the greatest value; among equal maxima, one chosen
@@ -270,6 +333,32 @@ mod tests {
         assert!((q.value(State(9), ActionId(0)) - 0.7944).abs() < 1e-12);
         assert_eq!(q.visits(State(5), ActionId(1)), 1);
         assert_eq!(q.states_visited(), 2);
+    }
+
+    #[test]
+    fn the_summary_counts_actions_taken_and_the_values_and_ties_of_visited_states() {
+        let mut q = QTable::new(StateHasher::Original, 4, 1.0);
+        assert_eq!(q.summary().value_percentiles, None);
+        let p = QParams {
+            alpha: 0.5,
+            gamma: 0.0,
+        };
+        // state 5: action 1 once, action 2 three times; state 9: action 0 once.
+        q.update(State(5), ActionId(1), 3.0, State(0), p); // Q(5,1) = 2
+        for _ in 0..3 {
+            q.update(State(5), ActionId(2), 1.0, State(0), p); // Q(5,2) stays 1
+        }
+        q.update(State(9), ActionId(0), -1.0, State(0), p); // Q(9,0) = 0
+        let summary = q.summary();
+        assert_eq!(summary.action_shares, vec![0.2, 0.2, 0.6, 0.0]);
+        // state 9's actions 1 to 3 keep 1.0, its best, three times: a tie;
+        // state 5's best (2.0) is alone.
+        assert_eq!(summary.tied_states, 1);
+        // the 8 values of states 5 and 9, sorted: 0, 1 x 6, 2
+        assert_eq!(
+            summary.value_percentiles,
+            Some([0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 2.0])
+        );
     }
 
     #[test]
