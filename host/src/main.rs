@@ -62,6 +62,7 @@ fn run(cli: Cli) -> Result<()> {
 
 fn simulate(args: RunArgs) -> Result<()> {
     ranges::RUN_STEPS.check_count("host run --steps", args.steps)?;
+    warn_policy_mismatch(&args.scenario)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let summary = run_timed(&mut sim, &mut controller, args.steps);
     if args.json {
@@ -79,6 +80,7 @@ fn render(args: RenderArgs) -> Result<()> {
     ranges::RUN_STEPS.check_count("host render --steps", args.steps)?;
     ranges::FRAME_EVERY.check_count("host render --every", args.every)?;
     ranges::RENDER_SIZE.check_count("--size", u64::from(args.size))?;
+    warn_policy_mismatch(&args.scenario)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let options = RenderOptions {
         size: args.size,
@@ -99,6 +101,15 @@ fn render(args: RenderArgs) -> Result<()> {
             sim.run(&mut controller, args.steps);
         }
         host::render::write_png(&sim, options, path)?;
+    }
+    Ok(())
+}
+
+/// Warns on stderr when `--controller policy:FILE` was trained for another
+/// sensor model or arena than the run's.
+fn warn_policy_mismatch(scenario: &cli::scenario::ScenarioArgs) -> Result<()> {
+    if let Some(warning) = scenario.policy_mismatch()? {
+        eprintln!("warning: {warning}");
     }
     Ok(())
 }
@@ -156,6 +167,9 @@ fn replay(args: ReplayArgs) -> Result<()> {
 
 fn flash(args: FlashArgs) -> Result<()> {
     use host::robot::flash;
+    if let Some(warning) = flash::check_trained_for(&args.policy, args.any_sensors)? {
+        eprintln!("warning: {warning}");
+    }
     let cwd = std::env::current_dir().context("cannot read the current directory")?;
     let plan = flash::FlashPlan::new(
         &args.policy,

@@ -245,6 +245,12 @@ impl TrainConfig {
             .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
     }
 
+    /// The sensor model and arena the run trains for, as its policy blob
+    /// records them.
+    pub fn trained_for(&self) -> shared::TrainedFor {
+        sim::scenario::trained_for::trained_for(&self.sensors, &self.arena_choice())
+    }
+
     /// The run as a scenario (arena and sensor files read and checked),
     /// without the settings only training has.
     pub fn scenario(&self) -> Result<Scenario> {
