@@ -51,6 +51,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Train(args) => train(args),
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
+        Command::Policy(PolicyCommand::Gap(args)) => policy_gap(args),
+        Command::Policy(PolicyCommand::GapTable { json, doc }) => gap_table(&json, &doc),
         Command::Monitor(args) => monitor(args),
         Command::Replay(args) => replay(args),
         Command::Flash(args) => flash(args),
@@ -124,6 +126,47 @@ fn train(args: TrainArgs) -> Result<()> {
     let report = host::train::train(&args.request())?;
     println!("{report}");
     Ok(())
+}
+
+fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
+    use host::flashed::{measure_learner, measure_policy, GapReport};
+    let mut config = match &args.config {
+        Some(path) => host::train::TrainConfig::from_file(path)?,
+        None => host::train::TrainConfig::default(),
+    };
+    args.flags.apply(&mut config)?;
+    if args.randomise {
+        config.noise = 1.0;
+    }
+    config.validate()?;
+    let blob = args
+        .policy
+        .as_deref()
+        .map(sim::control::policy_file::read)
+        .transpose()?;
+    let mut report = GapReport::load(&args.json)?;
+    let mut rows = Vec::new();
+    for &seed in &args.seeds {
+        config.seed = seed;
+        let row = match &blob {
+            Some(blob) => measure_policy(&args.label, blob, &config, args.window)?,
+            None => measure_learner(&args.label, &config, args.window)?,
+        };
+        eprintln!("{}: seed {seed}: {row:?}", args.label);
+        rows.push(row);
+    }
+    let command: Vec<String> = std::env::args().skip(1).collect();
+    report.replace(&args.label, format!("host {}", command.join(" ")), rows);
+    report.save(&args.json)
+}
+
+fn gap_table(json: &Path, doc: &Path) -> Result<()> {
+    let report = host::flashed::GapReport::load(json)?;
+    let text =
+        std::fs::read_to_string(doc).with_context(|| format!("cannot read {}", doc.display()))?;
+    let spliced = host::flashed::splice(&text, &host::flashed::render(&report))
+        .with_context(|| format!("doc {}", doc.display()))?;
+    host::atomic::write(doc, spliced.as_bytes())
 }
 
 fn inspect_policy(file: &Path, summary: bool) -> Result<()> {

@@ -546,8 +546,7 @@ impl PolicyBlob {
                     expected: PolicyTable::packed_len(hasher),
                     found: body.table.len(),
                 })?;
-            let provenance =
-                Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
+            let provenance = Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
             PolicyBlob::new(actions, table, provenance)
         } else {
             let body: BodyV2<'_> = take_body(body_bytes)?;
@@ -557,13 +556,13 @@ impl PolicyBlob {
                 &body.angular_speeds,
                 body.forward_speed,
             )?;
-            let sets = ActionSets::from_packed(hasher, body.sets).ok_or(BlobError::TableLength {
-                hasher,
-                expected: ActionSets::packed_len(hasher),
-                found: body.sets.len(),
-            })?;
-            let provenance =
-                Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
+            let sets =
+                ActionSets::from_packed(hasher, body.sets).ok_or(BlobError::TableLength {
+                    hasher,
+                    expected: ActionSets::packed_len(hasher),
+                    found: body.sets.len(),
+                })?;
+            let provenance = Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
             let trained_for = TrainedFor::new(body.sensors, body.arena)?;
             let blob = PolicyBlob::with_sets(actions, sets, provenance)?;
             Ok(if trained_for == TrainedFor::default() {

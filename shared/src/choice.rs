@@ -93,7 +93,10 @@ mod tests {
             for a in 0..4 {
                 if mask & (1 << a) != 0 {
                     let share = f64::from(counts[a]) / f64::from(draws);
-                    assert!((share - 1.0 / f64::from(n)).abs() < 0.01, "{mask:04b} {counts:?}");
+                    assert!(
+                        (share - 1.0 / f64::from(n)).abs() < 0.01,
+                        "{mask:04b} {counts:?}"
+                    );
                 }
             }
         }
@@ -101,8 +104,9 @@ mod tests {
 
     #[test]
     fn robots_start_apart_and_never_at_zero() {
-        let states: std::vec::Vec<u32> =
-            (0..=255u8).map(|id| ChoiceRng::for_robot(id).state()).collect();
+        let states: std::vec::Vec<u32> = (0..=255u8)
+            .map(|id| ChoiceRng::for_robot(id).state())
+            .collect();
         let mut sorted = states.clone();
         sorted.sort_unstable();
         sorted.dedup();

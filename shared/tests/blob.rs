@@ -471,7 +471,9 @@ fn a_blob_without_ties_or_trained_for_is_still_written_as_version_1() {
     let blob = default_blob();
     assert_eq!(blob.version(), 1);
     assert_eq!(blob.encode()[4], 1);
-    let with = blob.clone().with_trained_for(TrainedFor::new("disc", "thesis").unwrap());
+    let with = blob
+        .clone()
+        .with_trained_for(TrainedFor::new("disc", "thesis").unwrap());
     assert_eq!(with.version(), 2);
     // a version 1 blob decodes to single-action sets: its table's
     let back = PolicyBlob::decode(&blob.encode()).unwrap();

@@ -329,7 +329,11 @@ mod tests {
                 for _ in 0..400 {
                     seen |= 1 << q.greedy_within(State(s), tolerance, &mut rng).0;
                 }
-                assert_eq!(sets.mask(State(s)), seen, "state {s}, tolerance {tolerance}");
+                assert_eq!(
+                    sets.mask(State(s)),
+                    seen,
+                    "state {s}, tolerance {tolerance}"
+                );
             }
         }
         assert_eq!(q.best_sets(0.0).mask(State(2)), 0b0010);

@@ -53,7 +53,9 @@ impl Controller for GreedyPolicy {
             let state = hasher.hash_as(reading, robot.kind.role());
             // A decoded blob names only existing actions, so the lookup
             // cannot miss; 0 keeps the robot straight if it ever did.
-            *turn = actions.angular(choice.pick(sets.mask(state))).unwrap_or(0.0);
+            *turn = actions
+                .angular(choice.pick(sets.mask(state)))
+                .unwrap_or(0.0);
         }
     }
 }

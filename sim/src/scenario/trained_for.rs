@@ -25,9 +25,10 @@ pub fn sensors_label(sensors: &SensorChoice) -> String {
 /// arena file's name (without its folder).
 pub fn arena_label(arena: &ArenaChoice) -> String {
     match arena {
-        ArenaChoice::File(path) => path
-            .file_name()
-            .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into()),
+        ArenaChoice::File(path) => path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into(),
+        ),
         other => other.to_string(),
     }
 }
@@ -85,7 +86,10 @@ mod tests {
         let robot_file = SensorChoice::Robot(Some(PathBuf::from("x/fit.json")));
         let file = ArenaChoice::File(PathBuf::from("experiments/arenas/small.toml"));
         let t = trained_for(&robot_file, &file);
-        assert_eq!((t.sensors.as_str(), t.arena.as_str()), ("robot", "small.toml"));
+        assert_eq!(
+            (t.sensors.as_str(), t.arena.as_str()),
+            ("robot", "small.toml")
+        );
         let t = trained_for(&SensorChoice::Disc, &ArenaChoice::Thesis);
         assert_eq!((t.sensors.as_str(), t.arena.as_str()), ("disc", "thesis"));
         let mix = SensorChoice::Mixed(Box::new([
@@ -98,14 +102,22 @@ mod tests {
 
     #[test]
     fn a_mismatch_names_what_differs_and_agreement_says_nothing() {
-        let robot_tv = trained_for(&SensorChoice::Robot(None), &ArenaChoice::Named("tv75".into()));
+        let robot_tv = trained_for(
+            &SensorChoice::Robot(None),
+            &ArenaChoice::Named("tv75".into()),
+        );
         let disc = trained_for(&SensorChoice::Disc, &ArenaChoice::Named("tv75".into()));
         let text = mismatch(Some(&robot_tv), &disc).unwrap();
-        assert!(text.contains("sensor model robot (this run: disc)"), "{text}");
+        assert!(
+            text.contains("sensor model robot (this run: disc)"),
+            "{text}"
+        );
         assert!(!text.contains("arena"), "{text}");
         assert_eq!(mismatch(Some(&robot_tv), &robot_tv), None);
         assert_eq!(mismatch(None, &disc), None);
         let thesis = trained_for(&SensorChoice::Robot(None), &ArenaChoice::Thesis);
-        assert!(mismatch(Some(&robot_tv), &thesis).unwrap().contains("arena tv75 (this run: thesis)"));
+        assert!(mismatch(Some(&robot_tv), &thesis)
+            .unwrap()
+            .contains("arena tv75 (this run: thesis)"));
     }
 }
