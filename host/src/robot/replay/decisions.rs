@@ -3,8 +3,8 @@
 
 use super::report::{Divergence, Stage, StageCounts, LISTED};
 use shared::{
-    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob,
-    RobotProfile, Role, SensorReading, State,
+    ActionId, ActionMotors, ChoiceRng, FieldCalibration, FieldValue, LogFrame, MotorCommand,
+    PolicyBlob, RobotProfile, Role, SensorReading, State,
 };
 
 /// What each stage should have produced from a frame's own inputs.
@@ -16,6 +16,9 @@ struct Expected {
     /// Motor commands: the action's mix when the policy drove, else a stop
     /// (idle, calibrating standing still, or stopped by a fault).
     motors: MotorCommand,
+    /// Whether the logged choice generator is where the previous frame's
+    /// decision left it (always, when the previous tick's frame is missing).
+    choice_continues: bool,
 }
 
 /// Recomputes decisions with a policy and collects the divergences.
@@ -23,6 +26,8 @@ pub struct DecisionCheck<'a> {
     policy: &'a PolicyBlob,
     motors: ActionMotors,
     calibration: Option<FieldCalibration>,
+    /// The previous frame's tick and its choice generator after its decision.
+    after: Option<(u32, ChoiceRng)>,
     /// Calibrations logged, each differing from the one before.
     pub calibrations: Vec<FieldCalibration>,
     /// Frames whose values could be checked.
@@ -42,6 +47,7 @@ impl<'a> DecisionCheck<'a> {
             policy,
             motors: RobotProfile::ZUMO.action_motors(policy.actions()),
             calibration: None,
+            after: None,
             calibrations: Vec::new(),
             calibration_checked: 0,
             diverged: 0,
@@ -59,7 +65,12 @@ impl<'a> DecisionCheck<'a> {
             }
             self.calibration = Some(c);
         }
-        let expected = self.expected(f);
+        let previous = self.after;
+        let mut expected = self.expected(f);
+        if let Some((tick, rng)) = previous {
+            expected.choice_continues =
+                f.tick != tick.wrapping_add(1) || rng == ChoiceRng::from_state(f.choice);
+        }
         if expected.values.is_some() {
             self.calibration_checked += 1;
         }
@@ -70,7 +81,7 @@ impl<'a> DecisionCheck<'a> {
     }
 
     /// Each stage's result from the frame's logged inputs to that stage.
-    fn expected(&self, f: &LogFrame) -> Expected {
+    fn expected(&mut self, f: &LogFrame) -> Expected {
         let values = self.calibration.map(|c| c.scales().values(&f.raw_times));
         // the robot's role is its id's (odd: an innie), as the firmware takes it
         let role = Role::of_robot_id(f.robot_id);
@@ -79,11 +90,15 @@ impl<'a> DecisionCheck<'a> {
             .hasher()
             .hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
         let in_range = f.state.index() < self.policy.hasher().num_states();
+        // the robot's pick among the state's best actions, from its logged
+        // generator (one best action: no draw, the table's)
+        let mut rng = ChoiceRng::from_state(f.choice);
         let action = if in_range {
-            self.policy.table().action(f.state)
+            rng.pick(self.policy.sets().mask(f.state))
         } else {
             ActionId(u8::MAX)
         };
+        self.after = Some((f.tick, rng));
         let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
             self.motors.command(f.action)
         } else {
@@ -94,6 +109,7 @@ impl<'a> DecisionCheck<'a> {
             state,
             action,
             motors,
+            choice_continues: true,
         }
     }
 
@@ -135,7 +151,7 @@ fn divergent_stages(f: &LogFrame, e: &Expected) -> Vec<Stage> {
     [
         (Stage::Calibration, e.values.is_some_and(|v| v != f.values)),
         (Stage::Hash, e.state != f.state),
-        (Stage::Policy, e.action != f.action),
+        (Stage::Policy, e.action != f.action || !e.choice_continues),
         (Stage::Motors, !motors_ok),
     ]
     .into_iter()
