@@ -48,6 +48,8 @@ fn main() -> ! {
     let robot_id = board::robot_id();
     // odd ids are innies: only a role-aware policy tells them apart
     let role = shared::Role::of_robot_id(robot_id);
+    // the robot's choice among a state's best actions (docs/state-hash.md)
+    let mut choice = shared::ChoiceRng::for_robot(robot_id);
 
     board.watchdog_on();
     loop {
@@ -76,8 +78,14 @@ fn main() -> ! {
         } else {
             plan.motors
         };
-        let (decision, command) =
-            decide_and_drive(&board, &decider, &times, camera.blocks(), source);
+        let (decision, command) = decide_and_drive(
+            &board,
+            &decider,
+            &times,
+            camera.blocks(),
+            source,
+            &mut choice,
+        );
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;
@@ -107,6 +115,7 @@ fn main() -> ! {
             calibration: logged_calibration,
             robot_id,
             encoder_counts,
+            choice: decision.choice,
         };
         let n = log.encode(frame);
         let bytes = frame.get(..n).unwrap_or(&[]);
@@ -159,11 +168,12 @@ fn decide_and_drive(
     times: &[u16; 3],
     blocks: &[shared::PixyBlock],
     source: firmware::supervisor::MotorSource,
+    choice: &mut shared::ChoiceRng,
 ) -> (firmware::decision::Decision, shared::MotorCommand) {
     use firmware::supervisor::MotorSource;
     use shared::{DriveOutputs, MotorCommand};
     board.mark(1);
-    let decision = decider.decide(times, blocks);
+    let decision = decider.decide(times, blocks, choice);
     let (outputs, command) = match source {
         MotorSource::Policy => (decision.outputs, decision.command),
         MotorSource::Stop => (DriveOutputs::STOP, MotorCommand::default()),

@@ -74,10 +74,14 @@ fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutput
         CAMERA,
         embedded::HASHER,
         shared::Role::Outie,
-        &embedded::POLICY[..],
+        &embedded::POLICY_SETS[..],
         embedded::MOTORS,
     );
-    let expected = decider.decide(&frame.raw_times, blocks);
+    // from the generator the frame logs (the default policy has no ties,
+    // so it stays where the robot id put it)
+    let mut choice = shared::ChoiceRng::from_state(frame.choice);
+    assert_eq!(choice, shared::ChoiceRng::for_robot(frame.robot_id));
+    let expected = decider.decide(&frame.raw_times, blocks, &mut choice);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);
     assert_eq!(frame.state, expected.state);
