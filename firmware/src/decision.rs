@@ -37,8 +37,6 @@ pub struct Decision {
     /// The policy's action: the state's best action, or the one the
     /// generator picked among several.
     pub action: ActionId,
-    /// The choice generator's state before this decision (for the log).
-    pub choice: u32,
     /// The action's motor commands.
     pub command: MotorCommand,
     /// The action's pin-level outputs.
@@ -97,14 +95,12 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
             .hash_as(&SensorReading::from_parts(values, blobs), self.role);
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
         let byte = self.policy.byte(ActionSets::byte_index(masked));
-        let before = choice.state();
         let action = choice.pick(ActionSets::mask_in_byte(byte, masked));
         Decision {
             values,
             blobs,
             state,
             action,
-            choice: before,
             command: self.motors.command(action),
             outputs: self.motors.outputs(action),
         }
@@ -195,7 +191,6 @@ mod tests {
                 let dec = d.decide(&[left_time, mid_time, right_time], &blocks, &mut choice);
                 let expected_state = State(u16::from(bits) | bin << 4);
                 assert_eq!(dec.state, expected_state);
-                assert_eq!(dec.choice, expected_choice.state());
                 let action = expected_choice.pick(blob.sets().mask(expected_state));
                 assert_eq!(choice, expected_choice);
                 assert_eq!(dec.action, action);

@@ -110,6 +110,16 @@ impl Provenance {
     }
 }
 
+/// The longest prefix of `s` of at most [`MAX_NAME_LEN`] bytes (cut at a
+/// character boundary): a name that always fits.
+pub fn name_prefix(s: &str) -> &str {
+    let mut end = s.len().min(MAX_NAME_LEN);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
+}
+
 fn to_name(kind: NameKind, s: &str) -> Result<Name, BlobError> {
     Name::try_from(s).map_err(|_| BlobError::NameTooLong { kind, len: s.len() })
 }

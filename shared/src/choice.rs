@@ -4,45 +4,46 @@
 
 use crate::action::ActionId;
 
-/// Xorshift32 (Marsaglia 2003, shifts 13, 17, 5): 32 bits of state, never
-/// 0, period 2^32 - 1. Drawn only when a state has two or more best
-/// actions, so single-action policies never advance it.
+/// Xorshift16 (shifts 7, 9, 8): 16 bits of state, never 0, period
+/// 2^16 - 1; small enough that the robot logs it in 3 bytes. Drawn only
+/// when a state has two or more best actions, so single-action policies
+/// never advance it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct ChoiceRng(u32);
+pub struct ChoiceRng(u16);
 
 impl ChoiceRng {
     /// The generator of robot `robot_id` (the firmware's, `host flash
     /// --robot-id`): a fixed mix of the id, never 0.
     pub const fn for_robot(robot_id: u8) -> ChoiceRng {
-        let mixed = (robot_id as u32 + 1).wrapping_mul(0x9E37_79B9);
-        ChoiceRng::from_state(mixed ^ 0x2545_F491)
+        let mixed = (robot_id as u16 + 1).wrapping_mul(0x9E37);
+        ChoiceRng::from_state(mixed ^ 0x2545)
     }
 
     /// A generator in a logged state; 0 (which xorshift never leaves) is
     /// read as 1.
-    pub const fn from_state(state: u32) -> ChoiceRng {
+    pub const fn from_state(state: u16) -> ChoiceRng {
         ChoiceRng(if state == 0 { 1 } else { state })
     }
 
     /// The state, for the log.
-    pub const fn state(&self) -> u32 {
+    pub const fn state(&self) -> u16 {
         self.0
     }
 
-    /// The next 32 random bits.
-    pub fn next_u32(&mut self) -> u32 {
+    /// The next 16 random bits.
+    pub fn next_u16(&mut self) -> u16 {
         let mut x = self.0;
-        x ^= x << 13;
-        x ^= x >> 17;
-        x ^= x << 5;
+        x ^= x << 7;
+        x ^= x >> 9;
+        x ^= x << 8;
         self.0 = x;
         x
     }
 
     /// One action of `mask` (bit `a`: action `a`; only the low four bits
     /// count): the only one without drawing, otherwise the `k`-th set bit
-    /// with `k = (high 16 bits x count) >> 16`, uniform to within
-    /// `count / 65536` per action. An empty mask gives action 0, undrawn.
+    /// with `k = (draw x count) >> 16`, uniform to within `count / 65536`
+    /// per action. An empty mask gives action 0, undrawn.
     pub fn pick(&mut self, mask: u8) -> ActionId {
         let mask = mask & 0x0f;
         let count = mask.count_ones();
@@ -52,8 +53,7 @@ impl ChoiceRng {
         if count == 1 {
             return ActionId(mask.trailing_zeros() as u8);
         }
-        let high = self.next_u32() >> 16;
-        let k = (high * count) >> 16;
+        let k = (u32::from(self.next_u16()) * count) >> 16;
         let mut left = mask;
         for _ in 0..k {
             left &= left - 1;
@@ -104,7 +104,7 @@ mod tests {
 
     #[test]
     fn robots_start_apart_and_never_at_zero() {
-        let states: std::vec::Vec<u32> = (0..=255u8)
+        let states: std::vec::Vec<u16> = (0..=255u8)
             .map(|id| ChoiceRng::for_robot(id).state())
             .collect();
         let mut sorted = states.clone();

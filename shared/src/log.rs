@@ -40,9 +40,9 @@ const CRC16: Crc<u16, NoTable> = Crc::<u16, NoTable>::new(&CRC_16_IBM_3740);
 /// Largest body postcard can produce for a [`LogFrame`] (every varint at
 /// its longest): tick, mode, faults, raw times, values, blobs, blocks,
 /// state, action, motors, the calibration (tag + six times), the robot id
-/// the two encoder counts and the choice generator's state.
+/// the two encoder counts and the choice generator's state (tag + u16).
 const MAX_BODY_LEN: usize =
-    5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3 + 5;
+    5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3 + 1 + 3;
 /// Version byte + body + CRC.
 const MAX_RAW_LEN: usize = 1 + MAX_BODY_LEN + 2;
 
@@ -160,11 +160,12 @@ pub struct LogFrame {
     /// before this one (while the previous frame's motor commands drove);
     /// positive = forward.
     pub encoder_counts: [i16; 2],
-    /// The robot's [`crate::ChoiceRng`] state before this period's
-    /// decision: with the policy's best actions for `state`, it gives
-    /// `action` (`ChoiceRng::from_state(choice).pick(mask)`), so a host
-    /// rechecks every sampled decision.
-    pub choice: u32,
+    /// When this period's decision drew from the robot's
+    /// [`crate::ChoiceRng`] (its state had two or more best actions): the
+    /// generator's state before the draw, which with the state's best
+    /// actions gives `action` (`ChoiceRng::from_state(s).pick(mask)`), so a
+    /// host rechecks every sampled decision. `None` when it did not draw.
+    pub choice: Option<u16>,
 }
 
 /// Why a frame was refused.
@@ -321,7 +322,7 @@ mod tests {
             calibration: None,
             robot_id: 7,
             encoder_counts: [81, -12],
-            choice: 0x1234_5678,
+            choice: Some(0x1234),
         }
     }
 
@@ -369,13 +370,13 @@ mod tests {
             }),
             robot_id: u8::MAX,
             encoder_counts: [i16::MIN; 2],
-            choice: u32::MAX,
+            choice: Some(u16::MAX),
         };
         let (buf, n) = encoded(&big);
         assert!(n <= LogFrame::MAX_ENCODED_LEN);
         assert_eq!(
             LogFrame::MAX_ENCODED_LEN,
-            76,
+            75,
             "docs/firmware.md states this bound"
         );
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(big));
@@ -483,7 +484,7 @@ mod tests {
         }
 
         #[test]
-        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>(), id in any::<u8>(), counts in any::<[i16; 2]>(), choice in any::<u32>()) {
+        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>(), id in any::<u8>(), counts in any::<[i16; 2]>(), choice in any::<Option<u16>>()) {
             let calibration = cal.map(|t| FieldCalibration {
                 ranges: [SensorRange { bright: t[0], dark: t[1] }, SensorRange { bright: t[2], dark: t[3] }, SensorRange { bright: t[4], dark: t[5] }],
             });

@@ -77,10 +77,9 @@ fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutput
         &embedded::POLICY_SETS[..],
         embedded::MOTORS,
     );
-    // from the generator the frame logs (the default policy has no ties,
-    // so it stays where the robot id put it)
-    let mut choice = shared::ChoiceRng::from_state(frame.choice);
-    assert_eq!(choice, shared::ChoiceRng::for_robot(frame.robot_id));
+    // the default policy has no ties: the robot never draws
+    assert_eq!(frame.choice, None);
+    let mut choice = shared::ChoiceRng::for_robot(frame.robot_id);
     let expected = decider.decide(&frame.raw_times, blocks, &mut choice);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);

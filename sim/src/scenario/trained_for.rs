@@ -4,7 +4,7 @@
 
 use crate::scenario::arena_choice::ArenaChoice;
 use crate::scenario::sensor_choice::SensorChoice;
-use shared::blob::MAX_NAME_LEN;
+use shared::blob::name_prefix;
 use shared::TrainedFor;
 
 /// The sensor model's name in a blob: `disc`, `disc-thesis`, `robot` (with
@@ -34,19 +34,10 @@ pub fn arena_label(arena: &ArenaChoice) -> String {
 }
 
 /// What a run of `sensors` in `arena` trains for, each name cut to
-/// [`MAX_NAME_LEN`] bytes.
+/// [`shared::blob::MAX_NAME_LEN`] bytes.
 pub fn trained_for(sensors: &SensorChoice, arena: &ArenaChoice) -> TrainedFor {
     let (sensors, arena) = (sensors_label(sensors), arena_label(arena));
-    TrainedFor::new(truncate(&sensors), truncate(&arena)).unwrap_or_default()
-}
-
-/// The longest prefix of `s` of at most [`MAX_NAME_LEN`] bytes.
-fn truncate(s: &str) -> &str {
-    let mut end = s.len().min(MAX_NAME_LEN);
-    while !s.is_char_boundary(end) {
-        end -= 1;
-    }
-    &s[..end]
+    TrainedFor::new(name_prefix(&sensors), name_prefix(&arena)).unwrap_or_default()
 }
 
 /// The warning for running a policy trained for `policy` with `run`, or

@@ -16,9 +16,10 @@ struct Expected {
     /// Motor commands: the action's mix when the policy drove, else a stop
     /// (idle, calibrating standing still, or stopped by a fault).
     motors: MotorCommand,
-    /// Whether the logged choice generator is where the previous frame's
-    /// decision left it (always, when the previous tick's frame is missing).
-    choice_continues: bool,
+    /// Whether the logged choice generator is consistent: logged exactly
+    /// when the state had several best actions, and where the decisions
+    /// before left it (unknown across a lost frame).
+    choice_ok: bool,
 }
 
 /// Recomputes decisions with a policy and collects the divergences.
@@ -26,8 +27,9 @@ pub struct DecisionCheck<'a> {
     policy: &'a PolicyBlob,
     motors: ActionMotors,
     calibration: Option<FieldCalibration>,
-    /// The previous frame's tick and its choice generator after its decision.
-    after: Option<(u32, ChoiceRng)>,
+    /// The last frame's tick and the choice generator after its decision,
+    /// when known (from the last draw logged, with no frame lost since).
+    after: Option<(u32, Option<ChoiceRng>)>,
     /// Calibrations logged, each differing from the one before.
     pub calibrations: Vec<FieldCalibration>,
     /// Frames whose values could be checked.
@@ -65,12 +67,24 @@ impl<'a> DecisionCheck<'a> {
             }
             self.calibration = Some(c);
         }
-        let previous = self.after;
+        let known = match self.after {
+            Some((tick, rng)) if f.tick == tick.wrapping_add(1) => rng,
+            _ => None,
+        };
         let mut expected = self.expected(f);
-        if let Some((tick, rng)) = previous {
-            expected.choice_continues =
-                f.tick != tick.wrapping_add(1) || rng == ChoiceRng::from_state(f.choice);
+        if let (Some(rng), Some(logged)) = (known, f.choice) {
+            expected.choice_ok &= rng == ChoiceRng::from_state(logged);
         }
+        // a frame that did not draw leaves the generator where it was
+        let after = match f.choice {
+            Some(s) => {
+                let mut rng = ChoiceRng::from_state(s);
+                rng.pick(self.policy.sets().mask(f.state));
+                Some(rng)
+            }
+            None => known,
+        };
+        self.after = Some((f.tick, after));
         if expected.values.is_some() {
             self.calibration_checked += 1;
         }
@@ -81,7 +95,7 @@ impl<'a> DecisionCheck<'a> {
     }
 
     /// Each stage's result from the frame's logged inputs to that stage.
-    fn expected(&mut self, f: &LogFrame) -> Expected {
+    fn expected(&self, f: &LogFrame) -> Expected {
         let values = self.calibration.map(|c| c.scales().values(&f.raw_times));
         // the robot's role is its id's (odd: an innie), as the firmware takes it
         let role = Role::of_robot_id(f.robot_id);
@@ -90,15 +104,16 @@ impl<'a> DecisionCheck<'a> {
             .hasher()
             .hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
         let in_range = f.state.index() < self.policy.hasher().num_states();
-        // the robot's pick among the state's best actions, from its logged
-        // generator (one best action: no draw, the table's)
-        let mut rng = ChoiceRng::from_state(f.choice);
-        let action = if in_range {
-            rng.pick(self.policy.sets().mask(f.state))
-        } else {
-            ActionId(u8::MAX)
+        // the robot's pick among the state's best actions: the one, or
+        // the logged generator's draw among several
+        let mask = self.policy.sets().mask(f.state);
+        let several = mask.count_ones() > 1;
+        let action = match (in_range, f.choice) {
+            (false, _) => ActionId(u8::MAX),
+            (true, Some(s)) => ChoiceRng::from_state(s).pick(mask),
+            (true, None) if several => ActionId(u8::MAX),
+            (true, None) => self.policy.table().action(f.state),
         };
-        self.after = Some((f.tick, rng));
         let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
             self.motors.command(f.action)
         } else {
@@ -109,7 +124,7 @@ impl<'a> DecisionCheck<'a> {
             state,
             action,
             motors,
-            choice_continues: true,
+            choice_ok: !in_range || several == f.choice.is_some(),
         }
     }
 
@@ -151,7 +166,7 @@ fn divergent_stages(f: &LogFrame, e: &Expected) -> Vec<Stage> {
     [
         (Stage::Calibration, e.values.is_some_and(|v| v != f.values)),
         (Stage::Hash, e.state != f.state),
-        (Stage::Policy, e.action != f.action || !e.choice_continues),
+        (Stage::Policy, e.action != f.action || !e.choice_ok),
         (Stage::Motors, !motors_ok),
     ]
     .into_iter()

@@ -283,6 +283,7 @@ mod tests {
         let state = p.hasher().hash(&reading);
         let before = choice.state();
         let action = choice.pick(p.sets().mask(state));
+        let drew = choice.state() != before;
         let mut f = LogFrame {
             tick,
             mode,
@@ -293,7 +294,7 @@ mod tests {
             blocks: u8::from(puck_left),
             state,
             action,
-            choice: before,
+            choice: drew.then_some(before),
             ..LogFrame::default()
         };
         if f.policy_drove() {
@@ -472,7 +473,7 @@ mod tests {
         let p = tied_policy();
         let mut frames = session(&p);
         // the robot drew: its generator moved on every frame
-        assert!(frames.windows(2).all(|w| w[0].choice != w[1].choice));
+        assert!(frames.iter().all(|f| f.choice.is_some()));
         let r = report_of(&log_of(&frames), &p);
         assert_eq!((r.frames, r.diverged), (120, 0), "{r}");
         // another of the state's best actions than the generator's pick
@@ -484,13 +485,16 @@ mod tests {
         frames[i].action = ActionId(other);
         // a generator that jumps (the draw itself agrees with its state)
         let j = 70;
-        let mut jumped = ChoiceRng::from_state(frames[j].choice ^ 0x8000_0000);
-        frames[j].choice = jumped.state();
+        let mut jumped = ChoiceRng::from_state(frames[j].choice.unwrap() ^ 0x8000);
+        frames[j].choice = Some(jumped.state());
         frames[j].action = jumped.pick(p.sets().mask(frames[j].state));
+        // a tied state decided without a logged draw
+        frames[90].choice = None;
         let r = report_of(&log_of(&frames), &p);
         let ticks: Vec<u32> = r.first_divergences.iter().map(|d| d.tick).collect();
-        // 41: the wrong pick; 71: the jump; 72: the frame after the jump
-        assert_eq!(ticks, vec![41, 71, 72], "{r}");
+        // 41: the wrong pick; 71: the jump; 72: the frame after the jump;
+        // 91: no draw logged; 92: the generator moved without a logged draw
+        assert_eq!(ticks, vec![41, 71, 72, 91, 92], "{r}");
         assert!(r
             .first_divergences
             .iter()
