@@ -155,7 +155,11 @@ fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
         eprintln!("{}: seed {seed}: {row:?}", args.label);
         rows.push(row);
     }
-    let command: Vec<String> = std::env::args().skip(1).collect();
+    // as a shell would take it back: arguments with spaces quoted
+    let command: Vec<String> = std::env::args()
+        .skip(1)
+        .map(|a| if a.contains(' ') { format!("'{a}'") } else { a })
+        .collect();
     report.replace(&args.label, format!("host {}", command.join(" ")), rows);
     report.save(&args.json)
 }
