@@ -59,3 +59,74 @@ impl Controller for GreedyPolicy {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::policy_file;
+    use crate::scenario::Scenario;
+    use shared::{ActionSets, ActionTable, Provenance, State, StateHasher};
+    use std::path::Path;
+
+    /// The policy controller as it was before blob format version 2: each
+    /// state's table action, no generator.
+    struct TableOnly(PolicyBlob);
+
+    impl Controller for TableOnly {
+        fn decide(&mut self, p: &Perception<'_>, turns: &mut [f32], _rng: &mut SimRng) {
+            let (hasher, table, actions) = (self.0.hasher(), self.0.table(), self.0.actions());
+            for ((turn, reading), robot) in turns.iter_mut().zip(p.readings).zip(p.robots) {
+                let state = hasher.hash_as(reading, robot.kind.role());
+                *turn = actions.angular(table.action(state)).unwrap_or(0.0);
+            }
+        }
+    }
+
+    /// The world after `steps` steps of the thesis' standard run, seed 3.
+    fn world_after(controller: &mut dyn Controller, steps: u64) -> String {
+        let mut sim = Scenario::default()
+            .prepare()
+            .unwrap()
+            .simulation(3)
+            .unwrap();
+        sim.run(controller, steps);
+        format!("{:?}", sim.snapshot())
+    }
+
+    #[test]
+    fn a_blob_of_one_action_per_state_acts_as_before_and_never_draws() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../policies/disc-tv75-8bit.policy");
+        let blob = policy_file::read(&path).unwrap();
+        let mut policy = GreedyPolicy::new(blob.clone());
+        assert_eq!(
+            world_after(&mut policy, 3000),
+            world_after(&mut TableOnly(blob), 3000)
+        );
+        for robot in 0..8 {
+            assert_eq!(policy.choice_rng(robot), ChoiceRng::for_robot(robot as u8));
+        }
+    }
+
+    #[test]
+    fn each_robot_draws_its_firmwares_generator_once_per_tied_decision() {
+        // actions 1 and 3 tie in every state: every decision draws
+        let mut sets = ActionSets::new(StateHasher::Original);
+        for s in 0..256u16 {
+            sets.set(State(s), 0b1010);
+        }
+        let blob =
+            PolicyBlob::with_sets(ActionTable::default(), sets, Provenance::default()).unwrap();
+        let mut policy = GreedyPolicy::new(blob.clone());
+        let steps = 500;
+        let tied = world_after(&mut policy, steps);
+        for robot in 0..8 {
+            let mut expected = ChoiceRng::for_robot(robot as u8);
+            for _ in 0..steps {
+                expected.next_u16();
+            }
+            assert_eq!(policy.choice_rng(robot), expected, "robot {robot}");
+        }
+        // the draws decide: the same world as the table's lowest actions would be a coincidence
+        assert_ne!(tied, world_after(&mut TableOnly(blob), steps));
+    }
+}
