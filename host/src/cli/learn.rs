@@ -41,6 +41,37 @@ impl TrainArgs {
     }
 }
 
+/// `host policy gap`'s arguments: a training run's settings, as `host
+/// train` takes them, and what to measure.
+#[derive(Clone, Debug, Args)]
+pub struct GapArgs {
+    /// The rows' label in the report (e.g. annulus, L).
+    #[arg(long)]
+    pub label: String,
+    /// Steps of the final window of training, and of each frozen and
+    /// flashed run.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub window: u64,
+    /// The seeds, one training run each (comma-separated).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub seeds: Vec<u64>,
+    /// The JSON report: this label's rows are replaced, others kept.
+    #[arg(long)]
+    pub json: PathBuf,
+    /// Measure this policy blob (flashed only) instead of training.
+    #[arg(long)]
+    pub policy: Option<PathBuf>,
+    /// TOML file with any of the training settings; flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The training settings flags.
+    #[command(flatten)]
+    pub flags: TrainFlags,
+    /// The default real-world noise (the same as --noise 1).
+    #[arg(long, conflicts_with = "noise")]
+    pub randomise: bool,
+}
+
 /// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
 #[derive(Clone, Debug, Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]

@@ -2,7 +2,7 @@
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
-use shared::{ActionId, PolicyTable, State, StateHasher};
+use shared::{ActionId, ActionSets, PolicyTable, State, StateHasher};
 
 /// Q(s, a) for every state of one hasher and every action, with visit counts.
 ///
@@ -263,6 +263,30 @@ impl QTable {
         table
     }
 
+    /// Each state's best actions: exactly the set [`QTable::greedy_within`]
+    /// `tolerance` picks from uniformly (the actions within `tolerance` of
+    /// the greatest value; with 0 the equal maxima of [`QTable::greedy`]).
+    /// Unvisited states have every action.
+    pub fn best_sets(&self, tolerance: f64) -> ActionSets {
+        let mut sets = ActionSets::new(self.hasher);
+        for s in 0..self.hasher.num_states() as u16 {
+            let row = self.row(State(s));
+            let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let floor = if tolerance == 0.0 {
+                best
+            } else {
+                best - tolerance
+            };
+            let mask = row
+                .iter()
+                .enumerate()
+                .filter(|(_, &v)| v >= floor)
+                .fold(0u8, |m, (a, _)| m | 1 << a);
+            sets.set(State(s), mask);
+        }
+        sets
+    }
+
     /// A table that acts like a greedy policy: every value `initial`, plus
     /// [`POLICY_PREFERENCE`] on each state's policy action, no visits. Used
     /// to start learning from a policy blob, which carries no Q-values.
@@ -371,6 +395,40 @@ mod tests {
         }
         assert_eq!(q.greedy_policy().action(State(3)), ActionId(2));
         assert_eq!(q.greedy_policy().action(State(4)), ActionId(0));
+    }
+
+    #[test]
+    fn best_sets_are_exactly_the_actions_the_learner_picks_among() {
+        let mut q = QTable::new(StateHasher::Bits7, 4, 1.0);
+        let rows: [[f64; 4]; 5] = [
+            [1.0, 1.0, 0.5, 1.0],
+            [0.2, 0.9, 0.9, 0.1],
+            [0.3, 0.3005, 0.1, 0.2996],
+            [-1.0, -2.0, -3.0, -4.0],
+            [1.0, 1.0, 1.0, 1.0],
+        ];
+        for (s, row) in rows.iter().enumerate() {
+            q.values[s * 4..s * 4 + 4].copy_from_slice(row);
+        }
+        let mut rng = Pcg64Mcg::seed_from_u64(11);
+        for tolerance in [0.0, 0.001] {
+            let sets = q.best_sets(tolerance);
+            for s in 0..q.hasher().num_states() as u16 {
+                let mut seen = 0u8;
+                for _ in 0..400 {
+                    seen |= 1 << q.greedy_within(State(s), tolerance, &mut rng).0;
+                }
+                assert_eq!(
+                    sets.mask(State(s)),
+                    seen,
+                    "state {s}, tolerance {tolerance}"
+                );
+            }
+        }
+        assert_eq!(q.best_sets(0.0).mask(State(2)), 0b0010);
+        assert_eq!(q.best_sets(0.001).mask(State(2)), 0b1011);
+        // without ties the lowest of each set is the old export
+        assert_eq!(q.best_sets(0.0).lowest(), q.greedy_policy());
     }
 
     #[test]

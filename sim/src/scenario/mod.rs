@@ -9,6 +9,7 @@ pub mod arena_choice;
 pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;
+pub mod trained_for;
 
 use crate::base::ranges;
 use crate::config::actuation::ActuationNoise;
