@@ -76,7 +76,7 @@ fn main() {
     let motors = RobotProfile::ZUMO.action_motors(blob.actions());
     let mut out = String::new();
     let hasher = format!("{:?}", blob.hasher());
-    let packed = blob.table().packed();
+    let packed = blob.sets().packed();
     writeln!(out, "/// Path of the embedded policy blob.").unwrap();
     writeln!(
         out,
@@ -125,12 +125,12 @@ fn main() {
     .unwrap();
     writeln!(
         out,
-        "/// The packed greedy table, 2 bits per state (`shared::PolicyTable` layout)."
+        "/// Each state's best actions, 4 bits per state (`shared::ActionSets` layout; one action per state for a blob of format version 1)."
     )
     .unwrap();
     writeln!(
         out,
-        "pub const POLICY: [u8; {}] = {:?};",
+        "pub const POLICY_SETS: [u8; {}] = {:?};",
         packed.len(),
         packed
     )

@@ -37,9 +37,9 @@ use firmware::supervisor::{Buttons, Leds};
 use firmware::usb::{TouchChange, BOOT_KEY};
 use shared::{DriveOutputs, FieldScales};
 
-/// The policy table, in flash (read with `lpm`, never copied to SRAM).
+/// The policy's best-action sets, in flash (read with `lpm`, never copied to SRAM).
 #[link_section = ".progmem.data"]
-static POLICY: [u8; embedded::POLICY.len()] = embedded::POLICY;
+static POLICY: [u8; embedded::POLICY_SETS.len()] = embedded::POLICY_SETS;
 
 /// The image's identity record (robot id, policy CRC), in flash; `host
 /// flash` finds it in the hex before writing it.

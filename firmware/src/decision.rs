@@ -2,17 +2,18 @@
 //!
 //! Calibrate the three times, classify the blocks, hash the reading with
 //! the policy's hasher (`shared`, the trainer's code), look the state's
-//! action up in the packed greedy table, and take that action's motor
+//! best actions up in the packed sets, pick one with the robot's
+//! [`ChoiceRng`] (no draw when there is one), and take that action's motor
 //! outputs, computed at build time. Integer-only: this is the code path the
 //! 2,000-cycle budget covers. It cannot panic: every index is masked into
 //! its table.
 
 use shared::{
-    ActionId, ActionMotors, BlobSummary, CameraConfig, DriveOutputs, FieldScales, FieldValue,
-    MotorCommand, PixyBlock, PolicyTable, Role, SensorReading, State, StateHasher,
+    ActionId, ActionMotors, ActionSets, BlobSummary, CameraConfig, ChoiceRng, DriveOutputs,
+    FieldScales, FieldValue, MotorCommand, PixyBlock, Role, SensorReading, State, StateHasher,
 };
 
-/// Read access to the packed policy table (in flash on the robot).
+/// Read access to the packed best-action sets (in flash on the robot).
 pub trait PolicyBytes {
     /// The byte at `index`; `index` is below the table's length.
     fn byte(&self, index: usize) -> u8;
@@ -33,7 +34,8 @@ pub struct Decision {
     pub blobs: BlobSummary,
     /// The hashed state.
     pub state: State,
-    /// The policy's action.
+    /// The policy's action: the state's best action, or the one the
+    /// generator picked among several.
     pub action: ActionId,
     /// The action's motor commands.
     pub command: MotorCommand,
@@ -58,7 +60,8 @@ pub struct Decider<'a, P: PolicyBytes + ?Sized> {
 impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
     /// A decider with the curves of the robot's calibration
     /// (`FieldCalibration::scales`, or `FieldScales::calibrate` in place).
-    /// `policy` holds `hasher.num_states() / 4` packed bytes.
+    /// `policy` holds `hasher.num_states() / 2` packed bytes
+    /// ([`ActionSets::packed`]).
     pub fn new(
         scales: &'a FieldScales,
         camera: CameraConfig,
@@ -77,16 +80,22 @@ impl<'a, P: PolicyBytes + ?Sized> Decider<'a, P> {
         }
     }
 
-    /// Decides for one period's raw times and blocks.
-    pub fn decide(&self, times: &[u16; 3], blocks: &[PixyBlock]) -> Decision {
+    /// Decides for one period's raw times and blocks, drawing from
+    /// `choice` when the state has two or more best actions.
+    pub fn decide(
+        &self,
+        times: &[u16; 3],
+        blocks: &[PixyBlock],
+        choice: &mut ChoiceRng,
+    ) -> Decision {
         let values = self.scales.values(times);
         let blobs = self.camera.classify(blocks);
         let state = self
             .hasher
             .hash_as(&SensorReading::from_parts(values, blobs), self.role);
         let masked = State(state.0 & (self.hasher.num_states() as u16 - 1));
-        let byte = self.policy.byte(PolicyTable::byte_index(masked));
-        let action = PolicyTable::action_in_byte(byte, masked);
+        let byte = self.policy.byte(ActionSets::byte_index(masked));
+        let action = choice.pick(ActionSets::mask_in_byte(byte, masked));
         Decision {
             values,
             blobs,
@@ -114,7 +123,7 @@ mod tests {
     fn the_embedded_policy_matches_its_blob_for_every_state() {
         let blob = PolicyBlob::decode(embedded::POLICY_BLOB).unwrap();
         assert_eq!(blob.hasher(), embedded::HASHER);
-        assert_eq!(blob.table().packed(), &embedded::POLICY[..]);
+        assert_eq!(blob.sets().packed(), &embedded::POLICY_SETS[..]);
         assert_eq!(motors_of(&blob), embedded::MOTORS);
         let cal = FieldCalibration {
             ranges: [SensorRange {
@@ -128,7 +137,7 @@ mod tests {
             CAMERA,
             embedded::HASHER,
             Role::Outie,
-            &embedded::POLICY[..],
+            &embedded::POLICY_SETS[..],
             embedded::MOTORS,
         );
         // Walk states through readings: every (left < mid, right < mid, mid bin, pucks) combination.
@@ -177,10 +186,13 @@ mod tests {
                         angle: 0,
                     });
                 }
-                let dec = d.decide(&[left_time, mid_time, right_time], &blocks);
+                let mut choice = ChoiceRng::for_robot(0);
+                let mut expected_choice = choice;
+                let dec = d.decide(&[left_time, mid_time, right_time], &blocks, &mut choice);
                 let expected_state = State(u16::from(bits) | bin << 4);
                 assert_eq!(dec.state, expected_state);
-                let action = blob.table().action(expected_state);
+                let action = expected_choice.pick(blob.sets().mask(expected_state));
+                assert_eq!(choice, expected_choice);
                 assert_eq!(dec.action, action);
                 assert_eq!(dec.command, embedded::MOTORS.commands[action.index()]);
             }
@@ -195,10 +207,11 @@ mod tests {
             CAMERA,
             embedded::HASHER,
             Role::Outie,
-            &embedded::POLICY[..],
+            &embedded::POLICY_SETS[..],
             embedded::MOTORS,
         );
-        let dec = d.decide(&[u16::MAX; 3], &[]);
+        let mut choice = ChoiceRng::for_robot(0);
+        let dec = d.decide(&[u16::MAX; 3], &[], &mut choice);
         assert_eq!(dec.values, [FieldValue::ZERO; 3]);
         assert_eq!(dec.state, State(0));
         // A short policy slice reads zeros instead of panicking.
@@ -211,6 +224,32 @@ mod tests {
             &[0u8; 3][..],
             embedded::MOTORS,
         );
-        assert_eq!(d.decide(&[0; 3], &[]).action, ActionId(0));
+        assert_eq!(d.decide(&[0; 3], &[], &mut choice).action, ActionId(0));
+    }
+
+    #[test]
+    fn a_tied_state_is_decided_by_the_generator_and_only_among_its_best_actions() {
+        let scales = UNCALIBRATED.scales();
+        // every state: actions 1 and 3 tie
+        let sets = [0b1010_1010u8; 128];
+        let d = Decider::new(
+            &scales,
+            CAMERA,
+            StateHasher::Original,
+            Role::Outie,
+            &sets[..],
+            embedded::MOTORS,
+        );
+        let mut choice = ChoiceRng::for_robot(7);
+        let mut counts = [0u32; 4];
+        for _ in 0..4000 {
+            let mut expected = ChoiceRng::from_state(choice.state());
+            let dec = d.decide(&[100, 200, 300], &[], &mut choice);
+            assert_eq!(dec.action, expected.pick(0b1010));
+            assert_eq!(choice, expected);
+            counts[dec.action.index()] += 1;
+        }
+        assert_eq!((counts[0], counts[2]), (0, 0));
+        assert!(counts[1].abs_diff(2000) < 150, "{counts:?}");
     }
 }

@@ -40,7 +40,8 @@ fn main() -> ! {
         supervisor,
         camera,
         frame,
-    } = loop_state(stored.is_some());
+        choice,
+    } = loop_state(stored.is_some(), board::robot_id());
     // Frames since the log last carried the calibration in use: it goes out
     // in the first frame, after a new one takes effect, and every
     // `LogFrame::CALIBRATION_EVERY` frames (a counter: no 32-bit modulo).
@@ -76,8 +77,9 @@ fn main() -> ! {
         } else {
             plan.motors
         };
+        let before = choice.state();
         let (decision, command) =
-            decide_and_drive(&board, &decider, &times, camera.blocks(), source);
+            decide_and_drive(&board, &decider, &times, camera.blocks(), source, choice);
         since_calibration = since_calibration.saturating_add(1);
         let logged_calibration = if since_calibration >= LogFrame::CALIBRATION_EVERY {
             since_calibration = 0;
@@ -107,6 +109,8 @@ fn main() -> ! {
             calibration: logged_calibration,
             robot_id,
             encoder_counts,
+            // the generator's state before the decision, when it drew
+            choice: (choice.state() != before).then_some(before),
         };
         let n = log.encode(frame);
         let bytes = frame.get(..n).unwrap_or(&[]);
@@ -124,6 +128,8 @@ struct LoopState {
     supervisor: firmware::supervisor::Supervisor,
     camera: firmware::camera::Camera,
     frame: [u8; shared::LogFrame::MAX_ENCODED_LEN],
+    /// The robot's choice among a state's best actions (docs/state-hash.md).
+    choice: shared::ChoiceRng,
 }
 
 #[cfg(target_arch = "avr")]
@@ -133,13 +139,14 @@ static mut LOOP_STATE: core::mem::MaybeUninit<LoopState> = core::mem::MaybeUnini
 /// out of the loop's frame). Called once.
 #[cfg(target_arch = "avr")]
 #[inline(never)]
-fn loop_state(calibrated: bool) -> &'static mut LoopState {
+fn loop_state(calibrated: bool, robot_id: u8) -> &'static mut LoopState {
     // SAFETY: called once, before the loop: the only reference ever made.
     unsafe {
         (*core::ptr::addr_of_mut!(LOOP_STATE)).write(LoopState {
             supervisor: firmware::supervisor::Supervisor::new(calibrated),
             camera: firmware::camera::Camera::new(),
             frame: [0; shared::LogFrame::MAX_ENCODED_LEN],
+            choice: shared::ChoiceRng::for_robot(robot_id),
         })
     }
 }
@@ -159,11 +166,12 @@ fn decide_and_drive(
     times: &[u16; 3],
     blocks: &[shared::PixyBlock],
     source: firmware::supervisor::MotorSource,
+    choice: &mut shared::ChoiceRng,
 ) -> (firmware::decision::Decision, shared::MotorCommand) {
     use firmware::supervisor::MotorSource;
     use shared::{DriveOutputs, MotorCommand};
     board.mark(1);
-    let decision = decider.decide(times, blocks);
+    let decision = decider.decide(times, blocks, choice);
     let (outputs, command) = match source {
         MotorSource::Policy => (decision.outputs, decision.command),
         MotorSource::Stop => (DriveOutputs::STOP, MotorCommand::default()),

@@ -5,7 +5,7 @@ use std::fmt::Write;
 
 /// The blob's header ([`summary`]), then one line per state with its
 /// decoded inputs (the role too, for a hasher that has the role bit) and
-/// action.
+/// action, or its best actions (`0|2`) where they tie.
 pub fn render(blob: &PolicyBlob) -> String {
     let mut out = summary(blob);
     let a = blob.actions();
@@ -18,7 +18,7 @@ pub fn render(blob: &PolicyBlob) -> String {
         if obstacle { "  obsL obsR" } else { "" },
         if role { "  role " } else { "" }
     );
-    for (state, action) in blob.table().entries() {
+    for ((state, action), (_, mask)) in blob.table().entries().zip(blob.sets().masks()) {
         let Some(i) = blob.hasher().unpack(state) else {
             continue;
         };
@@ -44,24 +44,39 @@ pub fn render(blob: &PolicyBlob) -> String {
         if role {
             let _ = write!(out, "  {}", role_name(i.innie));
         }
-        let _ = writeln!(
-            out,
-            "  {:>6}  {:+.3}",
-            action.0,
-            a.angular(action).unwrap_or(f32::NAN)
-        );
+        if mask.count_ones() > 1 {
+            // a tie: the robot picks one of these uniformly
+            let _ = writeln!(out, "  {:>6}  tie", set_text(mask));
+        } else {
+            let _ = writeln!(
+                out,
+                "  {:>6}  {:+.3}",
+                action.0,
+                a.angular(action).unwrap_or(f32::NAN)
+            );
+        }
     }
     out
 }
 
-/// The blob's header: format, hasher, actions, provenance, and how many
-/// states choose each action (for a hasher with the role bit, also per
+/// A set of actions as `0|2|3`.
+fn set_text(mask: u8) -> String {
+    (0..4u8)
+        .filter(|a| mask & (1 << a) != 0)
+        .map(|a| a.to_string())
+        .collect::<Vec<_>>()
+        .join("|")
+}
+
+/// The blob's header: format, hasher, actions, provenance, what it was
+/// trained for, how many states have tied best actions, and how many
+/// states choose each action (their lowest best action) (for a hasher with the role bit, also per
 /// role): `host policy inspect --summary`.
 pub fn summary(blob: &PolicyBlob) -> String {
     let mut out = String::new();
     let p = blob.provenance();
     let a = blob.actions();
-    let _ = writeln!(out, "format     QPOL v{}", PolicyBlob::VERSION);
+    let _ = writeln!(out, "format     QPOL v{}", blob.version());
     let _ = writeln!(
         out,
         "hasher     {} ({} states)",
@@ -78,6 +93,28 @@ pub fn summary(blob: &PolicyBlob) -> String {
     let _ = writeln!(out, "field      {}", escaped(&p.field));
     let _ = writeln!(out, "name       {}", escaped(&p.name));
     let _ = writeln!(out, "trained    {} steps, seed {}", p.trainer_steps, p.seed);
+    match blob.trained_for() {
+        Some(t) => {
+            let _ = writeln!(
+                out,
+                "for        sensors {}, arena {}",
+                escaped(&t.sensors),
+                escaped(&t.arena)
+            );
+        }
+        None => {
+            let _ = writeln!(out, "for        not recorded (sensors and arena unknown)");
+        }
+    }
+    let mut by_size = [0usize; 5];
+    for (_, mask) in blob.sets().masks() {
+        by_size[mask.count_ones() as usize] += 1;
+    }
+    let _ = writeln!(
+        out,
+        "ties       {} states with 2 best actions, {} with 3, {} with 4 (the robot picks one uniformly: ChoiceRng)",
+        by_size[2], by_size[3], by_size[4]
+    );
     // [all, outies, innies]
     let mut histogram = [[0usize; 4]; 3];
     for (state, action) in blob.table().entries() {

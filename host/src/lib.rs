@@ -7,6 +7,7 @@ pub mod atomic;
 pub mod bench;
 pub mod display;
 pub mod experiment;
+pub mod flashed;
 pub mod inspect;
 pub mod learn;
 pub mod observe;

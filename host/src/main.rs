@@ -52,6 +52,8 @@ fn run(cli: Cli) -> Result<()> {
         Command::Search(args) => search(args),
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
+        Command::Policy(PolicyCommand::Gap(args)) => policy_gap(args),
+        Command::Policy(PolicyCommand::GapTable { json, doc }) => gap_table(&json, &doc),
         Command::Monitor(args) => monitor(args),
         Command::Replay(args) => replay(args),
         Command::Flash(args) => flash(args),
@@ -63,6 +65,7 @@ fn run(cli: Cli) -> Result<()> {
 
 fn simulate(args: RunArgs) -> Result<()> {
     ranges::RUN_STEPS.check_count("host run --steps", args.steps)?;
+    warn_policy_mismatch(&args.scenario)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let summary = run_timed(&mut sim, &mut controller, args.steps);
     if args.json {
@@ -80,10 +83,12 @@ fn render(args: RenderArgs) -> Result<()> {
     ranges::RUN_STEPS.check_count("host render --steps", args.steps)?;
     ranges::FRAME_EVERY.check_count("host render --every", args.every)?;
     ranges::RENDER_SIZE.check_count("--size", u64::from(args.size))?;
+    warn_policy_mismatch(&args.scenario)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
     let options = RenderOptions {
         size: args.size,
         footprints: args.footprints,
+        band: args.band,
     };
     if let Some(path) = &args.gif {
         host::render::animate(
@@ -104,6 +109,15 @@ fn render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// Warns on stderr when `--controller policy:FILE` was trained for another
+/// sensor model or arena than the run's.
+fn warn_policy_mismatch(scenario: &cli::scenario::ScenarioArgs) -> Result<()> {
+    if let Some(warning) = scenario.policy_mismatch()? {
+        eprintln!("warning: {warning}");
+    }
+    Ok(())
+}
+
 fn bench(args: BenchArgs) -> Result<()> {
     ranges::STEPS.check_count("host bench --steps", args.steps())?;
     println!("{}", host::bench::run(&args.variant()?, args.steps())?);
@@ -120,6 +134,51 @@ fn search(args: SearchArgs) -> Result<()> {
     let report = host::search::search(&args.request())?;
     println!("{report}");
     Ok(())
+}
+
+fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
+    use host::flashed::{measure_learner, measure_policy, GapReport};
+    let mut config = match &args.config {
+        Some(path) => host::train::TrainConfig::from_file(path)?,
+        None => host::train::TrainConfig::default(),
+    };
+    args.flags.apply(&mut config)?;
+    if args.randomise {
+        config.noise = 1.0;
+    }
+    config.validate()?;
+    let blob = args
+        .policy
+        .as_deref()
+        .map(sim::control::policy_file::read)
+        .transpose()?;
+    let mut report = GapReport::load(&args.json)?;
+    let mut rows = Vec::new();
+    for &seed in &args.seeds {
+        config.seed = seed;
+        let row = match &blob {
+            Some(blob) => measure_policy(&args.label, blob, &config, args.window)?,
+            None => measure_learner(&args.label, &config, args.window)?,
+        };
+        eprintln!("{}: seed {seed}: {row:?}", args.label);
+        rows.push(row);
+    }
+    // as a shell would take it back: arguments with spaces quoted
+    let command: Vec<String> = std::env::args()
+        .skip(1)
+        .map(|a| if a.contains(' ') { format!("'{a}'") } else { a })
+        .collect();
+    report.replace(&args.label, format!("host {}", command.join(" ")), rows);
+    report.save(&args.json)
+}
+
+fn gap_table(json: &Path, doc: &Path) -> Result<()> {
+    let report = host::flashed::GapReport::load(json)?;
+    let text =
+        std::fs::read_to_string(doc).with_context(|| format!("cannot read {}", doc.display()))?;
+    let spliced = host::flashed::splice(&text, &host::flashed::render(&report))
+        .with_context(|| format!("doc {}", doc.display()))?;
+    host::atomic::write(doc, spliced.as_bytes())
 }
 
 fn inspect_policy(file: &Path, summary: bool) -> Result<()> {
@@ -163,6 +222,9 @@ fn replay(args: ReplayArgs) -> Result<()> {
 
 fn flash(args: FlashArgs) -> Result<()> {
     use host::robot::flash;
+    if let Some(warning) = flash::check_trained_for(&args.policy, args.any_sensors)? {
+        eprintln!("warning: {warning}");
+    }
     let cwd = std::env::current_dir().context("cannot read the current directory")?;
     let plan = flash::FlashPlan::new(
         &args.policy,
@@ -188,7 +250,7 @@ fn flash(args: FlashArgs) -> Result<()> {
 
 fn export_field(args: FieldExportArgs) -> Result<()> {
     let arena = args.screen.arena.screen()?;
-    let (w, h) = host::panel_file::export(&arena, &args.screen.field, &args.out)?;
+    let (w, h) = host::panel_file::export(&arena, &args.screen.field, args.band, &args.out)?;
     println!(
         "wrote {} ({w} x {h}: {} on {})",
         args.out.display(),

@@ -6,7 +6,7 @@
 
 use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-use image::GrayImage;
+use image::{DynamicImage, GrayImage, ImageBuffer, Pixel, PixelWithColorType, RgbImage};
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
 use std::path::Path;
@@ -18,8 +18,30 @@ pub fn panel_image(arena: &ArenaSpec, source: &FieldSource) -> Result<GrayImage>
     Ok(sim::scenario::panel::panel_image(arena, &field))
 }
 
+/// The panel image of `source` on `arena` in colour, with the outline of
+/// the field's target band ([`sim::scenario::field_thresholds`]) drawn
+/// over it in [`sim::render::BAND`]: a picture to look at, not to show the
+/// robots (they would read the outline as field).
+pub fn panel_image_with_band(arena: &ArenaSpec, source: &FieldSource) -> Result<RgbImage> {
+    let field = arena.load_field(source)?;
+    let (layout, thresholds) = (
+        arena.field_layout(&field),
+        sim::scenario::field_thresholds(source),
+    );
+    let mut image =
+        DynamicImage::ImageLuma8(sim::scenario::panel::panel_image(arena, &field)).into_rgb8();
+    sim::render::outline_region(&mut image, sim::render::BAND, |i, j| {
+        let value = field.shown(arena.panel_pixel_centre(i, j), &layout);
+        sim::episodes::eval::in_band(value, &thresholds)
+    });
+    Ok(image)
+}
+
 /// `image` encoded as a PNG.
-pub fn encode_png(image: &GrayImage) -> Result<Vec<u8>> {
+pub fn encode_png<P>(image: &ImageBuffer<P, Vec<u8>>) -> Result<Vec<u8>>
+where
+    P: Pixel<Subpixel = u8> + PixelWithColorType,
+{
     let mut bytes = Vec::new();
     let encoder =
         PngEncoder::new_with_quality(&mut bytes, CompressionType::Fast, FilterType::Adaptive);
@@ -29,12 +51,24 @@ pub fn encode_png(image: &GrayImage) -> Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// Writes the panel image of `source` on `arena` to `out` (atomically);
+/// Writes the panel image of `source` on `arena` to `out` (atomically),
+/// with the target band outlined if `band` ([`panel_image_with_band`]);
 /// returns its size in pixels.
-pub fn export(arena: &ArenaSpec, source: &FieldSource, out: &Path) -> Result<(u32, u32)> {
-    let image = panel_image(arena, source)?;
-    crate::atomic::write(out, &encode_png(&image)?)?;
-    Ok(image.dimensions())
+pub fn export(
+    arena: &ArenaSpec,
+    source: &FieldSource,
+    band: bool,
+    out: &Path,
+) -> Result<(u32, u32)> {
+    let (png, size) = if band {
+        let image = panel_image_with_band(arena, source)?;
+        (encode_png(&image)?, image.dimensions())
+    } else {
+        let image = panel_image(arena, source)?;
+        (encode_png(&image)?, image.dimensions())
+    };
+    crate::atomic::write(out, &png)?;
+    Ok(size)
 }
 
 #[cfg(test)]
@@ -50,7 +84,7 @@ mod tests {
             ..ArenaSpec::tv75()
         };
         let source = FieldSource::Letter(sim::fields::letters::Letter::T);
-        assert_eq!(export(&arena, &source, &out).unwrap(), (96, 54));
+        assert_eq!(export(&arena, &source, false, &out).unwrap(), (96, 54));
         let back = image::open(&out).unwrap();
         assert_eq!(back.color(), image::ColorType::L8);
         assert_eq!(
@@ -58,7 +92,49 @@ mod tests {
             sim::scenario::panel::panel_image(&arena, &arena.load_field(&source).unwrap())
         );
         let missing = FieldSource::Image("/no/such/field.png".into());
-        let e = format!("{:#}", export(&arena, &missing, &out).unwrap_err());
+        let e = format!("{:#}", export(&arena, &missing, false, &out).unwrap_err());
         assert!(e.contains("/no/such/field.png"), "{e}");
+    }
+
+    #[test]
+    fn the_band_outline_colours_exactly_the_edge_pixels_of_the_target_band() {
+        let arena = ArenaSpec {
+            screen_px: [96, 54],
+            ..ArenaSpec::tv75()
+        };
+        let source = FieldSource::Annulus;
+        let grey = panel_image(&arena, &source).unwrap();
+        let outlined = panel_image_with_band(&arena, &source).unwrap();
+        let field = arena.load_field(&source).unwrap();
+        let layout = arena.field_layout(&field);
+        let thresholds = sim::scenario::field_thresholds(&source);
+        let in_band = |i: u32, j: u32| {
+            let v = field.shown(arena.panel_pixel_centre(i, j), &layout);
+            sim::episodes::eval::in_band(v, &thresholds)
+        };
+        let (w, h) = grey.dimensions();
+        let mut edges = 0;
+        for j in 0..h {
+            for i in 0..w {
+                let neighbours = [(-1, 0), (1, 0), (0, -1), (0, 1)]
+                    .map(|(di, dj)| (i as i64 + di, j as i64 + dj))
+                    .into_iter()
+                    .filter(|&(x, y)| x >= 0 && y >= 0 && x < i64::from(w) && y < i64::from(h));
+                let edge = in_band(i, j)
+                    && neighbours
+                        .into_iter()
+                        .any(|(x, y)| !in_band(x as u32, y as u32));
+                let level = grey.get_pixel(i, j)[0];
+                let expected = if edge {
+                    edges += 1;
+                    sim::render::BAND
+                } else {
+                    image::Rgb([level; 3])
+                };
+                assert_eq!(*outlined.get_pixel(i, j), expected, "pixel ({i}, {j})");
+            }
+        }
+        // The annulus' band is a ring: an inner and an outer edge.
+        assert!(edges > 2 * 40, "{edges} edge pixels");
     }
 }

@@ -85,6 +85,7 @@ fn render_writes_a_png_and_a_gif() {
             "--size",
             "200",
             "--footprints",
+            "--band",
             "--out",
         ])
         .arg(&png)
@@ -95,8 +96,12 @@ fn render_writes_a_png_and_a_gif() {
         "{}",
         String::from_utf8_lossy(&ok.stderr)
     );
-    let img = image::open(&png).unwrap();
+    let img = image::open(&png).unwrap().into_rgb8();
     assert_eq!((img.width(), img.height()), (200, 200));
+    assert!(
+        img.pixels().any(|p| *p == sim::render::BAND),
+        "--band draws the target band's outline"
+    );
     let ok = host()
         .args([
             "render", "--steps", "200", "--every", "100", "--size", "100", "--gif",

@@ -91,3 +91,142 @@ fn the_collisions_table_says_where_its_text_column_follows_the_code() {
         "the caption explains the asterisk"
     );
 }
+
+/// One training run's table at a glance, as the author's instrumented
+/// program or `host train` printed it.
+#[derive(Debug, Default)]
+struct TableAtEnd {
+    formations: f64,
+    stuck: f64,
+    states: f64,
+    shares: Vec<f64>,
+    median: f64,
+    p90: f64,
+    tied: f64,
+}
+
+/// The number `skip` + 1 tokens after `key` among whitespace-separated
+/// tokens.
+fn after_skipping(tokens: &[&str], key: &str, skip: usize) -> f64 {
+    let at = tokens
+        .iter()
+        .position(|t| *t == key)
+        .unwrap_or_else(|| panic!("no {key} in {tokens:?}"));
+    tokens[at + 1 + skip].trim_end_matches(',').parse().unwrap()
+}
+
+/// The number after `key` among whitespace-separated tokens.
+fn after(tokens: &[&str], key: &str) -> f64 {
+    after_skipping(tokens, key, 0)
+}
+
+/// The author's program's last lines (`END`, `ACTIONS_TOTAL`, `QSTATS`).
+fn author_run(text: &str) -> TableAtEnd {
+    let mut run = TableAtEnd::default();
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        match t.first() {
+            Some(&"END") => {
+                run.formations = after(&t, "formations");
+                run.stuck = after(&t, "stuck");
+            }
+            Some(&"ACTIONS_TOTAL") => {
+                run.shares = t[1..].iter().map(|v| v.parse().unwrap()).collect()
+            }
+            Some(&"QSTATS") => {
+                run.states = after(&t, "visited_states");
+                run.tied = after(&t, "states_with_tied_max");
+                run.median = after(&t, "q50");
+                run.p90 = after(&t, "q90");
+            }
+            _ => {}
+        }
+    }
+    run
+}
+
+/// `host train`'s report.
+fn our_run(text: &str) -> TableAtEnd {
+    let mut run = TableAtEnd::default();
+    for line in text.lines() {
+        let t: Vec<&str> = line.split_whitespace().collect();
+        match t.first() {
+            Some(&"formations") => run.formations = t[1].parse().unwrap(),
+            Some(&"stuck") => run.stuck = t[2].parse().unwrap(),
+            Some(&"states") => run.states = t[2].parse().unwrap(),
+            Some(&"actions") => run.shares = t[2..].iter().map_while(|v| v.parse().ok()).collect(),
+            Some(&"values,") => {
+                run.median = after(&t, "median");
+                run.p90 = after_skipping(&t, "90", 1); // "90 % -5.629,"
+            }
+            Some(&"tied") => run.tied = after(&t, "in"),
+            _ => {}
+        }
+    }
+    run
+}
+
+/// The side-by-side table of the learners' insides is what the runs under
+/// docs/reproduction/side-by-side/ printed: the author's program and ours,
+/// the same letters, length and number of runs.
+#[test]
+fn the_side_by_side_of_the_learned_tables_is_what_the_runs_printed() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");
+    // one space between words, as the rows and claims are written
+    let template = std::fs::read_to_string(root.join("template.md"))
+        .unwrap()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let mean = |runs: &[TableAtEnd], f: &dyn Fn(&TableAtEnd) -> f64| {
+        runs.iter().map(f).sum::<f64>() / runs.len() as f64
+    };
+    let mut missing = Vec::new();
+    for letter in ["T", "V"] {
+        let mut formations = Vec::new();
+        for (program, dir, read) in [
+            (
+                "the author's",
+                "author",
+                author_run as fn(&str) -> TableAtEnd,
+            ),
+            ("ours", "ours", our_run),
+        ] {
+            let runs: Vec<TableAtEnd> = (1..=4)
+                .map(|k| {
+                    let path = root.join(format!("side-by-side/{dir}/{letter}-{k}.txt"));
+                    read(&std::fs::read_to_string(&path).unwrap())
+                })
+                .collect();
+            assert!(runs.iter().all(|r| r.shares.len() == 4), "{runs:?}");
+            formations.push(runs.iter().map(|r| r.formations).collect::<Vec<f64>>());
+            let shares: Vec<String> = (0..4)
+                .map(|a| format!("{:.3}", mean(&runs, &|r| r.shares[a])))
+                .collect();
+            let row = format!(
+                "| {letter} | {program} | {} | {:.1} | {:.1} | {:.1} | {} | {:.2} | {:.2} | {:.0} |",
+                runs.len(),
+                mean(&runs, &|r| r.formations),
+                mean(&runs, &|r| r.stuck),
+                mean(&runs, &|r| r.states),
+                shares.join(", "),
+                mean(&runs, &|r| r.median),
+                mean(&runs, &|r| r.p90),
+                runs.iter().map(|r| r.tied).sum::<f64>(),
+            );
+            if !template.contains(&row) {
+                missing.push(row);
+            }
+        }
+        let p = host::report::stats::permutation_p(&formations[0], &formations[1]).unwrap();
+        let claim = format!("p {p:.2} on {letter}");
+        if !template.contains(&claim) {
+            missing.push(claim);
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "rows the template should hold:\n{}",
+        missing.join("\n")
+    );
+}

@@ -137,6 +137,7 @@ fn driving_capture(id: u8, motors: shared::MotorCommand, counts: [i16; 2]) -> Ve
             motors,
             robot_id: id,
             encoder_counts: counts,
+            choice: None,
             ..LogFrame::default()
         };
         let mut buf = [0u8; LogFrame::MAX_ENCODED_LEN];

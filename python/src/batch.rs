@@ -450,10 +450,31 @@ mod tests {
             b.step(Actions::Discrete(&actions_of(step, 3))).unwrap();
         }
         assert_eq!(b.reset(Some(&[1])).unwrap(), fresh);
-        assert_eq!(
-            b.reset(None).unwrap(),
-            fresh,
-            "a reset right after a reseed keeps the seed's first episode"
+        let reseeded = layout(&b);
+        b.reset(None).unwrap();
+        assert_ne!(
+            layout(&b),
+            reseeded,
+            "a reset after a reseed starts the next episode"
         );
+    }
+
+    /// Every body's position in world 0.
+    fn layout(b: &Batch) -> Vec<(f64, f64)> {
+        let world = b.worlds()[0].sim().world();
+        world.bodies().iter().map(|b| (b.pos.x, b.pos.y)).collect()
+    }
+
+    #[test]
+    fn every_reset_starts_a_new_episode_and_the_first_is_the_seeds() {
+        let mut b = batch(1, Autoreset::NextStep, 1, None);
+        let built = layout(&b);
+        b.reset(None).unwrap();
+        assert_eq!(layout(&b), built, "the first reset keeps the built world");
+        b.reset(None).unwrap();
+        let second = layout(&b);
+        assert_ne!(second, built, "reset(); reset() gives two episodes");
+        b.reset(None).unwrap();
+        assert_ne!(layout(&b), second);
     }
 }

@@ -276,9 +276,9 @@ impl PyBatch {
         self.batch.settings().reward.name()
     }
 
-    /// Starts every world's next episode (a world that has not stepped
-    /// since it was built or reseeded keeps its first one); with `seeds`,
-    /// one per world, each world starts afresh from its seed. Returns the
+    /// Starts every world's next episode (the first reset of a world just
+    /// built keeps the episode its seed laid out); with `seeds`, one per
+    /// world, each world starts afresh from its seed. Returns the
     /// observations.
     #[pyo3(signature = (seeds = None))]
     fn reset<'py>(
@@ -407,14 +407,16 @@ impl PyBatch {
     }
 
     /// World `world` drawn as `host render` draws it: an RGB array of
-    /// `size` x `size` pixels (field grey, pucks red, robots blue).
-    #[pyo3(signature = (world = 0, size = 800, footprints = false))]
+    /// `size` x `size` pixels (field grey, pucks red, robots blue; with
+    /// `band` the target band outlined in cyan).
+    #[pyo3(signature = (world = 0, size = 800, footprints = false, band = false))]
     fn render<'py>(
         &self,
         py: Python<'py>,
         world: usize,
         size: u32,
         footprints: bool,
+        band: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         let world = self.world_index(world)?;
         if !(16..=4096).contains(&size) {
@@ -424,12 +426,57 @@ impl PyBatch {
         }
         let image = sim::render::draw(
             self.batch.worlds()[world].sim(),
-            RenderOptions { size, footprints },
+            RenderOptions {
+                size,
+                footprints,
+                band,
+            },
         );
         let (w, h) = (image.width() as usize, image.height() as usize);
         Ok(PyArray1::from_vec(py, image.into_raw())
             .reshape([h, w, 3])?
             .into_any())
+    }
+
+    /// World `world`'s global state, for centralised critics: per robot its
+    /// position over the arena's size (x, y in [0, 1]), its heading's
+    /// cosine and sine and the field value under it; then per puck its
+    /// position over the arena's size and the field value under it
+    /// (float32, [`PyBatch::state_size`] values).
+    #[pyo3(signature = (world = 0))]
+    fn state<'py>(&self, py: Python<'py>, world: usize) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let sim = self.batch.worlds()[self.world_index(world)?].sim();
+        let w = sim.world();
+        let (arena, layout) = (w.config().arena(), w.config().field_layout());
+        let at = |p: sim::base::vec2::Vec2| {
+            [
+                (p.x / arena.x) as f32,
+                (p.y / arena.y) as f32,
+                sim.field().evaluate(p, &layout),
+            ]
+        };
+        let mut out = Vec::with_capacity(self.state_size());
+        for (body, robot) in w.bodies().iter().zip(w.robots()) {
+            let [x, y, field] = at(body.pos);
+            out.extend([
+                x,
+                y,
+                robot.direction.x as f32,
+                robot.direction.y as f32,
+                field,
+            ]);
+        }
+        for puck in w.pucks() {
+            out.extend(at(puck.pos));
+        }
+        Ok(PyArray1::from_vec(py, out))
+    }
+
+    /// Values in [`PyBatch::state`]: 5 per robot, 3 per puck.
+    #[getter]
+    fn state_size(&self) -> usize {
+        let w = self.batch.worlds()[0].sim().world();
+        5 * w.robots().len() + 3 * w.pucks().len()
     }
 
     /// World `world`'s bodies (robots first, then pucks): an array of

@@ -55,7 +55,8 @@ pub struct WorldEnv {
     signal: f64,
     /// The last step ended the episode, and it has not been reset since.
     ended: bool,
-    /// Built or reseeded and not stepped since: a reset keeps this world.
+    /// Built and neither reset nor stepped since: the first reset starts
+    /// the episode the world was built with.
     fresh: bool,
 }
 
@@ -75,16 +76,22 @@ impl WorldEnv {
         Ok(world)
     }
 
-    /// Starts again from `seed`, as a new world of that seed would.
+    /// Starts again from `seed`, as a new world of that seed would, and
+    /// counts as its first reset (the seed's first episode has begun).
     pub fn reseed(&mut self, settings: &EnvSettings, seed: u64) -> Result<(), ScenarioError> {
         *self = WorldEnv::new(settings, seed)?;
+        self.fresh = false;
         Ok(())
     }
 
-    /// Starts a new episode, unless nothing has happened since the world
-    /// was built or reseeded (then its first episode is still to come).
+    /// Starts a new episode; the first reset of a world just built starts
+    /// the episode its seed laid out (`host run --seed`'s start), every
+    /// later one a new episode, stepped or not (`reset(); reset()` gives
+    /// two episodes).
     pub fn reset(&mut self, settings: &EnvSettings) {
-        if !self.fresh {
+        if self.fresh {
+            self.fresh = false;
+        } else {
             self.start_episode(settings);
         }
     }

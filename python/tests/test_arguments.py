@@ -41,8 +41,13 @@ BAD_SETTINGS = [
     ({"forward_speed": 1e30}, ValueError, r"forward_speed = 1e30: outside its plausible range \[0, 10\] units per step"),
     ({"render_mode": "human"}, ValueError, r"render_mode = 'human'"),
     ({"render_mode": "rgb_array", "render_size": 5}, ValueError, r"render_size = 5: must be a whole number of pixels"),
-    ({"robots": "eight"}, TypeError, r"robots"),
-    ({"robts": 8}, TypeError, r"robts"),
+    ({"robots": "eight"}, TypeError, r"robots = 'eight': expected a whole number"),
+    ({"robots": 2.5}, TypeError, r"robots = 2.5: expected a whole number"),
+    ({"pucks": True}, TypeError, r"pucks = True: expected a whole number"),
+    ({"seed": 2**70}, ValueError, r"seed = 1180591620717411303424: too large"),
+    ({"robts": 8}, TypeError, r"unknown keyword argument 'robts' \(did you mean 'robots'\?\): the environment takes field, robots, pucks"),
+    ({"robot": 8}, TypeError, r"unknown keyword argument 'robot' \(did you mean 'robots'\?\)"),
+    ({"field": "square"}, ValueError, r"no field is named \"square\" .* annulus, letter:X \(X one of T, I, L, V, X, Z\), thesis:X"),
 ]
 
 

@@ -56,6 +56,33 @@ def test_a_missing_agent_action_is_named():
         env.step({"robot_0": 0, "robot_1": 0})
 
 
+def test_an_action_for_an_agent_that_does_not_exist_is_refused():
+    env = zumo_swarm.parallel_env(robots=2, pucks=10)
+    env.reset()
+    with pytest.raises(ValueError, match="no agent is named robot_7 .*robot_0 to robot_1"):
+        env.step({"robot_0": 0, "robot_1": 0, "robot_7": 1})
+
+
+def test_the_global_state_holds_every_body_and_the_field_under_it():
+    env = zumo_swarm.parallel_env(robots=3, pucks=10, seed=2)
+    env.reset()
+    state = env.state()
+    assert env.state_space.shape == (5 * 3 + 3 * 10,) and state.dtype == np.float32
+    assert env.state_space.contains(state)
+    positions, headings = env.positions()
+    robots = state[:15].reshape(3, 5)
+    pucks = state[15:].reshape(10, 3)
+    # positions over the arena's side (the thesis' square: 800 units)
+    assert np.allclose(robots[:, :2], positions[:3] / 800.0, atol=1e-6)
+    assert np.allclose(pucks[:, :2], positions[3:] / 800.0, atol=1e-6)
+    assert np.allclose(robots[:, 2], np.cos(headings), atol=1e-6)
+    assert np.allclose(robots[:, 3], np.sin(headings), atol=1e-6)
+    assert ((0 <= pucks[:, 2]) & (pucks[:, 2] <= 1)).all()
+    env.step({agent: 1 for agent in env.agents})
+    assert not np.array_equal(env.state(), state), "the state follows the world"
+    assert "render_fps" in env.metadata
+
+
 def test_render_returns_an_rgb_picture_of_the_world():
     env = zumo_swarm.parallel_env(render_mode="rgb_array", render_size=120)
     env.reset()

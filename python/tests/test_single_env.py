@@ -53,3 +53,22 @@ def test_reset_without_a_seed_starts_a_new_episode_of_the_same_stream():
     env.step(np.zeros(3, dtype=np.int64))
     env.reset()
     assert not np.array_equal(env.positions()[0], zumo_swarm.gym_env(robots=3, pucks=20, seed=4).positions()[0])
+
+
+def test_every_reset_starts_a_new_episode_unless_given_the_same_seed():
+    env = zumo_swarm.gym_env(robots=3, pucks=20, seed=4)
+    env.reset()
+    first = env.positions()[0]
+    env.reset()
+    second = env.positions()[0]
+    assert not np.array_equal(first, second), "reset(); reset() gives two episodes"
+    env.reset(seed=4)
+    assert np.array_equal(env.positions()[0], first), "the same seed, the same episode"
+    env.reset()
+    assert not np.array_equal(env.positions()[0], first)
+
+
+def test_the_registered_environment_truncates_at_the_default_stuck_limit():
+    import gymnasium
+
+    assert gymnasium.spec("zumo_swarm/Swarm-v0").max_episode_steps == 150_000

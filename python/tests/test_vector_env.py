@@ -88,6 +88,7 @@ def test_the_single_agent_view_has_gymnasiums_shapes():
 
     made = gym.make_vec("zumo_swarm/Swarm-v0", num_envs=3, vectorization_mode="vector_entry_point", **SMALL)
     assert made.num_envs == 3 and made.single_action_space == gym.spaces.MultiDiscrete([4] * 3)
+    assert made.env.batch.max_steps == 150_000, "the spec's max_episode_steps truncates"
 
 
 def test_continuous_actions_are_angular_speeds_clipped_to_the_table():

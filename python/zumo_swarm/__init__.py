@@ -47,7 +47,8 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
 - ``render_mode=None`` or ``"rgb_array"`` (the picture ``host render``
   draws), ``render_size=800`` pixels.
 
-A bad argument raises ``ValueError`` or ``TypeError`` naming it.
+A bad argument raises ``ValueError`` or ``TypeError`` naming it; an
+unknown keyword is refused with the closest valid name and the list.
 """
 
 from __future__ import annotations
@@ -106,4 +107,7 @@ if "zumo_swarm/Swarm-v0" not in gymnasium.registry:
         id="zumo_swarm/Swarm-v0",
         entry_point="zumo_swarm.single:SwarmEnv",
         vector_entry_point="zumo_swarm.vector:make_single_agent_vector_env",
+        # the default world's stuck limit (the annulus'); letters and images
+        # truncate at their own 50,000 first
+        max_episode_steps=150_000,
     )

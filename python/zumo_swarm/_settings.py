@@ -10,6 +10,8 @@ from what the batch reports.
 
 from __future__ import annotations
 
+import difflib
+import inspect
 import json
 import os
 from collections.abc import Mapping
@@ -23,9 +25,48 @@ from zumo_swarm._native import Batch
 #: Render modes of every environment: the picture ``host render`` draws.
 RENDER_MODES = ["rgb_array"]
 
+#: The simulator settings every environment takes: the native batch's
+#: keyword arguments, less those the environments set themselves.
+SETTINGS = tuple(name for name in inspect.signature(Batch).parameters if name not in ("num_worlds", "autoreset", "threads"))
 
-def make_batch(num_worlds: int, autoreset: str, threads: int | None, settings: dict[str, Any]) -> Batch:
-    """A batch of ``num_worlds`` worlds with the environment's settings."""
+#: Settings that are whole numbers (``None`` for the default).
+WHOLE_NUMBERS = ("robots", "pucks", "seed", "max_steps")
+
+
+def check_whole(name: str, value: Any) -> None:
+    """``value`` a whole number of at most 64 bits; the simulator checks
+    its range."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{name} = {value!r}: expected a whole number")
+    if not -(2**63) <= int(value) < 2**64:
+        raise ValueError(f"{name} = {value}: too large (at most 2**64 - 1)")
+
+
+def check_names(settings: Mapping[str, Any], own: tuple[str, ...]) -> None:
+    """Every keyword a setting of the simulator or one of the
+    environment's ``own``; an unknown one is refused with the closest
+    valid name and the list."""
+    valid = SETTINGS + own
+    for name in settings:
+        if name not in SETTINGS:
+            close = difflib.get_close_matches(name, valid, n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise TypeError(f"unknown keyword argument {name!r}{hint}: the environment takes {', '.join(valid)}")
+
+
+def make_batch(
+    num_worlds: int, autoreset: str, threads: int | None, settings: dict[str, Any], own: tuple[str, ...]
+) -> Batch:
+    """A batch of ``num_worlds`` worlds with the environment's settings;
+    ``own`` names the environment's own keywords (for the message that
+    refuses an unknown one)."""
+    check_names(settings, own)
+    check_whole("num_worlds", num_worlds)
+    if threads is not None:
+        check_whole("threads", threads)
+    for name in WHOLE_NUMBERS:
+        if settings.get(name) is not None:
+            check_whole(name, settings[name])
     settings = dict(settings)
     config = settings.get("robot_config")
     if isinstance(config, Mapping):

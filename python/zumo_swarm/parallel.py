@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from zumo_swarm._settings import (
@@ -37,17 +38,18 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
     Keyword arguments: see :func:`zumo_swarm.parallel_env`.
     """
 
-    metadata = {"name": "zumo_swarm_v0", "render_modes": ["rgb_array"], "is_parallelizable": True}
+    metadata = {"name": "zumo_swarm_v0", "render_modes": ["rgb_array"], "render_fps": 30, "is_parallelizable": True}
 
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
         self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
-        self._batch = make_batch(1, "off", 1, settings)
+        self._batch = make_batch(1, "off", 1, settings, ("render_mode", "render_size"))
         self.possible_agents = [f"robot_{i}" for i in range(self._batch.robots)]
         self.agents: list[str] = []
         self._observation_space = robot_observation_space(self._batch)
         self._action_space = robot_action_space(self._batch)
-        self._last_obs = self._batch.observations()[0]
+        #: The global state :meth:`state` returns.
+        self.state_space = spaces.Box(-1.0, 1.0, shape=(self._batch.state_size,), dtype=np.float32)
 
     def observation_space(self, agent: str):
         """Every agent's observation space (the same object for all)."""
@@ -62,7 +64,6 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
 
     def reset(self, seed: int | None = None, options: dict | None = None):
         obs = self._batch.reset(None if seed is None else [seed])[0]
-        self._last_obs = obs
         self.agents = list(self.possible_agents)
         return self._observations(obs), {agent: {} for agent in self.agents}
 
@@ -72,12 +73,14 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         missing = [agent for agent in self.possible_agents if agent not in actions]
         if missing:
             raise ValueError(f"actions: no action for {', '.join(missing)}")
+        unknown = [str(agent) for agent in actions if agent not in self.possible_agents]
+        if unknown:
+            raise ValueError(f"actions: no agent is named {', '.join(unknown)} (the agents are robot_0 to robot_{len(self.possible_agents) - 1})")
         ordered = [np.asarray(actions[agent]).reshape(-1) for agent in self.possible_agents]
         if any(a.size != 1 for a in ordered):
             raise ValueError("actions: each agent's action must be one number (an action index or an angular speed)")
         stacked = np.concatenate(ordered).reshape(1, len(self.possible_agents))
         obs, rewards, terminated, truncated, info = self._batch.step(flat_actions(self._batch, stacked, stacked.shape))
-        self._last_obs = obs[0]
         reward = float(rewards[0])
         term, trunc = bool(terminated[0]), bool(truncated[0])
         scalars = world_info(info, 0)
@@ -93,8 +96,11 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         )
 
     def state(self) -> np.ndarray:
-        """Every robot's current observation, stacked."""
-        return self._last_obs
+        """The world's global state (``state_space``): per robot its position
+        over the arena's size, its heading's cosine and sine and the field
+        value under it; then per puck its position and the field value under
+        it."""
+        return self._batch.state(0)
 
     def close(self) -> None:
         pass

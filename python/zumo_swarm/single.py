@@ -36,7 +36,7 @@ class SwarmEnv(OneWorld, gym.Env):
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
         self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
-        self._batch = make_batch(1, "off", 1, settings)
+        self._batch = make_batch(1, "off", 1, settings, ("render_mode", "render_size"))
         self.observation_space = world_observation_space(self._batch)
         self.action_space = world_action_space(self._batch)
 

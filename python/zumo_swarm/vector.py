@@ -67,7 +67,9 @@ class SwarmVectorEnv(VectorEnv):
             raise ValueError(f"autoreset_mode = {autoreset_mode!r}: expected 'next-step' or 'same-step'")
         self.render_mode, self.render_size = check_render(render_mode, render_size)
         self.settings = dict(settings)
-        self._batch = make_batch(num_worlds, _AUTORESET[mode], threads, settings)
+        self._batch = make_batch(
+            num_worlds, _AUTORESET[mode], threads, settings, ("autoreset_mode", "threads", "render_mode", "render_size")
+        )
         self.num_envs = self._batch.num_worlds
         self.metadata = {"render_modes": ["rgb_array"], "autoreset_mode": mode}
         self.single_observation_space = world_observation_space(self._batch)
@@ -126,7 +128,12 @@ class SingleAgentVectorEnv(VectorWrapper):
         return obs, rewards[:, 0].copy(), terminated, truncated, info
 
 
-def make_single_agent_vector_env(num_envs: int = 1, **kwargs: Any) -> SingleAgentVectorEnv:
+def make_single_agent_vector_env(
+    num_envs: int = 1, max_episode_steps: int | None = None, **kwargs: Any
+) -> SingleAgentVectorEnv:
     """``gymnasium.make_vec``'s entry point: the single-agent view of
-    ``num_envs`` worlds."""
+    ``num_envs`` worlds; the spec's ``max_episode_steps`` truncates as
+    ``max_steps`` does, unless ``max_steps`` is given."""
+    if max_episode_steps is not None and kwargs.get("max_steps") is None:
+        kwargs["max_steps"] = max_episode_steps
     return SwarmVectorEnv(num_envs, **kwargs).single_agent_view()

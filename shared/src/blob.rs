@@ -1,12 +1,12 @@
 //! The policy blob: the file that carries a greedy policy from the trainer
 //! to the firmware.
 //!
-//! Layout, format version 1 (all multi-byte integers little-endian):
+//! Layout, format versions 1 and 2 (all multi-byte integers little-endian):
 //!
 //! | offset       | size     | content                                        |
 //! |--------------|----------|------------------------------------------------|
 //! | 0            | 4        | magic `QPOL`                                   |
-//! | 4            | 1        | format version (1)                             |
+//! | 4            | 1        | format version (1 or 2)                        |
 //! | 5            | 2        | body length `n` (u16)                          |
 //! | 7            | n        | body, postcard-encoded (see [`PolicyBlob`])    |
 //! | 7 + n        | 4        | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 7+n` |
@@ -14,13 +14,18 @@
 //! The body holds, in order: hasher (its bit count, u8), action count (u8),
 //! four angular speeds (f32, unused ones 0), forward speed (f32), field name
 //! and free-text name (strings of at most 32 bytes), trainer steps and seed
-//! (varint u64), and the packed [`PolicyTable`] (byte string).
+//! (varint u64), then in version 1 the packed [`PolicyTable`] (byte
+//! string, one action per state), in version 2 the packed [`ActionSets`]
+//! (byte string, each state's best actions) and the sensor model and arena
+//! the policy was trained for ([`TrainedFor`], two strings of at most 32
+//! bytes, empty when not known).
 //!
 //! Decoding checks, in order: length of the fixed header, magic, version,
 //! declared length against the input, CRC, then each body field. The first
 //! failure is returned as a [`BlobError`]; decoding never panics.
 
 use crate::action::{ActionId, ActionTable, ActionTableError};
+use crate::action_sets::ActionSets;
 use crate::hasher::{State, StateHasher};
 use crate::policy::PolicyTable;
 use core::fmt;
@@ -36,8 +41,9 @@ pub type Name = heapless::String<MAX_NAME_LEN>;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
 const HEADER_LEN: usize = 7;
 const CRC_LEN: usize = 4;
-/// Largest body: 2 + 16 + 4 + (1 + 32) x 2 + 10 x 2 + (2 + 256).
-const MAX_BODY_LEN: usize = 366;
+/// Largest body: 2 + 16 + 4 + (1 + 32) x 2 + 10 x 2, then version 2's
+/// (2 + 512) + (1 + 32) x 2 (version 1's table is at most 2 + 256).
+const MAX_BODY_LEN: usize = 688;
 
 /// Where a policy came from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -52,13 +58,39 @@ pub struct Provenance {
     pub seed: u64,
 }
 
-/// Which of the two names an error is about.
+/// Which of the names an error is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum NameKind {
     /// [`Provenance::field`].
     Field,
     /// [`Provenance::name`].
     Name,
+    /// [`TrainedFor::sensors`].
+    Sensors,
+    /// [`TrainedFor::arena`].
+    Arena,
+}
+
+/// The sensor model and arena a policy was trained for (format version 2):
+/// a policy learnt with the robot's senses on the TV acts on what those
+/// senses report, so running it elsewhere is worth a word
+/// (`host run`, `render` and `flash` compare them).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct TrainedFor {
+    /// The sensor model (`disc`, `disc-thesis`, `robot`, ...).
+    pub sensors: Name,
+    /// The arena (`thesis`, `tv75`, an arena file's name).
+    pub arena: Name,
+}
+
+impl TrainedFor {
+    /// Trained-for names checked against [`MAX_NAME_LEN`].
+    pub fn new(sensors: &str, arena: &str) -> Result<TrainedFor, BlobError> {
+        Ok(TrainedFor {
+            sensors: to_name(NameKind::Sensors, sensors)?,
+            arena: to_name(NameKind::Arena, arena)?,
+        })
+    }
 }
 
 impl Provenance {
@@ -76,6 +108,16 @@ impl Provenance {
             seed,
         })
     }
+}
+
+/// The longest prefix of `s` of at most [`MAX_NAME_LEN`] bytes (cut at a
+/// character boundary): a name that always fits.
+pub fn name_prefix(s: &str) -> &str {
+    let mut end = s.len().min(MAX_NAME_LEN);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    &s[..end]
 }
 
 fn to_name(kind: NameKind, s: &str) -> Result<Name, BlobError> {
@@ -125,6 +167,8 @@ pub enum BlobError {
     ActionCount(u8),
     /// An angular or forward speed is NaN or infinite.
     NonFiniteSpeed,
+    /// A state's set of best actions is empty (format version 2).
+    EmptyActionSet(State),
     /// A table entry names an action beyond the action count.
     ActionOutOfRange {
         /// The state whose entry is wrong.
@@ -161,7 +205,7 @@ impl fmt::Display for BlobError {
             BlobError::UnsupportedVersion(v) => {
                 write!(
                     f,
-                    "unsupported policy blob format version {v} (this build reads version {})",
+                    "unsupported policy blob format version {v} (this build reads versions 1 to {})",
                     PolicyBlob::VERSION
                 )
             }
@@ -198,6 +242,9 @@ impl fmt::Display for BlobError {
                 ActionTable::MAX_ACTIONS
             ),
             BlobError::NonFiniteSpeed => f.write_str("an action speed is not a finite number"),
+            BlobError::EmptyActionSet(state) => {
+                write!(f, "state {state} has no best action")
+            }
             BlobError::ActionOutOfRange {
                 state,
                 action,
@@ -212,6 +259,8 @@ impl fmt::Display for BlobError {
                 let which = match kind {
                     NameKind::Field => "field name",
                     NameKind::Name => "name",
+                    NameKind::Sensors => "sensor model name",
+                    NameKind::Arena => "arena name",
                 };
                 write!(
                     f,
@@ -234,7 +283,7 @@ impl From<ActionTableError> for BlobError {
     }
 }
 
-/// The body as it is on the wire; the header and CRC wrap it.
+/// The version 1 body as it is on the wire; the header and CRC wrap it.
 #[derive(Serialize, Deserialize)]
 struct Body<'a> {
     hasher: u8,
@@ -249,23 +298,49 @@ struct Body<'a> {
     table: &'a [u8],
 }
 
+/// The version 2 body: version 1's with action sets in place of the table,
+/// then what the policy was trained for.
+#[derive(Serialize, Deserialize)]
+struct BodyV2<'a> {
+    hasher: u8,
+    action_count: u8,
+    angular_speeds: [f32; ActionTable::MAX_ACTIONS],
+    forward_speed: f32,
+    field: &'a str,
+    name: &'a str,
+    trainer_steps: u64,
+    seed: u64,
+    #[serde(borrow)]
+    sets: &'a [u8],
+    sensors: &'a str,
+    arena: &'a str,
+}
+
 /// An encoded blob.
 pub type EncodedBlob = heapless::Vec<u8, { PolicyBlob::MAX_ENCODED_LEN }>;
 
 /// A greedy policy with everything needed to run it: the hasher (carried
-/// by the table), the actions, and where it came from.
+/// by the table), the actions, each state's best actions, where it came
+/// from and what it was trained for.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PolicyBlob {
     actions: ActionTable,
     table: PolicyTable,
+    sets: ActionSets,
     provenance: Provenance,
+    trained_for: Option<TrainedFor>,
 }
 
 impl PolicyBlob {
     /// The magic bytes every blob starts with.
     pub const MAGIC: [u8; 4] = *b"QPOL";
-    /// The format version this build writes and reads.
-    pub const VERSION: u8 = 1;
+    /// The newest format version this build writes and reads (it reads
+    /// every version from 1).
+    pub const VERSION: u8 = 2;
+    /// The format version of a blob with one action per state and nothing
+    /// about what it was trained for: what every build before version 2
+    /// wrote, and what [`PolicyBlob::encode`] still writes for such a blob.
+    pub const VERSION_1: u8 = 1;
     /// Upper bound of an encoded blob's size (1024 states, longest names).
     pub const MAX_ENCODED_LEN: usize = HEADER_LEN + MAX_BODY_LEN + CRC_LEN;
 
@@ -284,9 +359,71 @@ impl PolicyBlob {
         }
         Ok(PolicyBlob {
             actions,
+            sets: ActionSets::of_table(&table),
             table,
             provenance,
+            trained_for: None,
         })
+    }
+
+    /// A blob from each state's best actions, checked: no set is empty and
+    /// every action is one of `actions`. Its [`PolicyBlob::table`] is each
+    /// set's lowest action.
+    pub fn with_sets(
+        actions: ActionTable,
+        sets: ActionSets,
+        provenance: Provenance,
+    ) -> Result<PolicyBlob, BlobError> {
+        for (state, mask) in sets.masks() {
+            if mask == 0 {
+                return Err(BlobError::EmptyActionSet(state));
+            }
+            let highest = 7 - mask.leading_zeros() as usize;
+            if highest >= actions.len() {
+                return Err(BlobError::ActionOutOfRange {
+                    state,
+                    action: ActionId(highest as u8),
+                    count: actions.len() as u8,
+                });
+            }
+        }
+        Ok(PolicyBlob {
+            actions,
+            table: sets.lowest(),
+            sets,
+            provenance,
+            trained_for: None,
+        })
+    }
+
+    /// This blob, recording the sensor model and arena it was trained for.
+    pub fn with_trained_for(mut self, trained_for: TrainedFor) -> PolicyBlob {
+        self.trained_for = Some(trained_for);
+        self
+    }
+
+    /// The sensor model and arena the policy was trained for, if the blob
+    /// says (format version 2 with them given).
+    pub fn trained_for(&self) -> Option<&TrainedFor> {
+        self.trained_for.as_ref()
+    }
+
+    /// Each state's best actions; a blob of version 1 has one per state,
+    /// its table's.
+    pub fn sets(&self) -> &ActionSets {
+        &self.sets
+    }
+
+    /// The format version [`PolicyBlob::encode`] writes: 2 when the blob
+    /// has a state with two or more best actions or says what it was
+    /// trained for, else 1 (so that such a blob is byte for byte what
+    /// builds before version 2 wrote).
+    pub fn version(&self) -> u8 {
+        if self.trained_for.is_some() || self.sets.has_ties() {
+            Self::VERSION
+        } else {
+            Self::VERSION_1
+        }
     }
 
     /// The state hasher the table is indexed by.
@@ -309,27 +446,54 @@ impl PolicyBlob {
         &self.provenance
     }
 
-    /// Encodes the blob.
+    /// Encodes the blob, in format version [`PolicyBlob::version`].
     pub fn encode(&self) -> EncodedBlob {
         let mut angular_speeds = [0.0; ActionTable::MAX_ACTIONS];
         angular_speeds[..self.actions.len()].copy_from_slice(self.actions.angular_speeds());
-        let body = Body {
-            hasher: self.hasher().id(),
-            action_count: self.actions.len() as u8,
-            angular_speeds,
-            forward_speed: self.actions.forward_speed(),
-            field: &self.provenance.field,
-            name: &self.provenance.name,
-            trainer_steps: self.provenance.trainer_steps,
-            seed: self.provenance.seed,
-            table: self.table.packed(),
-        };
+        let version = self.version();
         let mut buf = [0u8; PolicyBlob::MAX_ENCODED_LEN];
-        let body_len = postcard::to_slice(&body, &mut buf[HEADER_LEN..HEADER_LEN + MAX_BODY_LEN])
-            .expect("a body never exceeds MAX_BODY_LEN: names and table are bounded by their types")
-            .len();
+        let out = &mut buf[HEADER_LEN..HEADER_LEN + MAX_BODY_LEN];
+        let written = if version == Self::VERSION_1 {
+            postcard::to_slice(
+                &Body {
+                    hasher: self.hasher().id(),
+                    action_count: self.actions.len() as u8,
+                    angular_speeds,
+                    forward_speed: self.actions.forward_speed(),
+                    field: &self.provenance.field,
+                    name: &self.provenance.name,
+                    trainer_steps: self.provenance.trainer_steps,
+                    seed: self.provenance.seed,
+                    table: self.table.packed(),
+                },
+                out,
+            )
+            .map(|b| b.len())
+        } else {
+            let trained_for = self.trained_for.clone().unwrap_or_default();
+            postcard::to_slice(
+                &BodyV2 {
+                    hasher: self.hasher().id(),
+                    action_count: self.actions.len() as u8,
+                    angular_speeds,
+                    forward_speed: self.actions.forward_speed(),
+                    field: &self.provenance.field,
+                    name: &self.provenance.name,
+                    trainer_steps: self.provenance.trainer_steps,
+                    seed: self.provenance.seed,
+                    sets: self.sets.packed(),
+                    sensors: &trained_for.sensors,
+                    arena: &trained_for.arena,
+                },
+                out,
+            )
+            .map(|b| b.len())
+        };
+        let body_len = written.expect(
+            "a body never exceeds MAX_BODY_LEN: names and tables are bounded by their types",
+        );
         buf[..4].copy_from_slice(&Self::MAGIC);
-        buf[4] = Self::VERSION;
+        buf[4] = version;
         buf[5..7].copy_from_slice(&(body_len as u16).to_le_bytes());
         let end = HEADER_LEN + body_len;
         let crc = CRC32.checksum(&buf[..end]);
@@ -352,8 +516,9 @@ impl PolicyBlob {
         if magic != Self::MAGIC {
             return Err(BlobError::WrongMagic(magic));
         }
-        if bytes[4] != Self::VERSION {
-            return Err(BlobError::UnsupportedVersion(bytes[4]));
+        let version = bytes[4];
+        if version != Self::VERSION_1 && version != Self::VERSION {
+            return Err(BlobError::UnsupportedVersion(version));
         }
         let body_len = usize::from(u16::from_le_bytes([bytes[5], bytes[6]]));
         let end = HEADER_LEN + body_len;
@@ -377,42 +542,82 @@ impl PolicyBlob {
             return Err(BlobError::CrcMismatch { stored, computed });
         }
         let body_bytes = &bytes[HEADER_LEN..end];
-        let (body, rest): (Body<'_>, &[u8]) =
-            postcard::take_from_bytes(body_bytes).map_err(|e| match e {
-                postcard::Error::DeserializeUnexpectedEnd => BlobError::Truncated {
-                    needed: body_len + 1,
-                    found: body_len,
-                },
-                postcard::Error::DeserializeBadUtf8 => {
-                    BlobError::Malformed("a name is not valid UTF-8")
-                }
-                postcard::Error::DeserializeBadVarint => {
-                    BlobError::Malformed("an integer is not a valid varint")
-                }
-                _ => BlobError::Malformed("the body does not decode"),
-            })?;
-        if !rest.is_empty() {
-            return Err(BlobError::Malformed(
-                "the body is shorter than its declared length",
-            ));
+        if version == Self::VERSION_1 {
+            let body: Body<'_> = take_body(body_bytes)?;
+            let (hasher, actions) = hasher_and_actions(
+                body.hasher,
+                body.action_count,
+                &body.angular_speeds,
+                body.forward_speed,
+            )?;
+            let table =
+                PolicyTable::from_packed(hasher, body.table).ok_or(BlobError::TableLength {
+                    hasher,
+                    expected: PolicyTable::packed_len(hasher),
+                    found: body.table.len(),
+                })?;
+            let provenance = Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
+            PolicyBlob::new(actions, table, provenance)
+        } else {
+            let body: BodyV2<'_> = take_body(body_bytes)?;
+            let (hasher, actions) = hasher_and_actions(
+                body.hasher,
+                body.action_count,
+                &body.angular_speeds,
+                body.forward_speed,
+            )?;
+            let sets =
+                ActionSets::from_packed(hasher, body.sets).ok_or(BlobError::TableLength {
+                    hasher,
+                    expected: ActionSets::packed_len(hasher),
+                    found: body.sets.len(),
+                })?;
+            let provenance = Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
+            let trained_for = TrainedFor::new(body.sensors, body.arena)?;
+            let blob = PolicyBlob::with_sets(actions, sets, provenance)?;
+            Ok(if trained_for == TrainedFor::default() {
+                blob
+            } else {
+                blob.with_trained_for(trained_for)
+            })
         }
-        Self::from_body(&body)
     }
+}
 
-    fn from_body(body: &Body<'_>) -> Result<PolicyBlob, BlobError> {
-        let hasher =
-            StateHasher::from_id(body.hasher).ok_or(BlobError::UnknownHasher(body.hasher))?;
-        let count = usize::from(body.action_count);
-        if !(ActionTable::MIN_ACTIONS..=ActionTable::MAX_ACTIONS).contains(&count) {
-            return Err(BlobError::ActionCount(body.action_count));
+/// A body of either version, all of `bytes` used.
+fn take_body<'a, T: Deserialize<'a>>(bytes: &'a [u8]) -> Result<T, BlobError> {
+    let (body, rest): (T, &[u8]) = postcard::take_from_bytes(bytes).map_err(|e| match e {
+        postcard::Error::DeserializeUnexpectedEnd => BlobError::Truncated {
+            needed: bytes.len() + 1,
+            found: bytes.len(),
+        },
+        postcard::Error::DeserializeBadUtf8 => BlobError::Malformed("a name is not valid UTF-8"),
+        postcard::Error::DeserializeBadVarint => {
+            BlobError::Malformed("an integer is not a valid varint")
         }
-        let actions = ActionTable::new(&body.angular_speeds[..count], body.forward_speed)?;
-        let table = PolicyTable::from_packed(hasher, body.table).ok_or(BlobError::TableLength {
-            hasher,
-            expected: PolicyTable::packed_len(hasher),
-            found: body.table.len(),
-        })?;
-        let provenance = Provenance::new(body.field, body.name, body.trainer_steps, body.seed)?;
-        PolicyBlob::new(actions, table, provenance)
+        _ => BlobError::Malformed("the body does not decode"),
+    })?;
+    if !rest.is_empty() {
+        return Err(BlobError::Malformed(
+            "the body is shorter than its declared length",
+        ));
     }
+    Ok(body)
+}
+
+/// The hasher and actions of a body of either version.
+fn hasher_and_actions(
+    hasher: u8,
+    action_count: u8,
+    angular_speeds: &[f32; ActionTable::MAX_ACTIONS],
+    forward_speed: f32,
+) -> Result<(StateHasher, ActionTable), BlobError> {
+    let id = hasher;
+    let hasher = StateHasher::from_id(id).ok_or(BlobError::UnknownHasher(id))?;
+    let count = usize::from(action_count);
+    if !(ActionTable::MIN_ACTIONS..=ActionTable::MAX_ACTIONS).contains(&count) {
+        return Err(BlobError::ActionCount(action_count));
+    }
+    let actions = ActionTable::new(&angular_speeds[..count], forward_speed)?;
+    Ok((hasher, actions))
 }

@@ -9,6 +9,8 @@
 //!   `docs/state-hash.md`;
 //! - [`ActionTable`]: the angular speeds a policy chooses among;
 //! - [`PolicyTable`]: the greedy policy, 2 bits per state;
+//! - [`ActionSets`]: each state's best actions, 4 bits per state, and
+//!   [`ChoiceRng`], the robot's seeded choice among them;
 //! - [`PolicyBlob`]: the versioned, checksummed file that carries a policy
 //!   from the trainer to the firmware;
 //! - [`FieldCalibration`]: RC discharge times -> the field values the
@@ -25,9 +27,11 @@
 #![warn(missing_docs)]
 
 pub mod action;
+pub mod action_sets;
 pub mod blob;
 pub mod calibration;
 pub mod camera;
+pub mod choice;
 pub mod drive;
 pub mod field;
 pub mod hasher;
@@ -37,9 +41,11 @@ pub mod policy;
 pub mod reading;
 
 pub use action::{ActionId, ActionTable, ActionTableError};
-pub use blob::{BlobError, PolicyBlob, Provenance};
+pub use action_sets::ActionSets;
+pub use blob::{BlobError, PolicyBlob, Provenance, TrainedFor};
 pub use calibration::{FieldCalibration, FieldScales, SensorCurve, SensorRange, SensorScale};
 pub use camera::{BlobSummary, CameraConfig, ImageRegion, PixyBlock};
+pub use choice::ChoiceRng;
 pub use drive::{ActionMotors, DriveOutputs, MotorCommand, MotorOutput, RobotProfile};
 pub use field::FieldValue;
 pub use hasher::{Role, State, StateHasher, StateInputs};

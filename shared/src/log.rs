@@ -1,7 +1,7 @@
 //! The robot's log frame: one per control period, sent on the serial line
 //! and decoded on the host with this same code.
 //!
-//! Wire format, format version 3:
+//! Wire format, format version 4:
 //!
 //! ```text
 //! COBS( version (1 byte) | postcard(LogFrame) | CRC-16 (LE) ) | 0x00
@@ -9,8 +9,11 @@
 //!
 //! Version 2 added [`LogFrame::calibration`], so that a host can recompute
 //! the calibrated values from the raw times (`host replay`); version 3
-//! added [`LogFrame::robot_id`] and [`LogFrame::encoder_counts`] (odometry).
-//! Frames of other versions are refused, by their version.
+//! added [`LogFrame::robot_id`] and [`LogFrame::encoder_counts`] (odometry);
+//! version 4 added [`LogFrame::choice`], the robot's choice generator
+//! before the decision, so that a host rechecks decisions sampled among a
+//! state's best actions. Frames of other versions are refused, by their
+//! version.
 //!
 //! - The first byte of every format's payload is its version, so a host
 //!   refuses frames of another format with [`LogError::UnsupportedVersion`]
@@ -37,9 +40,9 @@ const CRC16: Crc<u16, NoTable> = Crc::<u16, NoTable>::new(&CRC_16_IBM_3740);
 /// Largest body postcard can produce for a [`LogFrame`] (every varint at
 /// its longest): tick, mode, faults, raw times, values, blobs, blocks,
 /// state, action, motors, the calibration (tag + six times), the robot id
-/// and the two encoder counts.
+/// the two encoder counts and the choice generator's state (tag + u16).
 const MAX_BODY_LEN: usize =
-    5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3;
+    5 + 1 + 1 + 3 * 3 + 3 * 3 + 4 + 1 + 3 + 1 + 3 * 2 + 1 + 6 * 3 + 1 + 2 * 3 + 1 + 3;
 /// Version byte + body + CRC.
 const MAX_RAW_LEN: usize = 1 + MAX_BODY_LEN + 2;
 
@@ -157,6 +160,12 @@ pub struct LogFrame {
     /// before this one (while the previous frame's motor commands drove);
     /// positive = forward.
     pub encoder_counts: [i16; 2],
+    /// When this period's decision drew from the robot's
+    /// [`crate::ChoiceRng`] (its state had two or more best actions): the
+    /// generator's state before the draw, which with the state's best
+    /// actions gives `action` (`ChoiceRng::from_state(s).pick(mask)`), so a
+    /// host rechecks every sampled decision. `None` when it did not draw.
+    pub choice: Option<u16>,
 }
 
 /// Why a frame was refused.
@@ -219,7 +228,7 @@ pub type EncodedFrame = [u8; LogFrame::MAX_ENCODED_LEN];
 
 impl LogFrame {
     /// The format version this build writes and reads.
-    pub const VERSION: u8 = 3;
+    pub const VERSION: u8 = 4;
     /// The robot repeats its calibration at least every this many frames
     /// (one second), so a host that starts listening mid-run learns it.
     pub const CALIBRATION_EVERY: u8 = 50;
@@ -313,6 +322,7 @@ mod tests {
             calibration: None,
             robot_id: 7,
             encoder_counts: [81, -12],
+            choice: Some(0x1234),
         }
     }
 
@@ -360,12 +370,13 @@ mod tests {
             }),
             robot_id: u8::MAX,
             encoder_counts: [i16::MIN; 2],
+            choice: Some(u16::MAX),
         };
         let (buf, n) = encoded(&big);
         assert!(n <= LogFrame::MAX_ENCODED_LEN);
         assert_eq!(
             LogFrame::MAX_ENCODED_LEN,
-            71,
+            75,
             "docs/firmware.md states this bound"
         );
         assert_eq!(LogFrame::decode(&buf[..n]), Ok(big));
@@ -473,11 +484,11 @@ mod tests {
         }
 
         #[test]
-        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>(), id in any::<u8>(), counts in any::<[i16; 2]>()) {
+        fn any_frame_round_trips(tick in any::<u32>(), raw in any::<[u16; 3]>(), state in 0u16..1024, l in -400i16..=400, r in -400i16..=400, cal in any::<Option<[u16; 6]>>(), id in any::<u8>(), counts in any::<[i16; 2]>(), choice in any::<Option<u16>>()) {
             let calibration = cal.map(|t| FieldCalibration {
                 ranges: [SensorRange { bright: t[0], dark: t[1] }, SensorRange { bright: t[2], dark: t[3] }, SensorRange { bright: t[4], dark: t[5] }],
             });
-            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, calibration, robot_id: id, encoder_counts: counts, ..sample() };
+            let f = LogFrame { tick, raw_times: raw, state: State(state), motors: MotorCommand { left: l, right: r }, calibration, robot_id: id, encoder_counts: counts, choice, ..sample() };
             let (buf, n) = encoded(&f);
             prop_assert_eq!(LogFrame::decode(&buf[..n]), Ok(f));
         }

@@ -4,7 +4,8 @@ use proptest::prelude::*;
 use serde::Serialize;
 use shared::blob::NameKind;
 use shared::{
-    ActionId, ActionTable, BlobError, PolicyBlob, PolicyTable, Provenance, State, StateHasher,
+    ActionId, ActionSets, ActionTable, BlobError, PolicyBlob, PolicyTable, Provenance, State,
+    StateHasher, TrainedFor,
 };
 
 const LONG_NAME: &str = "abcdefghijklmnopqrstuvwxyz012345"; // 32 bytes
@@ -149,10 +150,12 @@ fn wrong_magic() {
 #[test]
 fn unsupported_version() {
     let body = postcard::to_allocvec(&WireBody::valid(&[0; 64])).unwrap();
-    assert_eq!(
-        PolicyBlob::decode(&frame(2, &body)),
-        Err(BlobError::UnsupportedVersion(2))
-    );
+    for version in [0, 3, 255] {
+        assert_eq!(
+            PolicyBlob::decode(&frame(version, &body)),
+            Err(BlobError::UnsupportedVersion(version))
+        );
+    }
 }
 
 #[test]
@@ -341,6 +344,19 @@ proptest! {
     fn decoder_never_panics_on_framed_arbitrary_bodies(body in proptest::collection::vec(any::<u8>(), 0..400)) {
         // A correct header and CRC around garbage reaches the body decoder.
         let _ = PolicyBlob::decode(&frame(1, &body));
+        let _ = PolicyBlob::decode(&frame(2, &body));
+    }
+
+    #[test]
+    fn decoder_never_panics_on_mutated_version_2_blobs(
+        edits in proptest::collection::vec((0usize..400, any::<u8>()), 1..8)
+    ) {
+        let mut bytes = tied(StateHasher::Original, ActionTable::default()).encode().to_vec();
+        for (i, b) in edits {
+            let n = bytes.len();
+            bytes[i % n] = b;
+        }
+        let _ = PolicyBlob::decode(&bytes);
     }
 
     #[test]
@@ -362,4 +378,183 @@ fn every_error_type_is_a_standard_error() {
     is_error(&shared::BlobError::NonFiniteSpeed);
     is_error(&shared::LogError::BadCobs);
     is_error(&shared::ActionTableError::NonFiniteSpeed);
+}
+
+// ---- format version 2: each state's best actions and what it was trained for
+
+/// A blob with a mix of one-, two-, three- and all-action sets (as many as
+/// the action count allows) that says what it was trained for.
+fn tied(hasher: StateHasher, actions: ActionTable) -> PolicyBlob {
+    let all = (1u8 << actions.len()) - 1;
+    let mut sets = ActionSets::new(hasher);
+    for s in 0..hasher.num_states() as u16 {
+        let mask = ((s as u8).wrapping_mul(7) ^ (s / 3) as u8) & all;
+        sets.set(State(s), if mask == 0 { all } else { mask });
+    }
+    let provenance = Provenance::new(LONG_NAME, LONG_NAME, 5_000_000, u64::MAX).unwrap();
+    PolicyBlob::with_sets(actions, sets, provenance)
+        .unwrap()
+        .with_trained_for(TrainedFor::new("robot", LONG_NAME).unwrap())
+}
+
+/// The version 2 wire body, written out independently of the crate.
+#[derive(Serialize)]
+struct WireBodyV2<'a> {
+    hasher: u8,
+    action_count: u8,
+    angular_speeds: [f32; 4],
+    forward_speed: f32,
+    field: &'a str,
+    name: &'a str,
+    trainer_steps: u64,
+    seed: u64,
+    sets: &'a [u8],
+    sensors: &'a str,
+    arena: &'a str,
+}
+
+fn framed_v2(sets: &[u8], sensors: &str, arena: &str) -> Vec<u8> {
+    let body = WireBodyV2 {
+        hasher: 8,
+        action_count: 4,
+        angular_speeds: [0.3, 0.15, -0.15, -0.3],
+        forward_speed: 2.0,
+        field: "annulus",
+        name: "test",
+        trainer_steps: 10,
+        seed: 1,
+        sets,
+        sensors,
+        arena,
+    };
+    frame(2, &postcard::to_allocvec(&body).unwrap())
+}
+
+#[test]
+fn a_version_2_blob_round_trips_for_every_hasher_and_action_count() {
+    for hasher in StateHasher::ALL {
+        for n in 2..=4 {
+            let actions = ActionTable::new(&ActionTable::DEFAULT_ANGULAR[..n], 1.5).unwrap();
+            let blob = tied(hasher, actions);
+            let bytes = blob.encode();
+            assert_eq!(bytes[4], 2, "{hasher} with {n} actions");
+            assert!(bytes.len() <= PolicyBlob::MAX_ENCODED_LEN);
+            let back = PolicyBlob::decode(&bytes).unwrap();
+            assert_eq!(back, blob, "{hasher} with {n} actions");
+            assert_eq!(back.sets(), blob.sets());
+            assert_eq!(back.trained_for(), blob.trained_for());
+        }
+    }
+}
+
+#[test]
+fn a_version_2_blob_is_the_documented_wire_body() {
+    let mut sets = ActionSets::new(StateHasher::Original);
+    for s in 0..256u16 {
+        sets.set(State(s), if s % 5 == 0 { 0b1010 } else { 0b0001 });
+    }
+    let provenance = Provenance::new("annulus", "test", 10, 1).unwrap();
+    let blob = PolicyBlob::with_sets(ActionTable::default(), sets.clone(), provenance)
+        .unwrap()
+        .with_trained_for(TrainedFor::new("disc", "thesis").unwrap());
+    assert_eq!(
+        blob.encode().to_vec(),
+        framed_v2(sets.packed(), "disc", "thesis")
+    );
+    // its table, for whatever wants one action, is each set's lowest
+    assert_eq!(blob.table().action(State(5)), ActionId(1));
+    assert_eq!(blob.table().action(State(6)), ActionId(0));
+}
+
+#[test]
+fn a_blob_without_ties_or_trained_for_is_still_written_as_version_1() {
+    let blob = default_blob();
+    assert_eq!(blob.version(), 1);
+    assert_eq!(blob.encode()[4], 1);
+    let with = blob
+        .clone()
+        .with_trained_for(TrainedFor::new("disc", "thesis").unwrap());
+    assert_eq!(with.version(), 2);
+    // a version 1 blob decodes to single-action sets: its table's
+    let back = PolicyBlob::decode(&blob.encode()).unwrap();
+    assert_eq!(back.sets(), &ActionSets::of_table(blob.table()));
+    assert_eq!(back.trained_for(), None);
+}
+
+#[test]
+fn every_single_bit_flip_of_a_version_2_blob_is_rejected() {
+    for hasher in [StateHasher::Original, StateHasher::OriginalObstacle] {
+        let bytes = tied(hasher, ActionTable::default()).encode();
+        for i in 0..bytes.len() * 8 {
+            let mut corrupt = bytes.to_vec();
+            corrupt[i / 8] ^= 1 << (i % 8);
+            assert!(
+                PolicyBlob::decode(&corrupt).is_err(),
+                "{hasher}: flip of bit {i} accepted"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_truncation_of_a_version_2_blob_is_rejected() {
+    let bytes = tied(StateHasher::Original, ActionTable::default()).encode();
+    for len in 0..bytes.len() {
+        let err = PolicyBlob::decode(&bytes[..len]).unwrap_err();
+        assert!(
+            matches!(err, BlobError::Truncated { .. }),
+            "length {len}: {err:?}"
+        );
+    }
+}
+
+#[test]
+fn version_2_refuses_empty_sets_missing_actions_wrong_lengths_and_long_names() {
+    let mut sets = [0x11u8; 128];
+    sets[3] = 0x10; // state 6's set is empty
+    assert_eq!(
+        PolicyBlob::decode(&framed_v2(&sets, "disc", "thesis")),
+        Err(BlobError::EmptyActionSet(State(6)))
+    );
+    let two = ActionTable::new(&[0.3, -0.3], 2.0).unwrap();
+    let mut beyond = ActionSets::new(StateHasher::Original);
+    for s in 0..256u16 {
+        beyond.set(State(s), 0b0001);
+    }
+    beyond.set(State(9), 0b0101);
+    assert_eq!(
+        PolicyBlob::with_sets(two, beyond, Provenance::default()),
+        Err(BlobError::ActionOutOfRange {
+            state: State(9),
+            action: ActionId(2),
+            count: 2
+        })
+    );
+    assert!(matches!(
+        PolicyBlob::decode(&framed_v2(&[0x11; 64], "disc", "thesis")),
+        Err(BlobError::TableLength {
+            expected: 128,
+            found: 64,
+            ..
+        })
+    ));
+    let long = "x".repeat(33);
+    assert!(matches!(
+        PolicyBlob::decode(&framed_v2(&[0x11; 128], &long, "thesis")),
+        Err(BlobError::NameTooLong {
+            kind: NameKind::Sensors,
+            len: 33
+        })
+    ));
+    assert!(matches!(
+        TrainedFor::new("disc", &long),
+        Err(BlobError::NameTooLong {
+            kind: NameKind::Arena,
+            ..
+        })
+    ));
+    // empty trained-for names read as "not known"
+    let unknown = PolicyBlob::decode(&framed_v2(&[0x31; 128], "", "")).unwrap();
+    assert_eq!(unknown.trained_for(), None);
+    assert!(unknown.sets().has_ties());
 }

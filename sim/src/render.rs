@@ -1,12 +1,15 @@
 //! Pictures of the world like the thesis' Figure 11: the field as a grey
 //! background (0 black, 1 white), pucks red, robots blue with a heading
-//! line, optionally each robot's sensor footprints. (Writing them as PNG
-//! or GIF files is the host's.)
+//! line, optionally the outline of the target band (cyan: the edge of the
+//! region whose field value lies between the thresholds, where Eval wants
+//! every puck) and each robot's sensor footprints. (Writing them as PNG or
+//! GIF files is the host's.)
 //!
 //! Room 11 of the simulator (`lib.rs`), at the top: it reads a simulation and
 //! changes nothing.
 
 use crate::base::vec2::Vec2;
+use crate::episodes::eval::in_band;
 use crate::fields::ScalarField;
 use crate::sensors::{FootprintKind, SensorModel};
 use crate::simulation::Simulation;
@@ -20,6 +23,8 @@ const HEADING: Rgb<u8> = Rgb([255, 255, 255]);
 const PUCK_SENSOR: Rgb<u8> = Rgb([250, 200, 0]);
 const OBSTACLE_SENSOR: Rgb<u8> = Rgb([220, 0, 220]);
 const FIELD_SENSOR: Rgb<u8> = Rgb([0, 200, 0]);
+/// The target band's outline.
+pub const BAND: Rgb<u8> = Rgb([0, 220, 220]);
 
 /// How to draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,14 +33,17 @@ pub struct RenderOptions {
     pub size: u32,
     /// Draw each robot's sensor discs and field points.
     pub footprints: bool,
+    /// Outline the target band under the bodies.
+    pub band: bool,
 }
 
 impl Default for RenderOptions {
-    /// 800 pixels, no footprints.
+    /// 800 pixels, no footprints, no band.
     fn default() -> RenderOptions {
         RenderOptions {
             size: 800,
             footprints: false,
+            band: false,
         }
     }
 }
@@ -43,11 +51,20 @@ impl Default for RenderOptions {
 /// Draws the simulation's current world.
 pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbImage {
     let world = sim.world();
-    let mut img = draw_world(world, sim.field(), options.size);
+    let mut img = draw_field(world, sim.field(), options.size);
+    let scale = scale_of(world, options.size);
+    if options.band {
+        let layout = world.config().field_layout();
+        let thresholds = &sim.config().thresholds;
+        outline_region(&mut img, BAND, |x, y| {
+            let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
+            in_band(f64::from(sim.field().evaluate(p, &layout)), thresholds)
+        });
+    }
+    draw_bodies(&mut img, world, scale);
     if !options.footprints {
         return img;
     }
-    let scale = scale_of(world, options.size);
     let to_px = |p: Vec2| p * scale;
     let mut footprints = Vec::new();
     for i in 0..world.robots().len() {
@@ -72,25 +89,59 @@ pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbI
 /// Draws a world over `field`, `size` pixels wide: the field (its value as
 /// grey, as the world reads it), pucks, robots with their heading.
 pub fn draw_world(world: &World, field: &ScalarField, size: u32) -> RgbImage {
+    let mut img = draw_field(world, field, size);
+    draw_bodies(&mut img, world, scale_of(world, size));
+    img
+}
+
+/// The field as the world reads it, as grey, `size` pixels wide.
+fn draw_field(world: &World, field: &ScalarField, size: u32) -> RgbImage {
     let (arena, layout) = (world.config().arena(), world.config().field_layout());
     let scale = scale_of(world, size);
     let height = (arena.y * scale).round().max(1.0) as u32;
-    let mut img = RgbImage::from_fn(size, height, |x, y| {
+    RgbImage::from_fn(size, height, |x, y| {
         let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
         let v = (field.evaluate(p, &layout) * 255.0).round() as u8;
         Rgb([v, v, v])
-    });
+    })
+}
+
+/// Pucks, then robots with their heading, `scale` pixels per unit.
+fn draw_bodies(img: &mut RgbImage, world: &World, scale: f64) {
     let to_px = |p: Vec2| p * scale;
     for puck in world.pucks() {
-        fill_circle(&mut img, to_px(puck.pos), puck.radius * scale, PUCK);
+        fill_circle(img, to_px(puck.pos), puck.radius * scale, PUCK);
     }
     for (i, robot) in world.robots().iter().enumerate() {
         let body = &world.bodies()[i];
-        fill_circle(&mut img, to_px(body.pos), body.radius * scale, ROBOT);
+        fill_circle(img, to_px(body.pos), body.radius * scale, ROBOT);
         let tip = body.pos + robot.direction * body.radius;
-        draw_line(&mut img, to_px(body.pos), to_px(tip), HEADING);
+        draw_line(img, to_px(body.pos), to_px(tip), HEADING);
     }
-    img
+}
+
+/// Colours the edge of a region of `img`: every pixel inside it (`inside(x,
+/// y)`) with a 4-neighbour in the image outside it. The image's border is
+/// no edge, so a region that fills the picture draws nothing.
+pub fn outline_region(img: &mut RgbImage, colour: Rgb<u8>, inside: impl Fn(u32, u32) -> bool) {
+    let (w, h) = img.dimensions();
+    let mask: Vec<bool> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| inside(x, y))
+        .collect();
+    let at = |x: u32, y: u32| mask[y as usize * w as usize + x as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let edge = at(x, y)
+                && ((x > 0 && !at(x - 1, y))
+                    || (x + 1 < w && !at(x + 1, y))
+                    || (y > 0 && !at(x, y - 1))
+                    || (y + 1 < h && !at(x, y + 1)));
+            if edge {
+                img.put_pixel(x, y, colour);
+            }
+        }
+    }
 }
 
 /// Pixels per unit of a drawing `size` pixels wide.
@@ -131,5 +182,60 @@ fn draw_line(img: &mut RgbImage, a: Vec2, b: Vec2, colour: Rgb<u8>) {
     for k in 0..=steps {
         let p = a + (b - a) * (k as f64 / steps as f64);
         put(img, p.x.floor() as i64, p.y.floor() as i64, colour);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::Scenario;
+
+    #[test]
+    fn the_band_option_adds_only_band_coloured_pixels_and_only_on_the_band() {
+        let (sim, _) = Scenario::default().build().unwrap();
+        let plain = draw(&sim, RenderOptions::default());
+        let banded = draw(
+            &sim,
+            RenderOptions {
+                band: true,
+                ..RenderOptions::default()
+            },
+        );
+        let scale = scale_of(sim.world(), plain.width());
+        let layout = sim.world().config().field_layout();
+        let mut changed = 0;
+        for (x, y, p) in banded.enumerate_pixels() {
+            if p == plain.get_pixel(x, y) {
+                continue;
+            }
+            changed += 1;
+            assert_eq!(*p, BAND, "pixel ({x}, {y})");
+            let centre = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
+            let value = f64::from(sim.field().evaluate(centre, &layout));
+            assert!(
+                in_band(value, &sim.config().thresholds),
+                "({x}, {y}): {value}"
+            );
+        }
+        assert!(changed > 100, "{changed} pixels outlined");
+    }
+
+    #[test]
+    fn a_region_filling_the_picture_has_no_outline_and_a_square_has_its_rim() {
+        let mut img = RgbImage::new(8, 8);
+        outline_region(&mut img, BAND, |_, _| true);
+        assert!(img.pixels().all(|p| *p != BAND));
+        outline_region(&mut img, BAND, |x, y| {
+            (2..6).contains(&x) && (2..6).contains(&y)
+        });
+        let rim: Vec<(u32, u32)> = img
+            .enumerate_pixels()
+            .filter(|(_, _, p)| **p == BAND)
+            .map(|(x, y, _)| (x, y))
+            .collect();
+        assert_eq!(rim.len(), 12, "{rim:?}");
+        assert!(rim
+            .iter()
+            .all(|&(x, y)| x == 2 || x == 5 || y == 2 || y == 5));
     }
 }

@@ -248,10 +248,11 @@ pub fn read_policy(file: &str) -> Result<(std::path::PathBuf, PolicyBlob)> {
     Ok((path, blob))
 }
 
-/// Fails unless the ELF embeds `policy`'s packed table (a stale build).
+/// Fails unless the ELF embeds `policy`'s packed best-action sets (a
+/// stale build).
 pub fn check_elf_embeds(elf: &Path, policy: &PolicyBlob, rebuild: &str) -> Result<()> {
     let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
-    let table = policy.table().packed();
+    let table = policy.sets().packed();
     if !bytes.windows(table.len()).any(|w| w == table) {
         bail!(
             "{} does not embed this policy's table (a stale build): rebuild it with `{rebuild}`",

@@ -74,10 +74,13 @@ fn check_decision(frame: &LogFrame, blocks: &[PixyBlock]) -> shared::DriveOutput
         CAMERA,
         embedded::HASHER,
         shared::Role::Outie,
-        &embedded::POLICY[..],
+        &embedded::POLICY_SETS[..],
         embedded::MOTORS,
     );
-    let expected = decider.decide(&frame.raw_times, blocks);
+    // the default policy has no ties: the robot never draws
+    assert_eq!(frame.choice, None);
+    let mut choice = shared::ChoiceRng::for_robot(frame.robot_id);
+    let expected = decider.decide(&frame.raw_times, blocks, &mut choice);
     assert_eq!(frame.values, expected.values);
     assert_eq!(frame.blobs, expected.blobs);
     assert_eq!(frame.state, expected.state);

@@ -89,7 +89,7 @@ fn clear(register: *mut u8, flags: u8) {
 }
 
 /// Bytes of log frames the port holds for the host: two frames of the
-/// usual ~50 bytes, or one of the longest (71) and one more.
+/// usual ~51 bytes, or one of the longest (75) and one more.
 const QUEUE: usize = 128;
 
 /// An IN data stage in progress on endpoint 0.

@@ -70,6 +70,37 @@ impl SearchArgs {
     }
 }
 
+/// `host policy gap`'s arguments: a training run's settings, as `host
+/// train` takes them, and what to measure.
+#[derive(Clone, Debug, Args)]
+pub struct GapArgs {
+    /// The rows' label in the report (e.g. annulus, L).
+    #[arg(long)]
+    pub label: String,
+    /// Steps of the final window of training, and of each frozen and
+    /// flashed run.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub window: u64,
+    /// The seeds, one training run each (comma-separated).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub seeds: Vec<u64>,
+    /// The JSON report: this label's rows are replaced, others kept.
+    #[arg(long)]
+    pub json: PathBuf,
+    /// Measure this policy blob (flashed only) instead of training.
+    #[arg(long)]
+    pub policy: Option<PathBuf>,
+    /// TOML file with any of the training settings; flags override it.
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+    /// The training settings flags.
+    #[command(flatten)]
+    pub flags: TrainFlags,
+    /// The default real-world noise (the same as --noise 1).
+    #[arg(long, conflicts_with = "noise")]
+    pub randomise: bool,
+}
+
 /// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
 #[derive(Clone, Debug, Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
@@ -127,7 +158,8 @@ pub struct ExperimentRunArgs {
     /// Trials per arm.
     #[arg(long, default_value_t = 10)]
     pub trials: usize,
-    /// Fraction of the thesis' step counts, for quick runs (e.g. 0.001).
+    /// Fraction of the thesis' step counts, for quick runs (0.05: about a
+    /// minute for the annulus, long enough for its arms to form shapes).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
     /// Output directory [default: out/experiments/<name>, with --shard

@@ -93,6 +93,20 @@ pub enum PolicyCommand {
         #[arg(long)]
         summary: bool,
     },
+    /// Measure what a flashed policy keeps of what was learned
+    /// (docs/flashed.md): train, then formations of the final window of
+    /// learning, of the final table frozen and of the exported blob, per
+    /// seed, into a JSON report; with --policy, the blob's only.
+    Gap(learn::GapArgs),
+    /// Render docs/flashed.md's tables from the report `policy gap` wrote.
+    GapTable {
+        /// The report.
+        #[arg(long)]
+        json: PathBuf,
+        /// The doc whose generated part is replaced.
+        #[arg(long)]
+        doc: PathBuf,
+    },
 }
 
 /// A positive, finite number (lengths, scales).

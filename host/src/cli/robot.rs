@@ -83,6 +83,10 @@ pub struct FlashArgs {
     /// Validate and print the exact commands; build and write nothing.
     #[arg(long)]
     pub dry_run: bool,
+    /// Flash a policy whose blob says it was trained for another sensor
+    /// model than the robot's (refused otherwise).
+    #[arg(long)]
+    pub any_sensors: bool,
 }
 
 fn parse_hasher(s: &str) -> Result<StateHasher, String> {

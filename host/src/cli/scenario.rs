@@ -7,6 +7,7 @@ use sim::config::{BroadPhase, Walls};
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::sensor_choice::SensorChoice;
+use sim::scenario::trained_for;
 use sim::scenario::{ControllerChoice, Scenario};
 
 /// The scenario flags `run` and `render` share: `--controller` and
@@ -71,6 +72,30 @@ impl FromArgMatches for ScenarioArgs {
 impl ScenarioArgs {
     /// The scenario, with robot sensor and arena files read and checked.
     pub fn scenario(self) -> anyhow::Result<Scenario> {
+        let mut scenario = self.config().scenario()?;
+        scenario.controller = self.own.controller;
+        if self.own.naive {
+            scenario.broad_phase = BroadPhase::Naive;
+        }
+        Ok(scenario)
+    }
+
+    /// With `--controller policy:FILE` of a blob that records what it was
+    /// trained for (format version 2): a warning when this scenario's
+    /// sensor model or arena is another (a policy may be run elsewhere on
+    /// purpose, as the robustness experiments do, so it is not refused).
+    pub fn policy_mismatch(&self) -> anyhow::Result<Option<String>> {
+        let ControllerChoice::Policy(path) = &self.own.controller else {
+            return Ok(None);
+        };
+        let blob = sim::control::policy_file::read(path)?;
+        let here = self.config().trained_for();
+        Ok(trained_for::mismatch(blob.trained_for(), &here)
+            .map(|why| format!("policy file {}: {why}", path.display())))
+    }
+
+    /// The training config of the world flags given.
+    fn config(&self) -> TrainConfig {
         let mut config = TrainConfig::default();
         let m = &self.world;
         if let Some(field) = m.get_one::<FieldSource>("field") {
@@ -89,11 +114,6 @@ impl ScenarioArgs {
             config.noise = noise;
         }
         config.walls = m.get_one::<Walls>("walls").copied();
-        let mut scenario = config.scenario()?;
-        scenario.controller = self.own.controller;
-        if self.own.naive {
-            scenario.broad_phase = BroadPhase::Naive;
-        }
-        Ok(scenario)
+        config
     }
 }

@@ -72,6 +72,10 @@ impl FromArgMatches for ScreenArgs {
 pub struct FieldExportArgs {
     #[command(flatten)]
     pub screen: ScreenArgs,
+    /// Outline the target band in cyan: a colour picture to look at, not
+    /// for the TV (the robots would read the outline as field).
+    #[arg(long)]
+    pub band: bool,
     /// PNG file to write.
     #[arg(long)]
     pub out: PathBuf,

@@ -104,4 +104,7 @@ pub struct RenderArgs {
     /// Draw each robot's sensor discs and field points.
     #[arg(long)]
     pub footprints: bool,
+    /// Outline the target band (cyan): where Eval wants every puck.
+    #[arg(long)]
+    pub band: bool,
 }

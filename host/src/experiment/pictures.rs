@@ -95,7 +95,7 @@ pub fn snapshots(
                     running.simulation(),
                     RenderOptions {
                         size: 600,
-                        footprints: false,
+                        ..RenderOptions::default()
                     },
                 ),
             ));

@@ -1,9 +1,11 @@
 //! Tabular Q-learning with one policy shared by all robots: the table
-//! ([`qtable`]) and the learning controller ([`learner`]), rewarded by
-//! `sim::episodes::reward`.
+//! ([`qtable`]), the learning controller ([`learner`]), rewarded by
+//! `sim::episodes::reward`, and a learned table frozen ([`frozen`]).
 
+pub mod frozen;
 pub mod learner;
 pub mod qtable;
 
+pub use frozen::FrozenLearner;
 pub use learner::{LearnConfig, LearnerRules, QLearner, StateHasherName, Updates};
-pub use qtable::{QParams, QTable};
+pub use qtable::{QParams, QTable, TableSummary};

@@ -2,7 +2,7 @@
 
 use rand::RngExt;
 use serde::{Deserialize, Serialize};
-use shared::{ActionId, PolicyTable, State, StateHasher};
+use shared::{ActionId, ActionSets, PolicyTable, State, StateHasher};
 
 /// Q(s, a) for every state of one hasher and every action, with visit counts.
 ///
@@ -14,6 +14,26 @@ pub struct QTable {
     actions: usize,
     values: Vec<f64>,
     visits: Vec<u64>,
+}
+
+/// A learned table at a glance: what the robots did and what the table
+/// learned, the figures a side-by-side with the thesis author's program
+/// compares (`docs/reproduction.md`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableSummary {
+    /// Each action's share of all updates (of the actions taken), by id.
+    pub action_shares: Vec<f64>,
+    /// The values of every action of the visited states at
+    /// [`TableSummary::PERCENTILES`] (the sorted value at index `floor(p (n
+    /// - 1))`); none before the first update.
+    pub value_percentiles: Option<[f64; 7]>,
+    /// Visited states whose greatest value two or more actions share.
+    pub tied_states: usize,
+}
+
+impl TableSummary {
+    /// Minimum, 10th, 25th, 50th, 75th, 90th percentile, maximum.
+    pub const PERCENTILES: [f64; 7] = [0.0, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0];
 }
 
 /// How much a policy's action is preferred in [`QTable::from_policy`]:
@@ -84,6 +104,49 @@ impl QTable {
             .chunks(self.actions)
             .filter(|row| row.iter().any(|&v| v > 0))
             .count()
+    }
+
+    /// The table at a glance ([`TableSummary`]).
+    pub fn summary(&self) -> TableSummary {
+        let total: u64 = self.visits.iter().sum();
+        let mut taken = vec![0u64; self.actions];
+        for row in self.visits.chunks(self.actions) {
+            for (sum, &v) in taken.iter_mut().zip(row) {
+                *sum += v;
+            }
+        }
+        let visited = || {
+            self.values
+                .chunks(self.actions)
+                .zip(self.visits.chunks(self.actions))
+                .filter(|(_, visits)| visits.iter().any(|&v| v > 0))
+                .map(|(values, _)| values)
+        };
+        let mut values: Vec<f64> = visited().flatten().copied().collect();
+        values.sort_by(f64::total_cmp);
+        let tied_states = visited()
+            .filter(|row| {
+                let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                row.iter().filter(|&&v| v == best).count() > 1
+            })
+            .count();
+        TableSummary {
+            action_shares: taken
+                .iter()
+                .map(|&n| {
+                    if total > 0 {
+                        n as f64 / total as f64
+                    } else {
+                        0.0
+                    }
+                })
+                .collect(),
+            value_percentiles: (!values.is_empty()).then(|| {
+                TableSummary::PERCENTILES
+                    .map(|p| values[(p * (values.len() - 1) as f64).floor() as usize])
+            }),
+            tied_states,
+        }
     }
 
     /// An action with the greatest value; among equal maxima, one chosen
@@ -200,6 +263,30 @@ impl QTable {
         table
     }
 
+    /// Each state's best actions: exactly the set [`QTable::greedy_within`]
+    /// `tolerance` picks from uniformly (the actions within `tolerance` of
+    /// the greatest value; with 0 the equal maxima of [`QTable::greedy`]).
+    /// Unvisited states have every action.
+    pub fn best_sets(&self, tolerance: f64) -> ActionSets {
+        let mut sets = ActionSets::new(self.hasher);
+        for s in 0..self.hasher.num_states() as u16 {
+            let row = self.row(State(s));
+            let best = row.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let floor = if tolerance == 0.0 {
+                best
+            } else {
+                best - tolerance
+            };
+            let mask = row
+                .iter()
+                .enumerate()
+                .filter(|(_, &v)| v >= floor)
+                .fold(0u8, |m, (a, _)| m | 1 << a);
+            sets.set(State(s), mask);
+        }
+        sets
+    }
+
     /// A table that acts like a greedy policy: every value `initial`, plus
     /// [`POLICY_PREFERENCE`] on each state's policy action, no visits. Used
     /// to start learning from a policy blob, which carries no Q-values.
@@ -273,6 +360,32 @@ mod tests {
     }
 
     #[test]
+    fn the_summary_counts_actions_taken_and_the_values_and_ties_of_visited_states() {
+        let mut q = QTable::new(StateHasher::Original, 4, 1.0);
+        assert_eq!(q.summary().value_percentiles, None);
+        let p = QParams {
+            alpha: 0.5,
+            gamma: 0.0,
+        };
+        // state 5: action 1 once, action 2 three times; state 9: action 0 once.
+        q.update(State(5), ActionId(1), 3.0, State(0), p); // Q(5,1) = 2
+        for _ in 0..3 {
+            q.update(State(5), ActionId(2), 1.0, State(0), p); // Q(5,2) stays 1
+        }
+        q.update(State(9), ActionId(0), -1.0, State(0), p); // Q(9,0) = 0
+        let summary = q.summary();
+        assert_eq!(summary.action_shares, vec![0.2, 0.2, 0.6, 0.0]);
+        // state 9's actions 1 to 3 keep 1.0, its best, three times: a tie;
+        // state 5's best (2.0) is alone.
+        assert_eq!(summary.tied_states, 1);
+        // the 8 values of states 5 and 9, sorted: 0, 1 x 6, 2
+        assert_eq!(
+            summary.value_percentiles,
+            Some([0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 2.0])
+        );
+    }
+
+    #[test]
     fn greedy_picks_the_maximum() {
         let mut q = QTable::new(StateHasher::Bits7, 4, 0.0);
         q.update(State(3), ActionId(2), 1.0, State(0), QParams::default());
@@ -282,6 +395,40 @@ mod tests {
         }
         assert_eq!(q.greedy_policy().action(State(3)), ActionId(2));
         assert_eq!(q.greedy_policy().action(State(4)), ActionId(0));
+    }
+
+    #[test]
+    fn best_sets_are_exactly_the_actions_the_learner_picks_among() {
+        let mut q = QTable::new(StateHasher::Bits7, 4, 1.0);
+        let rows: [[f64; 4]; 5] = [
+            [1.0, 1.0, 0.5, 1.0],
+            [0.2, 0.9, 0.9, 0.1],
+            [0.3, 0.3005, 0.1, 0.2996],
+            [-1.0, -2.0, -3.0, -4.0],
+            [1.0, 1.0, 1.0, 1.0],
+        ];
+        for (s, row) in rows.iter().enumerate() {
+            q.values[s * 4..s * 4 + 4].copy_from_slice(row);
+        }
+        let mut rng = Pcg64Mcg::seed_from_u64(11);
+        for tolerance in [0.0, 0.001] {
+            let sets = q.best_sets(tolerance);
+            for s in 0..q.hasher().num_states() as u16 {
+                let mut seen = 0u8;
+                for _ in 0..400 {
+                    seen |= 1 << q.greedy_within(State(s), tolerance, &mut rng).0;
+                }
+                assert_eq!(
+                    sets.mask(State(s)),
+                    seen,
+                    "state {s}, tolerance {tolerance}"
+                );
+            }
+        }
+        assert_eq!(q.best_sets(0.0).mask(State(2)), 0b0010);
+        assert_eq!(q.best_sets(0.001).mask(State(2)), 0b1011);
+        // without ties the lowest of each set is the old export
+        assert_eq!(q.best_sets(0.0).lowest(), q.greedy_policy());
     }
 
     #[test]

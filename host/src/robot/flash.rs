@@ -57,6 +57,38 @@ pub struct FlashPlan {
     pub robot_id: u8,
 }
 
+/// The robot's own sensor model, as a blob names it
+/// ([`sim::scenario::trained_for::sensors_label`]).
+pub const ROBOT_SENSORS: &str = "robot";
+
+/// What `policy` was trained for, against a robot: refused when it names
+/// another sensor model than the robot's (its states would mean what disc
+/// sensors report, not what the photo-transistors and the Pixy do) unless
+/// `any_sensors`; a warning when its arena is the thesis' square, which no
+/// robot drives on. A blob that does not say (format version 1) passes.
+pub fn check_trained_for(policy: &Path, any_sensors: bool) -> Result<Option<String>> {
+    let blob = sim::control::policy_file::read(policy)?;
+    let Some(t) = blob.trained_for() else {
+        return Ok(None);
+    };
+    if t.sensors.as_str() != ROBOT_SENSORS && !any_sensors {
+        bail!(
+            "policy file {} was trained for the sensor model {} but a robot has its own ({ROBOT_SENSORS}): \
+             its states would mean other readings on the robot (train with --sensors robot, \
+             or pass --any-sensors to flash it anyway)",
+            policy.display(),
+            t.sensors.escape_debug()
+        );
+    }
+    Ok((t.arena.as_str() == "thesis").then(|| {
+        format!(
+            "policy file {} was trained in the thesis' square arena, not on a screen: \
+             the TV's size, pucks and robots differ",
+            policy.display()
+        )
+    }))
+}
+
 impl FlashPlan {
     /// Validates the request: the policy decodes (and uses `hasher`, when
     /// one is asked for) and a checkout is found (`repo`, or the nearest

@@ -5,7 +5,7 @@
 use super::checkpoint;
 use super::config::{TrainConfig, TrainFlags};
 use super::trainer::{Trainer, TrainingState};
-use crate::learn::QTable;
+use crate::learn::{QTable, TableSummary};
 use anyhow::{bail, Context, Result};
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use shared::PolicyBlob;
@@ -51,6 +51,8 @@ pub struct TrainReport {
     pub states_visited: usize,
     /// States of the hasher.
     pub states_total: usize,
+    /// The table at the end: actions taken, values, ties.
+    pub table: TableSummary,
     /// With policy selection: the training step of the policy written and
     /// its formations in the evaluation.
     pub selected: Option<(u64, u64)>,
@@ -74,6 +76,28 @@ impl fmt::Display for TrainReport {
             f,
             "states visited       {} of {}",
             self.states_visited, self.states_total
+        )?;
+        let shares: Vec<String> = self
+            .table
+            .action_shares
+            .iter()
+            .map(|s| format!("{s:.3}"))
+            .collect();
+        writeln!(
+            f,
+            "actions taken        {} (share of each action id)",
+            shares.join(" ")
+        )?;
+        if let Some([min, p10, p25, p50, p75, p90, max]) = self.table.value_percentiles {
+            writeln!(
+                f,
+                "values, visited      min {min:.3}, 10 % {p10:.3}, 25 % {p25:.3}, median {p50:.3}, 75 % {p75:.3}, 90 % {p90:.3}, max {max:.3}"
+            )?;
+        }
+        writeln!(
+            f,
+            "tied best actions    in {} of the visited states",
+            self.table.tied_states
         )?;
         if let Some((step, formations)) = self.selected {
             writeln!(
@@ -231,6 +255,7 @@ fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport
         },
         states_visited: q.states_visited(),
         states_total: q.hasher().num_states(),
+        table: q.summary(),
         selected: trainer.selected().map(|s| (s.step, s.formations)),
         policy: policy_path,
         checkpoint: checkpoint_path,

@@ -9,6 +9,7 @@ use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
 use serde::{Deserialize, Serialize};
+use shared::blob::name_prefix;
 use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::orbital_innies;
@@ -255,6 +256,12 @@ impl TrainConfig {
             .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
     }
 
+    /// The sensor model and arena the run trains for, as its policy blob
+    /// records them.
+    pub fn trained_for(&self) -> shared::TrainedFor {
+        sim::scenario::trained_for::trained_for(&self.sensors, &self.arena_choice())
+    }
+
     /// The run as a scenario (arena and sensor files read and checked),
     /// without the settings only training has.
     pub fn scenario(&self) -> Result<Scenario> {
@@ -328,11 +335,12 @@ impl TrainConfig {
     pub fn name(&self) -> String {
         match &self.output.name {
             Some(name) => name.clone(),
-            None => truncate(&format!(
+            None => name_prefix(&format!(
                 "{}-{}",
                 field_label(&self.field).replace(':', "-"),
                 self.learn.hasher.0.name()
-            )),
+            ))
+            .to_string(),
         }
     }
 
@@ -396,23 +404,15 @@ impl TrainConfig {
 /// and letters, an image's file name; at most 32 bytes.
 pub fn field_label(field: &FieldSource) -> String {
     match field {
-        FieldSource::Image(path) => truncate(
+        FieldSource::Image(path) => name_prefix(
             &path
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "image".into()),
-        ),
-        other => truncate(&other.to_string()),
+        )
+        .to_string(),
+        other => name_prefix(&other.to_string()).to_string(),
     }
-}
-
-/// The longest prefix of `s` of at most [`MAX_NAME_LEN`] bytes.
-fn truncate(s: &str) -> String {
-    let mut end = s.len().min(MAX_NAME_LEN);
-    while !s.is_char_boundary(end) {
-        end -= 1;
-    }
-    s[..end].to_string()
 }
 
 /// The `host train` flags of [`TrainConfig`]'s settings, as given: each

@@ -240,29 +240,49 @@ impl<S: SensorModel> Trainer<S> {
         &self.sim
     }
 
-    /// The run's policy as a blob for the firmware: with selection the
-    /// best evaluated so far (the current greedy one before the first
-    /// evaluation), else the current greedy one; its provenance names the
-    /// field, the run's name, the training steps it had and the seed.
+    /// The run's policy as a blob for the firmware, recording the sensor
+    /// model and arena it was trained for: with selection the best
+    /// evaluated so far (the current greedy one before the first
+    /// evaluation; one action per state, as selection evaluated it), else
+    /// each state's best actions now ([`QTable::best_sets`] with the run's
+    /// tie tolerance: the learner's own choice among equal actions, which
+    /// the robot samples). Its provenance names the field, the run's name,
+    /// the training steps it had and the seed.
     pub fn policy(&self) -> Result<PolicyBlob> {
         let hasher = self.learner.table().hasher();
-        match self.selected.as_ref().filter(|_| self.evaluation.is_some()) {
+        let blob = match self.selected.as_ref().filter(|_| self.evaluation.is_some()) {
             Some(best) => {
                 let table = best
                     .table(hasher)
                     .context("the selected policy does not fit the run's hasher")?;
-                self.blob(table, best.step)
+                self.blob(table, best.step)?
             }
-            None => self.greedy_policy(),
-        }
+            None => {
+                let sets = self
+                    .learner
+                    .table()
+                    .best_sets(self.config.rules.tie_tolerance);
+                let (actions, provenance) = self.blob_parts(self.totals().steps)?;
+                PolicyBlob::with_sets(actions, sets, provenance)
+                    .context("cannot export the policy")?
+            }
+        };
+        Ok(blob.with_trained_for(self.config.trained_for()))
     }
 
-    /// The current greedy policy as a blob.
+    /// The current greedy policy as a blob, ties broken towards the lowest
+    /// action (what policy selection evaluates).
     pub fn greedy_policy(&self) -> Result<PolicyBlob> {
         self.blob(self.learner.table().greedy_policy(), self.totals().steps)
     }
 
     fn blob(&self, table: PolicyTable, steps: u64) -> Result<PolicyBlob> {
+        let (actions, provenance) = self.blob_parts(steps)?;
+        PolicyBlob::new(actions, table, provenance).context("cannot export the policy")
+    }
+
+    /// The actions and provenance of an exported blob.
+    fn blob_parts(&self, steps: u64) -> Result<(ActionTable, Provenance)> {
         let c = &self.config;
         let actions = ActionTable::new(
             &c.learn.actions,
@@ -271,7 +291,7 @@ impl<S: SensorModel> Trainer<S> {
         .context("cannot export the policy")?;
         let provenance = Provenance::new(&field_label(&c.field), &c.name(), steps, c.seed)
             .context("cannot export the policy")?;
-        PolicyBlob::new(actions, table, provenance).context("cannot export the policy")
+        Ok((actions, provenance))
     }
 }
 

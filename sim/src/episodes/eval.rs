@@ -14,6 +14,12 @@ use crate::fields::{FieldLayout, FieldSampling, ScalarField};
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 
+/// Whether a field value lies in the band `[T_o, T_i]` (where Eval wants
+/// every puck).
+pub fn in_band(value: f64, t: &Thresholds) -> bool {
+    band_distance(value, t) == 0.0
+}
+
 /// How far a field value lies outside the band `[T_o, T_i]`.
 pub(crate) fn band_distance(value: f64, t: &Thresholds) -> f64 {
     if value < t.outie {

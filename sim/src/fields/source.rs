@@ -45,6 +45,8 @@ pub enum FieldError {
     ImageFile(ImageFileError),
     /// `thesis:` followed by a letter the thesis has no image of.
     NoThesisImage(String),
+    /// Neither a field's name nor an existing file.
+    Unknown(PathBuf),
 }
 
 impl fmt::Display for FieldError {
@@ -71,6 +73,15 @@ impl fmt::Display for FieldError {
                     THESIS_LETTERS.join(", ")
                 )
             }
+            FieldError::Unknown(path) => write!(
+                f,
+                "no field is named {:?} and there is no image file of that name: a field is \
+                 annulus, letter:X (X one of {}), thesis:X (X one of {}) or the path of a \
+                 PNG or JPEG image",
+                path.display().to_string(),
+                Letter::NAMES,
+                THESIS_LETTERS.join(", ")
+            ),
         }
     }
 }
@@ -224,6 +235,9 @@ pub fn read_image(
 /// An image file's field ([`read_image`] with
 /// [`ranges::FIELD_IMAGE_SIDE`]).
 fn load_image(path: &Path) -> Result<ScalarField, FieldError> {
+    if !path.exists() {
+        return Err(FieldError::Unknown(path.to_path_buf()));
+    }
     let img = read_image(path, "field image", &ranges::FIELD_IMAGE_SIDE)
         .map_err(FieldError::ImageFile)?;
     field_of(img, path)
@@ -265,6 +279,17 @@ mod tests {
         let missing = FieldSource::Image(PathBuf::from("/no/such/field.png"));
         let e = missing.load().unwrap_err().to_string();
         assert!(e.contains("/no/such/field.png"), "{e}");
+        // a misspelt name lists the names there are
+        let e = "square"
+            .parse::<FieldSource>()
+            .unwrap()
+            .load()
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("\"square\"") && e.contains("annulus, letter:X"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -195,7 +195,7 @@ impl ArenaSpec {
     /// The position of panel pixel (`i`, `j`)'s centre, in units from the
     /// screen's top-left corner (column `i` from the left, row `j` from the
     /// top): the panel's pixels tile the visible area.
-    pub(crate) fn panel_pixel_centre(&self, i: u32, j: u32) -> Vec2 {
+    pub fn panel_pixel_centre(&self, i: u32, j: u32) -> Vec2 {
         let size = self.size();
         Vec2::new(
             (f64::from(i) + 0.5) * size.x / f64::from(self.screen_px[0]),

@@ -10,6 +10,7 @@ pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;
 pub mod shape_pucks;
+pub mod trained_for;
 
 use crate::base::ranges;
 use crate::config::actuation::ActuationNoise;
@@ -131,11 +132,21 @@ pub fn field_config(field: &FieldSource, robots: usize, pucks: usize) -> SimConf
     let mut c = SimConfig::default();
     c.world.robots = robots;
     c.world.pucks = pucks;
+    c.thresholds = field_thresholds(field);
     if !field.has_cavity() {
-        c.thresholds = Thresholds::LETTERS;
         c.episode.stuck_limit = 50_000;
     }
     c
+}
+
+/// The target band of a field's experiments: the annulus thresholds on
+/// the annulus, 1.0 on letters and images.
+pub fn field_thresholds(field: &FieldSource) -> Thresholds {
+    if field.has_cavity() {
+        Thresholds::default()
+    } else {
+        Thresholds::LETTERS
+    }
 }
 
 /// The number of innies orbital construction uses: half the robots on a

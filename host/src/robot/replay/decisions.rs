@@ -3,8 +3,8 @@
 
 use super::report::{Divergence, Stage, StageCounts, LISTED};
 use shared::{
-    ActionId, ActionMotors, FieldCalibration, FieldValue, LogFrame, MotorCommand, PolicyBlob,
-    RobotProfile, Role, SensorReading, State,
+    ActionId, ActionMotors, ChoiceRng, FieldCalibration, FieldValue, LogFrame, MotorCommand,
+    PolicyBlob, RobotProfile, Role, SensorReading, State,
 };
 
 /// What each stage should have produced from a frame's own inputs.
@@ -16,6 +16,10 @@ struct Expected {
     /// Motor commands: the action's mix when the policy drove, else a stop
     /// (idle, calibrating standing still, or stopped by a fault).
     motors: MotorCommand,
+    /// Whether the logged choice generator is consistent: logged exactly
+    /// when the state had several best actions, and where the decisions
+    /// before left it (unknown across a lost frame).
+    choice_ok: bool,
 }
 
 /// Recomputes decisions with a policy and collects the divergences.
@@ -23,6 +27,9 @@ pub struct DecisionCheck<'a> {
     policy: &'a PolicyBlob,
     motors: ActionMotors,
     calibration: Option<FieldCalibration>,
+    /// The last frame's tick and the choice generator after its decision,
+    /// when known (from the last draw logged, with no frame lost since).
+    after: Option<(u32, Option<ChoiceRng>)>,
     /// Calibrations logged, each differing from the one before.
     pub calibrations: Vec<FieldCalibration>,
     /// Frames whose values could be checked.
@@ -42,6 +49,7 @@ impl<'a> DecisionCheck<'a> {
             policy,
             motors: RobotProfile::ZUMO.action_motors(policy.actions()),
             calibration: None,
+            after: None,
             calibrations: Vec::new(),
             calibration_checked: 0,
             diverged: 0,
@@ -59,7 +67,24 @@ impl<'a> DecisionCheck<'a> {
             }
             self.calibration = Some(c);
         }
-        let expected = self.expected(f);
+        let known = match self.after {
+            Some((tick, rng)) if f.tick == tick.wrapping_add(1) => rng,
+            _ => None,
+        };
+        let mut expected = self.expected(f);
+        if let (Some(rng), Some(logged)) = (known, f.choice) {
+            expected.choice_ok &= rng == ChoiceRng::from_state(logged);
+        }
+        // a frame that did not draw leaves the generator where it was
+        let after = match f.choice {
+            Some(s) => {
+                let mut rng = ChoiceRng::from_state(s);
+                rng.pick(self.policy.sets().mask(f.state));
+                Some(rng)
+            }
+            None => known,
+        };
+        self.after = Some((f.tick, after));
         if expected.values.is_some() {
             self.calibration_checked += 1;
         }
@@ -79,10 +104,15 @@ impl<'a> DecisionCheck<'a> {
             .hasher()
             .hash_as(&SensorReading::from_parts(f.values, f.blobs), role);
         let in_range = f.state.index() < self.policy.hasher().num_states();
-        let action = if in_range {
-            self.policy.table().action(f.state)
-        } else {
-            ActionId(u8::MAX)
+        // the robot's pick among the state's best actions: the one, or
+        // the logged generator's draw among several
+        let mask = self.policy.sets().mask(f.state);
+        let several = mask.count_ones() > 1;
+        let action = match (in_range, f.choice) {
+            (false, _) => ActionId(u8::MAX),
+            (true, Some(s)) => ChoiceRng::from_state(s).pick(mask),
+            (true, None) if several => ActionId(u8::MAX),
+            (true, None) => self.policy.table().action(f.state),
         };
         let motors = if f.policy_drove() && f.action.index() < self.policy.actions().len() {
             self.motors.command(f.action)
@@ -94,6 +124,7 @@ impl<'a> DecisionCheck<'a> {
             state,
             action,
             motors,
+            choice_ok: !in_range || several == f.choice.is_some(),
         }
     }
 
@@ -135,7 +166,7 @@ fn divergent_stages(f: &LogFrame, e: &Expected) -> Vec<Stage> {
     [
         (Stage::Calibration, e.values.is_some_and(|v| v != f.values)),
         (Stage::Hash, e.state != f.state),
-        (Stage::Policy, e.action != f.action),
+        (Stage::Policy, e.action != f.action || !e.choice_ok),
         (Stage::Motors, !motors_ok),
     ]
     .into_iter()

@@ -237,9 +237,9 @@ mod tests {
     use super::*;
     use crate::robot::log_file::{self, encode_record, HEADER_LEN, MAGIC, VERSION};
     use shared::{
-        ActionId, ActionTable, BlobSummary, Faults, FieldCalibration, FieldValue, MotorCommand,
-        PolicyTable, Provenance, RobotProfile, RunMode, SensorRange, SensorReading, State,
-        StateHasher,
+        ActionId, ActionTable, BlobSummary, ChoiceRng, Faults, FieldCalibration, FieldValue,
+        MotorCommand, PolicyTable, Provenance, RobotProfile, RunMode, SensorRange, SensorReading,
+        State, StateHasher,
     };
     use std::collections::BTreeMap;
 
@@ -267,6 +267,7 @@ mod tests {
     /// A frame as the firmware would log it for these raw times and blobs.
     fn firmware_frame(
         p: &PolicyBlob,
+        choice: &mut ChoiceRng,
         tick: u32,
         mode: RunMode,
         faults: Faults,
@@ -280,7 +281,9 @@ mod tests {
         };
         let reading = SensorReading::from_parts(values, blobs);
         let state = p.hasher().hash(&reading);
-        let action = p.table().action(state);
+        let before = choice.state();
+        let action = choice.pick(p.sets().mask(state));
+        let drew = choice.state() != before;
         let mut f = LogFrame {
             tick,
             mode,
@@ -291,6 +294,7 @@ mod tests {
             blocks: u8::from(puck_left),
             state,
             action,
+            choice: drew.then_some(before),
             ..LogFrame::default()
         };
         if f.policy_drove() {
@@ -302,6 +306,7 @@ mod tests {
 
     fn session(p: &PolicyBlob) -> Vec<LogFrame> {
         let mut frames = Vec::new();
+        let mut choice = ChoiceRng::for_robot(0);
         for tick in 1..=120u32 {
             let mode = if tick <= 10 {
                 RunMode::Idle
@@ -318,7 +323,15 @@ mod tests {
                 40 + (tick * 13 % 400) as u16,
                 40 + (tick * 3 % 400) as u16,
             ];
-            frames.push(firmware_frame(p, tick, mode, faults, raw, tick % 3 == 0));
+            frames.push(firmware_frame(
+                p,
+                &mut choice,
+                tick,
+                mode,
+                faults,
+                raw,
+                tick % 3 == 0,
+            ));
         }
         frames
     }
@@ -442,6 +455,50 @@ mod tests {
         assert_eq!(by_tick(6).stages, vec![Stage::Motors]);
         assert_eq!(by_tick(6).expected_motors, [0, 0]);
         assert!(r.to_string().contains("tick 41 at byte"));
+    }
+
+    /// `policy()` with every state's set widened to two or more actions.
+    fn tied_policy() -> PolicyBlob {
+        let p = policy();
+        let mut sets = shared::ActionSets::new(StateHasher::Original);
+        for (state, mask) in p.sets().masks() {
+            let next = (mask.trailing_zeros() + 1 + u32::from(state.0 / 4 % 2)) % 4;
+            sets.set(state, mask | 1 << next);
+        }
+        PolicyBlob::with_sets(*p.actions(), sets, p.provenance().clone()).unwrap()
+    }
+
+    #[test]
+    fn replay_rechecks_every_decision_sampled_among_tied_actions() {
+        let p = tied_policy();
+        let mut frames = session(&p);
+        // the robot drew: its generator moved on every frame
+        assert!(frames.iter().all(|f| f.choice.is_some()));
+        let r = report_of(&log_of(&frames), &p);
+        assert_eq!((r.frames, r.diverged), (120, 0), "{r}");
+        // another of the state's best actions than the generator's pick
+        let i = 40;
+        let mask = p.sets().mask(frames[i].state);
+        let other = (0..4u8)
+            .find(|&a| mask & (1 << a) != 0 && a != frames[i].action.0)
+            .unwrap();
+        frames[i].action = ActionId(other);
+        // a generator that jumps (the draw itself agrees with its state)
+        let j = 70;
+        let mut jumped = ChoiceRng::from_state(frames[j].choice.unwrap() ^ 0x8000);
+        frames[j].choice = Some(jumped.state());
+        frames[j].action = jumped.pick(p.sets().mask(frames[j].state));
+        // a tied state decided without a logged draw
+        frames[90].choice = None;
+        let r = report_of(&log_of(&frames), &p);
+        let ticks: Vec<u32> = r.first_divergences.iter().map(|d| d.tick).collect();
+        // 41: the wrong pick; 71: the jump; 72: the frame after the jump;
+        // 91: no draw logged; 92: the generator moved without a logged draw
+        assert_eq!(ticks, vec![41, 71, 72, 91, 92], "{r}");
+        assert!(r
+            .first_divergences
+            .iter()
+            .all(|d| d.stages[0] == Stage::Policy));
     }
 
     #[test]

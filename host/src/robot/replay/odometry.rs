@@ -241,6 +241,7 @@ mod tests {
             action: ActionId(action),
             motors,
             encoder_counts: counts,
+            choice: None,
             robot_id: 3,
             ..LogFrame::default()
         }
