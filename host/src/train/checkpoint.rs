@@ -6,16 +6,16 @@
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1 to 4), u16                         |
+//! | 8      | 2    | format version (1 to 5), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
-//! Format 4's body is the [`TrainingState`]; formats 1 to 3 are the
+//! Format 5's body is the [`TrainingState`]; formats 1 to 4 are the
 //! state without the settings added since ([`super::format1`],
-//! [`super::format2`], [`super::format3`]). A state is written in the
-//! oldest format that holds it, byte for byte what earlier builds wrote;
-//! all four are read.
+//! [`super::format2`], [`super::format3`], [`super::format4`]). A state is
+//! written in the oldest format that holds it, byte for byte what earlier
+//! builds wrote; all five are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
@@ -24,6 +24,7 @@
 use super::format1::StateV1;
 use super::format2::StateV2;
 use super::format3::StateV3;
+use super::format4::StateV4;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
@@ -41,8 +42,9 @@ pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// run's arena and noise, the counts left to the arena, the motion noise,
 /// the world's seed, episode count and dropped-period turns, the robot
 /// senses' memory. 4: the arena's border (`walls`) and the learner's
-/// rules (`rules`).
-pub const VERSION: u16 = 4;
+/// rules (`rules`). 5: the robots' outline (`robot_shape`: a wedge; disc
+/// states keep format 4 or older).
+pub const VERSION: u16 = 5;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
@@ -124,6 +126,8 @@ pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()>
         (2, postcard::to_stdvec(&v2))
     } else if let Some(v3) = StateV3::of(state) {
         (3, postcard::to_stdvec(&v3))
+    } else if let Some(v4) = StateV4::of(state) {
+        (4, postcard::to_stdvec(&v4))
     } else {
         (VERSION, postcard::to_stdvec(state))
     };
@@ -198,6 +202,9 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
             .map_err(malformed),
         3 => postcard::from_bytes::<StateV3>(body)
             .map(StateV3::into_state)
+            .map_err(malformed),
+        4 => postcard::from_bytes::<StateV4>(body)
+            .map(StateV4::into_state)
             .map_err(malformed),
         _ => postcard::from_bytes(body).map_err(malformed),
     }
