@@ -14,7 +14,7 @@ use sim::config::robot_shape::RobotShape;
 use sim::config::Walls;
 use sim::control::random::RandomTurns;
 use sim::physics::outline::Outline;
-use sim::scenario::arena::ArenaSpec;
+use sim::scenario::arena::{ArenaSpec, SkirtShape};
 use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::sensors::robot::RobotSensorConfig;
 use sim::{
@@ -337,6 +337,54 @@ fn deepest(world: &World) -> f64 {
     deepest
 }
 
+/// tv75 with the thesis' wedge (`experiments/arenas/tv75-wedge.toml`).
+fn tv75_wedge() -> ArenaSpec {
+    ArenaSpec {
+        robot_shape: SkirtShape::thesis_wedge(),
+        ..ArenaSpec::tv75()
+    }
+}
+
+#[test]
+fn the_wedge_arena_file_is_tv75_in_the_thesis_skirt() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../experiments/arenas/tv75-wedge.toml");
+    let spec = sim::scenario::arena_choice::read_arena(&path).unwrap();
+    assert_eq!(
+        spec,
+        ArenaSpec {
+            name: "tv75-wedge".into(),
+            ..tv75_wedge()
+        }
+    );
+    // 85 mm over 6.5 mm per unit; the faces meet at 2 asin(65 / 85).
+    assert_eq!(
+        spec.robot_shape_units(),
+        RobotShape::Wedge { tip: 85.0 / 6.5 }
+    );
+    let o = Outline::of(spec.robot_shape_units(), 10.0).unwrap();
+    assert!(
+        (o.tip_angle().to_degrees() - 99.76).abs() < 0.01,
+        "{}",
+        o.tip_angle().to_degrees()
+    );
+}
+
+#[test]
+fn an_arena_file_s_tip_outside_its_range_is_refused_naming_it() {
+    for tip_mm in [65.0, 40.0, 196.0, f64::NAN] {
+        let spec = ArenaSpec {
+            robot_shape: SkirtShape::Wedge { tip_mm },
+            ..ArenaSpec::tv75()
+        };
+        let e = spec.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("arena.robot_shape.wedge.tip_mm / arena.robot_radius_mm"),
+            "{e}"
+        );
+    }
+}
+
 /// A crowded TV: 12 wedge robots and 30 pucks turning at random.
 fn crowded(shape: RobotShape, seed: u64) -> Simulation {
     let tv = ArenaSpec::tv75();
@@ -355,7 +403,7 @@ fn crowded_wedges_leave_no_overlap_once_they_stop_pushing() {
     // the walls deeper than one pass of resolution undoes, discs and
     // wedges alike; once they stop driving, every overlap is resolved
     // within a few steps.
-    for shape in [RobotShape::Disc, ArenaSpec::tv75().robot_shape_units()] {
+    for shape in [RobotShape::Disc, tv75_wedge().robot_shape_units()] {
         let mut sim = crowded(shape, 11);
         let mut controller = RandomTurns::new(ActionTable::default());
         let mut deepest_seen = f64::NEG_INFINITY;
@@ -437,10 +485,10 @@ fn standing_wedges_hit_by_sliding_pucks_gain_no_energy_over_a_long_run() {
     }
 }
 
-/// A TV run with the robot's senses and the default noise (the wedge is
-/// tv75's default).
+/// A TV run with the robot's senses and the default noise, the robots in
+/// the thesis' wedge.
 fn tv_run(seed: u64) -> Simulation<SelectedSensors> {
-    let tv = ArenaSpec::tv75();
+    let tv = tv75_wedge();
     let field = ScalarField::annulus_of(64, 36);
     let mut c = SimConfig::default();
     tv.apply(&mut c, &field);
@@ -484,4 +532,97 @@ fn a_wedge_run_is_the_same_for_the_same_seed_and_resumes_exactly_from_a_snapshot
     .build(first.config());
     let mut resumed = Simulation::resume(state, Arc::new(first.field().clone()), sensors);
     assert_eq!(positions(&mut resumed, 1800), whole);
+}
+
+/// `docs/robot-sensors/skirt.svg`: the thesis' skirt on the TV's robots
+/// (`experiments/arenas/tv75-wedge.toml`) drawn to scale, 2 pixels per
+/// mm, heading up: the outline, the Zumo's 98 x 86 mm chassis, the three
+/// photo-transistors where the sensor model puts them, the Pixy's lens,
+/// and the disc of tv75's radius for comparison. Every figure is the
+/// code's.
+fn skirt_svg() -> String {
+    let spec = tv75_wedge();
+    let unit = spec.unit_mm();
+    let o = Outline::of(spec.robot_shape_units(), 10.0).unwrap();
+    let (r, tip) = (o.radius() * unit, o.tip() * unit);
+    let t = o.tangent_point() * unit;
+    let world = sim::config::WorldConfig {
+        unit_mm: unit,
+        robot_shape: spec.robot_shape_units(),
+        ..Default::default()
+    };
+    let mounts = sim::sensors::photo::PhotoSensorConfig::default().mounts_on(&world);
+    let lens = sim::sensors::pixy_camera::PixyCameraConfig::default().forward_mm;
+    // SVG: x to the robot's right, y down the page (minus ahead), mm.
+    let p = |forward: f64, right: f64| format!("{:.2} {:.2}", right, -forward);
+    let mut s = String::new();
+    s.push_str(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"360\" height=\"440\" \
+         viewBox=\"-90 -110 180 220\" font-family=\"sans-serif\" font-size=\"5\">\n",
+    );
+    s.push_str("<rect x=\"-90\" y=\"-110\" width=\"180\" height=\"220\" fill=\"white\"/>\n");
+    s.push_str(&format!(
+        "<circle cx=\"0\" cy=\"0\" r=\"{r:.2}\" fill=\"none\" stroke=\"#999\" stroke-dasharray=\"2 2\" stroke-width=\"0.5\"/>\n"
+    ));
+    s.push_str(&format!(
+        "<path d=\"M {} L {} A {r:.2} {r:.2} 0 1 1 {} Z\" fill=\"#cfe0ff\" fill-opacity=\"0.6\" stroke=\"#1f4fbf\" stroke-width=\"0.8\"/>\n",
+        p(tip, 0.0),
+        p(t.x, t.y),
+        p(t.x, -t.y)
+    ));
+    s.push_str(
+        "<rect x=\"-43\" y=\"-49\" width=\"86\" height=\"98\" fill=\"none\" stroke=\"#333\" stroke-width=\"0.6\"/>\n",
+    );
+    for (m, name) in mounts.iter().zip(["DN1", "DN3", "DN5"]) {
+        s.push_str(&format!(
+            "<circle cx=\"{:.2}\" cy=\"{:.2}\" r=\"1.5\" fill=\"#d62728\"/><text x=\"{:.2}\" y=\"{:.2}\">{name}</text>\n",
+            m.right_mm,
+            -m.forward_mm,
+            m.right_mm + 3.0,
+            -m.forward_mm + 6.0
+        ));
+    }
+    s.push_str(&format!(
+        "<rect x=\"-2\" y=\"{:.2}\" width=\"4\" height=\"4\" fill=\"#2ca02c\"/><text x=\"4\" y=\"{:.2}\">Pixy lens</text>\n",
+        -lens - 2.0,
+        -lens + 2.0
+    ));
+    s.push_str(
+        "<line x1=\"0\" y1=\"0\" x2=\"0\" y2=\"-20\" stroke=\"#1f4fbf\" stroke-width=\"0.5\"/>\n",
+    );
+    for (k, line) in [
+        format!("round back: radius {r:.0} mm (dashed: tv75's disc)"),
+        format!(
+            "tip {tip:.0} mm ahead; faces tangent at {:.1} mm ahead, {:.1} mm to each side",
+            t.x, t.y
+        ),
+        format!("angle at the tip {:.1} degrees", o.tip_angle().to_degrees()),
+        "chassis 98 x 86 mm (Zumo 32U4); 1 mm = 2 px".to_string(),
+    ]
+    .iter()
+    .enumerate()
+    {
+        s.push_str(&format!(
+            "<text x=\"-88\" y=\"{}\">{line}</text>\n",
+            80 + 7 * k
+        ));
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+#[test]
+fn the_skirt_drawing_in_the_docs_is_the_outline_drawn_to_scale() {
+    // REGENERATE_DOCS=1 cargo test -p sim --test wedge writes it.
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/robot-sensors/skirt.svg");
+    let svg = skirt_svg();
+    if std::env::var_os("REGENERATE_DOCS").is_some() {
+        std::fs::write(&path, &svg).unwrap();
+    }
+    let published = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        published == svg,
+        "docs/robot-sensors/skirt.svg is not the outline's drawing; regenerate it with REGENERATE_DOCS=1 cargo test -p sim --test wedge"
+    );
 }

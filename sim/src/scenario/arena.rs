@@ -59,7 +59,7 @@ pub enum SkirtShape {
     },
 }
 
-/// Where the tip of `tv75`'s wedge is, mm ahead of the robot's centre
+/// Where the tip of the thesis' wedge is on `tv75`'s robots, mm ahead of the robot's centre
 /// (`docs/robot-sensors.md`, "The skirt's outline"): as far as the skirt
 /// can reach and stay out of the Pixy's image. The camera's lowest ray
 /// (lens 80 mm high, 15 mm ahead, tilted 20 degrees, 47 degrees of view:
@@ -69,8 +69,19 @@ pub enum SkirtShape {
 pub const TV75_TIP_MM: f64 = 85.0;
 
 /// The height of the skirt's top above the floor, mm: two layers of 5 mm
-/// foam board (an assumption; the thesis does not give it).
+/// foam board (an assumption; the thesis does not give it), for
+/// [`TV75_TIP_MM`]'s margin.
 pub const SKIRT_HEIGHT_MM: f64 = 10.0;
+
+impl SkirtShape {
+    /// The thesis' skirt on `tv75`'s robots: the wedge with its tip
+    /// [`TV75_TIP_MM`] ahead (`experiments/arenas/tv75-wedge.toml`).
+    pub fn thesis_wedge() -> SkirtShape {
+        SkirtShape::Wedge {
+            tip_mm: TV75_TIP_MM,
+        }
+    }
+}
 
 /// A screen arena and the bodies on it. Every field is optional in a file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -119,11 +130,11 @@ impl ArenaSpec {
 
     /// The thesis' hardware (section 1.4): a 75" LG TV (75UK6190PUB) lying
     /// flat, 1,650 x 928 mm visible, 3840 x 2160 pixels; a Zumo 32U4
-    /// (98 x 86 mm) in the thesis' skirt: round, 65 mm radius (the least
-    /// circle around the chassis), with a pointed wedge whose tip is
-    /// [`TV75_TIP_MM`] ahead of the centre; 5 robots and 12 pucks as large
-    /// (the round back's radius) and heavy as a robot (as
-    /// in the thesis, radius and mass equal); the thesis' forward speed of
+    /// (98 x 86 mm) in a round skirt of 65 mm radius, the least circle
+    /// around the chassis (the thesis' wedge-fronted skirt is
+    /// `experiments/arenas/tv75-wedge.toml`, with its tip [`TV75_TIP_MM`]
+    /// ahead of the centre); 5 robots and 12 pucks as large and heavy as a
+    /// robot (as in the thesis, radius and mass equal); the thesis' forward speed of
     /// 2 units (0.2 radii) per step; trials of 15,000 steps (5 minutes);
     /// images kept in their aspect; display gamma 2.2 (a TV's nominal). The
     /// counts, sizes and trial length are ours, from a sweep with the disc
@@ -137,9 +148,7 @@ impl ArenaSpec {
             fit: FieldFit::Contain,
             display_gamma: 2.2,
             robot_radius_mm: 65.0,
-            robot_shape: SkirtShape::Wedge {
-                tip_mm: TV75_TIP_MM,
-            },
+            robot_shape: SkirtShape::Disc,
             puck_radius_mm: 65.0,
             puck_mass_ratio: 1.0,
             robots: 5,

@@ -948,10 +948,12 @@ mod reference;
 mod tests {
     use super::*;
     use crate::base::rng::SimRng;
+    use crate::config::robot_shape::RobotShape;
     use crate::config::SimConfig;
     use crate::physics::body::RobotKind;
     use rand::{RngExt, SeedableRng};
     use shared::ImageRegion;
+    use std::f64::consts::FRAC_PI_2;
     use std::sync::Arc;
 
     const R: f64 = 10.0;
@@ -1082,6 +1084,52 @@ mod tests {
             "{blocks:?}"
         );
         assert_eq!(blocks.last().map(|b| b.signature), Some(2));
+    }
+
+    /// Robot 0 at (400, 400) facing +x and robot 1 six radii ahead of it
+    /// facing +y (robot 0's right), both of `shape`: robot 0's frame.
+    fn side_on(shape: RobotShape) -> Vec<PixyBlock> {
+        let mut config = SimConfig::default();
+        config.world.robot_shape = shape;
+        config.world.robots = 2;
+        config.world.pucks = 0;
+        let scene = [
+            (Vec2::new(400.0, 400.0), 0.0, RobotKind::Outie),
+            (Vec2::new(460.0, 400.0), FRAC_PI_2, RobotKind::Outie),
+        ];
+        let world = World::scene(&config, &scene, &[], 1);
+        let mut camera = PixyCamera::new(&PixyCameraConfig::default(), 5.0);
+        let mut out = Vec::new();
+        camera.frame(&world, 0, &mut out);
+        out
+    }
+
+    #[test]
+    fn a_wedge_seen_side_on_reaches_to_its_tip_s_hand_computed_column() {
+        // The wedge's tip (13 units = 65 mm to the right of its centre,
+        // 57 units = 285 mm ahead of the lens) at the robot's top (60 mm;
+        // the lens is 80 mm up, tilted 20 degrees) is its rightmost point:
+        // depth 285 cos 20 + 20 sin 20 mm, column 160 + fx 65 / depth, fx
+        // = 160 / tan 37.5 degrees. The tangent points and the round back
+        // reach less far right (at most 38 / 236 of the depth against the
+        // tip's 65 / 285).
+        let t = 20f64.to_radians();
+        let depth = 285.0 * t.cos() + 20.0 * t.sin();
+        let fx = 160.0 / 37.5f64.to_radians().tan();
+        let right = (160.0 + fx * 65.0 / depth).ceil() as u16 - 1;
+        let wedge = side_on(RobotShape::Wedge { tip: 13.0 });
+        assert_eq!(wedge.len(), 1, "{wedge:?}");
+        let w = wedge[0];
+        assert_eq!(w.signature, 2);
+        assert_eq!(w.x - w.width / 2 + w.width, right, "{w:?}");
+        // Its round back is the disc's: the same rows, and on the left no
+        // further out than the disc's own edge (the back's rim is sampled
+        // from the robot's heading, the disc's from the lens).
+        let disc = side_on(RobotShape::Disc)[0];
+        assert_eq!((w.y, w.height), (disc.y, disc.height), "{w:?} {disc:?}");
+        let (left, disc_left) = (w.x - w.width / 2, disc.x - disc.width / 2);
+        assert!(left >= disc_left && left <= disc_left + 1, "{w:?} {disc:?}");
+        assert!(w.width > disc.width + 10, "{w:?} {disc:?}");
     }
 
     #[test]
