@@ -406,8 +406,15 @@ impl StepContext<'_> {
             }
         }
         let d = d2.sqrt();
-        let overlap = ri + rj - d;
-        let normal = delta * (1.0 / d);
+        self.push_apart(i, j, ri + rj - d, delta * (1.0 / d));
+        true
+    }
+
+    /// Moves bodies `i` and `j`, overlapping by `overlap`, apart along the
+    /// unit `normal` (from `i` to `j`) by shares of their masses, and
+    /// records the contact.
+    #[inline]
+    fn push_apart(&mut self, i: usize, j: usize, overlap: f64, normal: Vec2) {
         let (mi, mj) = (self.bodies[i].mass, self.bodies[j].mass);
         let total = mi + mj;
         self.bodies[i].pos -= normal * (overlap * mj / total);
@@ -416,7 +423,6 @@ impl StepContext<'_> {
         self.relocated(j);
         self.scratch.pending.insert(j);
         self.record_bodies(i as u32, j as u32);
-        true
     }
 
     /// [`Self::separate`] for a pair with a wedge robot: the outline's
@@ -427,14 +433,7 @@ impl StepContext<'_> {
         if overlap <= self.config.overlap_threshold {
             return false;
         }
-        let (mi, mj) = (self.bodies[i].mass, self.bodies[j].mass);
-        let total = mi + mj;
-        self.bodies[i].pos -= normal * (overlap * mj / total);
-        self.bodies[j].pos += normal * (overlap * mi / total);
-        self.relocated(i);
-        self.relocated(j);
-        self.scratch.pending.insert(j);
-        self.record_bodies(i as u32, j as u32);
+        self.push_apart(i, j, overlap, normal);
         true
     }
 
