@@ -209,7 +209,9 @@ fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5
     assert_eq!(resumes_exactly(wedge.clone(), 1100, 2500), 5);
     // the same run on tv75's discs is another run, of an older format
     let disc = TrainConfig {
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named("tv75".into())),
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
+            "tv75".into(),
+        )),
         ..wedge.clone()
     };
     assert!(resumes_exactly(disc.clone(), 1100, 2500) < 5);
