@@ -558,7 +558,7 @@ fn skirt_svg() -> String {
     let mut s = String::new();
     s.push_str(
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"360\" height=\"440\" \
-         viewBox=\"-90 -110 180 220\" font-family=\"sans-serif\" font-size=\"5\">\n",
+         viewBox=\"-90 -110 180 220\" font-family=\"sans-serif\" font-size=\"4\">\n",
     );
     s.push_str("<rect x=\"-90\" y=\"-110\" width=\"180\" height=\"220\" fill=\"white\"/>\n");
     s.push_str(&format!(
@@ -593,7 +593,7 @@ fn skirt_svg() -> String {
     for (k, line) in [
         format!("round back: radius {r:.0} mm (dashed: tv75's disc)"),
         format!(
-            "tip {tip:.0} mm ahead; faces tangent at {:.1} mm ahead, {:.1} mm to each side",
+            "tip {tip:.0} mm ahead; faces tangent {:.1} mm ahead, {:.1} mm aside",
             t.x, t.y
         ),
         format!("angle at the tip {:.1} degrees", o.tip_angle().to_degrees()),
