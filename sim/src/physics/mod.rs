@@ -147,6 +147,18 @@ pub(crate) struct StepContext<'a> {
     pub scratch: &'a mut PhysicsScratch,
 }
 
+/// The four walls of a `w` x `h` arena in the order contacts meet them:
+/// (whether the wall is vertical, its coordinate, its inward normal).
+#[inline]
+fn walls(w: f64, h: f64) -> [(bool, f64, Vec2); 4] {
+    [
+        (false, 0.0, Vec2::new(0.0, 1.0)),
+        (true, w, Vec2::new(-1.0, 0.0)),
+        (false, h, Vec2::new(0.0, -1.0)),
+        (true, 0.0, Vec2::new(1.0, 0.0)),
+    ]
+}
+
 impl StepContext<'_> {
     /// Runs one step (dt = 1).
     pub fn step(&mut self) {
@@ -256,14 +268,7 @@ impl StepContext<'_> {
         if (p.x >= reach) & (p.x <= w - reach) & (p.y >= reach) & (p.y <= h - reach) {
             return; // farther than `reach` from every wall: no contact possible
         }
-        // (axis is x?, wall coordinate, inward normal)
-        let walls = [
-            (false, 0.0, Vec2::new(0.0, 1.0)),
-            (true, w, Vec2::new(-1.0, 0.0)),
-            (false, h, Vec2::new(0.0, -1.0)),
-            (true, 0.0, Vec2::new(1.0, 0.0)),
-        ];
-        for (vertical, at, inward) in walls {
+        for (vertical, at, inward) in walls(w, h) {
             let b = self.bodies[i];
             let across = if vertical { b.pos.x - at } else { b.pos.y - at };
             if across.abs() >= reach {
@@ -301,13 +306,7 @@ impl StepContext<'_> {
             return;
         }
         let direction = self.robots[i].direction;
-        let walls = [
-            (false, 0.0, Vec2::new(0.0, 1.0)),
-            (true, w, Vec2::new(-1.0, 0.0)),
-            (false, h, Vec2::new(0.0, -1.0)),
-            (true, 0.0, Vec2::new(1.0, 0.0)),
-        ];
-        for (vertical, at, inward) in walls {
+        for (vertical, at, inward) in walls(w, h) {
             let b = self.bodies[i];
             // The centre's distance from the wall, positive inside.
             let across = if vertical {
