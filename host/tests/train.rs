@@ -226,6 +226,34 @@ fn decaying_exploration_is_the_same_per_seed_and_resumes_exactly_from_a_format_5
 }
 
 #[test]
+fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5_checkpoint() {
+    let arena = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../experiments/arenas/tv75-wedge.toml");
+    let wedge = TrainConfig {
+        sensors: SensorChoice::Robot(None),
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(arena)),
+        noise: 1.0,
+        seed: 17,
+        ..TrainConfig::default()
+    };
+    assert_eq!(resumes_exactly(wedge.clone(), 1100, 2500), 5);
+    // the same run on tv75's discs is another run, of an older format
+    let disc = TrainConfig {
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
+            "tv75".into(),
+        )),
+        ..wedge.clone()
+    };
+    assert!(resumes_exactly(disc.clone(), 1100, 2500) < 5);
+    let table = |config: TrainConfig| {
+        let mut t = trainer(config);
+        t.run(5_000);
+        t.learner().table().clone()
+    };
+    assert_ne!(table(wedge), table(disc), "the wedge changed nothing");
+}
+
+#[test]
 fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_byte() {
     // the published pre-trained tables of docs/reproduction were written by earlier builds
     let docs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");

@@ -1,9 +1,9 @@
 //! Pictures of the world like the thesis' Figure 11: the field as a grey
-//! background (0 black, 1 white), pucks red, robots blue with a heading
-//! line, optionally the outline of the target band (cyan: the edge of the
-//! region whose field value lies between the thresholds, where Eval wants
-//! every puck) and each robot's sensor footprints. (Writing them as PNG or
-//! GIF files is the host's.)
+//! background (0 black, 1 white), pucks red, robots blue (discs, or their
+//! wedge-fronted outline) with a heading line, optionally the outline of
+//! the target band (cyan: the edge of the region whose field value lies
+//! between the thresholds, where Eval wants every puck) and each robot's
+//! sensor footprints. (Writing them as PNG or GIF files is the host's.)
 //!
 //! Room 11 of the simulator (`lib.rs`), at the top: it reads a simulation and
 //! changes nothing.
@@ -11,6 +11,7 @@
 use crate::base::vec2::Vec2;
 use crate::episodes::eval::in_band;
 use crate::fields::ScalarField;
+use crate::physics::outline::Outline;
 use crate::sensors::{FootprintKind, SensorModel};
 use crate::simulation::Simulation;
 use crate::world::World;
@@ -112,9 +113,13 @@ fn draw_bodies(img: &mut RgbImage, world: &World, scale: f64) {
     for puck in world.pucks() {
         fill_circle(img, to_px(puck.pos), puck.radius * scale, PUCK);
     }
+    let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
     for (i, robot) in world.robots().iter().enumerate() {
         let body = &world.bodies()[i];
-        fill_circle(img, to_px(body.pos), body.radius * scale, ROBOT);
+        match &outline {
+            None => fill_circle(img, to_px(body.pos), body.radius * scale, ROBOT),
+            Some(o) => fill_outline(img, to_px(body.pos), robot.direction, o, scale, ROBOT),
+        }
         let tip = body.pos + robot.direction * body.radius;
         draw_line(img, to_px(body.pos), to_px(tip), HEADING);
     }
@@ -139,6 +144,34 @@ pub fn outline_region(img: &mut RgbImage, colour: Rgb<u8>, inside: impl Fn(u32, 
                     || (y + 1 < h && !at(x, y + 1)));
             if edge {
                 img.put_pixel(x, y, colour);
+            }
+        }
+    }
+}
+
+/// Fills the outline of a wedge-fronted robot centred at `c` (pixels),
+/// facing `direction`, at `scale` pixels per unit: every pixel whose centre
+/// lies inside it.
+pub fn fill_outline(
+    img: &mut RgbImage,
+    c: Vec2,
+    direction: Vec2,
+    outline: &Outline,
+    scale: f64,
+    colour: Rgb<u8>,
+) {
+    let reach = (outline.tip() * scale).ceil() as i64;
+    let (cx, cy) = (c.x.floor() as i64, c.y.floor() as i64);
+    let right = Vec2::new(-direction.y, direction.x);
+    for y in cy - reach..=cy + reach {
+        for x in cx - reach..=cx + reach {
+            let d = (Vec2::new(x as f64 + 0.5, y as f64 + 0.5) - c) * (1.0 / scale);
+            if outline
+                .distance(Vec2::new(d.dot(direction), d.dot(right)))
+                .0
+                <= 0.0
+            {
+                put(img, x, y, colour);
             }
         }
     }

@@ -15,7 +15,7 @@ use std::sync::Arc;
 fn the_same_seed_gives_the_same_trajectory_with_the_robot_model() {
     let run = || {
         let config = SimConfig::default();
-        let sensors = RobotSensors::new(&RobotSensorConfig::default(), config.world.unit_mm);
+        let sensors = RobotSensors::new(&RobotSensorConfig::default(), &config.world);
         let mut sim =
             Simulation::with_sensors(config, Arc::new(ScalarField::annulus()), sensors, 5).unwrap();
         let mut controller = RandomTurns::new(ActionTable::default());
@@ -48,7 +48,11 @@ fn a_puck_in_the_thesis_side_disc_is_sensed_by_the_discs_but_not_the_camera() {
     let mut reading = [SensorReading::default()];
     DiscSensors::new(&DiscSensorConfig::default(), 10.0).sense(&world, &field, &mut reading);
     assert!(reading[0].puck_right);
-    RobotSensors::new(&RobotSensorConfig::default(), 5.0).sense(&world, &field, &mut reading);
+    RobotSensors::new(&RobotSensorConfig::default(), &config.world).sense(
+        &world,
+        &field,
+        &mut reading,
+    );
     assert!(!reading[0].puck_right && !reading[0].puck_left);
 }
 

@@ -311,7 +311,10 @@ mod tests {
 
     #[test]
     fn mirroring_swaps_sides_and_the_hash_notices() {
-        let model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
+        let model = RobotSensors::new(
+            &RobotSensorConfig::default(),
+            &sim::config::WorldConfig::default(),
+        );
         let policy = read_policy("robot-annulus-10bit.policy").unwrap().1;
         assert_eq!(policy.hasher(), StateHasher::OriginalObstacle);
         let e = Expectation::new(&model, &policy, shared::Role::Outie);

@@ -248,7 +248,7 @@ fn equivalence(v: &Variant) {
     check_elf_embeds(&elf, &policy, v.build).unwrap_or_else(|e| panic!("{e:#}"));
 
     let config = RobotSensorConfig::default();
-    let model = RobotSensors::new(&config, 5.0);
+    let model = RobotSensors::new(&config, &sim::config::WorldConfig::default());
     let role = Role::of_robot_id(v.robot_id);
     let expectation = Expectation::new(&model, &policy, role);
     let samples = samples_of(&path);

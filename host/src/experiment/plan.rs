@@ -16,7 +16,8 @@ use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
 use sim::base::ranges;
-use sim::scenario::{orbital_innies, THESIS_ROBOTS};
+use sim::config::robot_shape::RobotShape;
+use sim::scenario::{orbital_innies, Arena, THESIS_ROBOTS};
 use std::path::PathBuf;
 
 /// Version of `TrialResult`'s layout and meaning, and of the
@@ -25,7 +26,9 @@ use std::path::PathBuf;
 /// `sin_cos` (`sim::base::trig`) instead of the platform's. (The settings of the
 /// thesis author's runs, `formation_check` and the others, left it at 2:
 /// at their defaults every trial runs and means what it did, and keeps its
-/// hash: see `hashed`.)
+/// hash: see `hashed`. Runs whose robots wear the wedge-fronted skirt,
+/// `tv75`'s since issue 30, also hash their outline, so their trials of the
+/// disc-bodied TV are run again, while every disc run keeps its hash.)
 pub const RESULT_FORMAT: u32 = 2;
 
 /// Everything one trial needs.
@@ -108,6 +111,11 @@ enum Hashed {
         model: u32,
         settings: Box<Hashed>,
     },
+    /// Settings whose robots are not discs, and their outline.
+    Outline {
+        robot_shape: RobotShape,
+        settings: Box<Hashed>,
+    },
 }
 
 /// [`Hashed`] settings of `config`.
@@ -128,13 +136,29 @@ fn hashed(config: &TrainConfig) -> Hashed {
     } else {
         Hashed::Current(c)
     };
-    if robot_senses {
+    let settings = if robot_senses {
         Hashed::RobotSenses {
             model: sim::sensors::robot::MODEL_VERSION,
             settings: Box::new(settings),
         }
     } else {
         settings
+    };
+    match robot_shape(config) {
+        RobotShape::Disc => settings,
+        robot_shape => Hashed::Outline {
+            robot_shape,
+            settings: Box::new(settings),
+        },
+    }
+}
+
+/// The outline of the run's robots: its screen arena's (an arena file
+/// that cannot be read fails the run itself, and hashes as discs).
+fn robot_shape(config: &TrainConfig) -> RobotShape {
+    match config.arena_choice().arena() {
+        Ok(Arena::Screen(spec)) => spec.robot_shape_units(),
+        Ok(Arena::Square(_)) | Err(_) => RobotShape::Disc,
     }
 }
 

@@ -52,6 +52,8 @@ pub const DOCUMENTS: [Document; 2] = [
             "robot-senses-sweep",
             "robustness",
             "robot-senses-letter",
+            "wedge",
+            "wedge-sweep",
         ],
     },
 ];

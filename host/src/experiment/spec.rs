@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 12] = [
+pub const BUILT_IN: [(&str, &str); 14] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
@@ -58,6 +58,11 @@ pub const BUILT_IN: [(&str, &str); 12] = [
     (
         "robot-senses-letter",
         include_str!("../../../experiments/robot-senses-letter.toml"),
+    ),
+    ("wedge", include_str!("../../../experiments/wedge.toml")),
+    (
+        "wedge-sweep",
+        include_str!("../../../experiments/wedge-sweep.toml"),
     ),
 ];
 

@@ -13,9 +13,9 @@
 //!
 //! Format 5's body is the [`TrainingState`]; formats 1 to 4 are the
 //! state without the settings added since ([`super::format1`],
-//! [`super::format2`], [`super::format3`], [`super::format4`]). A state is written in the
-//! oldest format that holds it, byte for byte what earlier builds wrote;
-//! all five are read.
+//! [`super::format2`], [`super::format3`], [`super::format4`]). A state is
+//! written in the oldest format that holds it, byte for byte what earlier
+//! builds wrote; all five are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
@@ -42,7 +42,9 @@ pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// run's arena and noise, the counts left to the arena, the motion noise,
 /// the world's seed, episode count and dropped-period turns, the robot
 /// senses' memory. 4: the arena's border (`walls`) and the learner's
-/// rules (`rules`). 5: decaying exploration (`epsilon_decay`).
+/// rules (`rules`). 5: the robots' outline (`robot_shape`: a wedge) and
+/// decaying exploration (`epsilon_decay`); disc states of constant
+/// exploration keep format 4 or older.
 pub const VERSION: u16 = 5;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;

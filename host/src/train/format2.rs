@@ -19,6 +19,7 @@ use crate::learn::{LearnConfig, LearnerRules, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
+use sim::config::robot_shape::RobotShape;
 use sim::config::{EpisodeConfig, SimConfig, SuccessSignal, Thresholds, Walls, WorldConfig};
 use sim::fields::{FieldFrame, FieldSampling};
 use sim::scenario::arena_choice::ArenaChoice;
@@ -161,7 +162,7 @@ pub(super) struct WorldConfigV2 {
 
 impl WorldConfigV2 {
     pub(super) fn of(w: &WorldConfig) -> Option<WorldConfigV2> {
-        w.actuation.is_none().then_some(WorldConfigV2 {
+        (w.actuation.is_none() && w.robot_shape.is_disc()).then_some(WorldConfigV2 {
             arena_width: w.arena_width,
             arena_height: w.arena_height,
             unit_mm: w.unit_mm,
@@ -187,6 +188,7 @@ impl WorldConfigV2 {
             innies: self.innies,
             pucks: self.pucks,
             robot_radius: self.robot_radius,
+            robot_shape: RobotShape::Disc,
             puck_radius: self.puck_radius,
             puck_mass: self.puck_mass,
             forward_speed: self.forward_speed,

@@ -8,9 +8,11 @@
 //!
 //! postcard is positional: these structs list format 3's fields in their
 //! order, the types they share with the newest format unchanged.
-//! [`PhysicsConfigV3`] is also the physics layout of formats 1 and 2.
+//! [`PhysicsConfigV3`] is also the physics layout of formats 1 and 2; the
+//! world's is format 4's ([`WorldConfigV4`]: discs).
 
 use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::format4::WorldConfigV4;
 use super::selection::{SelectConfig, Selected};
 use super::trainer::TrainingState;
 use crate::learn::{LearnConfig, LearnerRules, QLearner};
@@ -18,9 +20,7 @@ use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::base::rng::SimRng;
 use sim::config::disc_sensors::DiscSensorConfig;
-use sim::config::{
-    EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, Walls, WorldConfig,
-};
+use sim::config::{EpisodeConfig, PhysicsConfig, SimConfig, SuccessSignal, Thresholds, Walls};
 use sim::fields::source::FieldSource;
 use sim::physics::body::{Body, Robot};
 use sim::scenario::arena_choice::ArenaChoice;
@@ -158,7 +158,7 @@ impl PhysicsConfigV3 {
 
 #[derive(Serialize, Deserialize)]
 struct SimConfigV3 {
-    world: WorldConfig,
+    world: WorldConfigV4,
     physics: PhysicsConfigV3,
     sensors: DiscSensorConfig,
     thresholds: Thresholds,
@@ -167,7 +167,7 @@ struct SimConfigV3 {
 
 #[derive(Serialize, Deserialize)]
 struct WorldV3 {
-    config: WorldConfig,
+    config: WorldConfigV4,
     physics: PhysicsConfigV3,
     bodies: Vec<Body>,
     robots: Vec<Robot>,
@@ -201,14 +201,14 @@ impl StateV3 {
             field_crc: state.field_crc,
             sim: SimulationV3 {
                 config: SimConfigV3 {
-                    world: s.config.world.clone(),
+                    world: WorldConfigV4::of(&s.config.world)?,
                     physics: PhysicsConfigV3::of(&s.config.physics)?,
                     sensors: s.config.sensors.clone(),
                     thresholds: s.config.thresholds.clone(),
                     episode: s.config.episode.clone(),
                 },
                 world: WorldV3 {
-                    config: w.config.clone(),
+                    config: WorldConfigV4::of(&w.config)?,
                     physics: PhysicsConfigV3::of(&w.physics)?,
                     bodies: w.bodies.clone(),
                     robots: w.robots.clone(),
@@ -235,7 +235,7 @@ impl StateV3 {
         let s = self.sim;
         let w = s.world;
         let world = World::from_state(WorldState {
-            config: w.config,
+            config: w.config.into_config(),
             physics: w.physics.into_config(),
             bodies: w.bodies,
             robots: w.robots,
@@ -250,7 +250,7 @@ impl StateV3 {
             field_crc: self.field_crc,
             sim: SimulationState {
                 config: SimConfig {
-                    world: s.config.world,
+                    world: s.config.world.into_config(),
                     physics: s.config.physics.into_config(),
                     sensors: s.config.sensors,
                     thresholds: s.config.thresholds,

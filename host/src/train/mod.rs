@@ -1,6 +1,6 @@
 //! Training: a run's settings ([`config`]), the learning loop over any
 //! sensor model ([`trainer`]), its checkpoint file ([`checkpoint`]; the
-//! layouts of formats 1 and 2: [`format1`], [`format2`]) and the `host train` command
+//! layouts of formats 1 to 4: [`format1`], [`format2`], [`format3`], [`format4`]) and the `host train` command
 //! ([`command`]).
 
 pub mod checkpoint;

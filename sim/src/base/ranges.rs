@@ -308,6 +308,20 @@ pub const ROBOT_RADIUS_UNITS: Range = Range::closed(
     "10 in every built-in arena (the unit is a tenth of it)",
 );
 
+/// A wedge skirt's tip distance from the robot's centre over the round
+/// back's radius (`docs/robot-sensors.md`, "The skirt's outline").
+pub const TIP_RADII: Range = Range::closed(
+    &[
+        "world.robot_shape.wedge.tip / world.robot_radius",
+        "arena.robot_shape.wedge.tip_mm / arena.robot_radius_mm",
+    ],
+    1.0,
+    3.0,
+    "robot radii",
+    "the tip lies beyond the round back; the thesis' wedge on the TV (tv75-wedge.toml) is 1.31 radii, and a longer needle is no skirt",
+)
+.above_min();
+
 /// A puck's radius over a robot's.
 pub const PUCK_OVER_ROBOT_RADIUS: Range = Range::closed(
     &["world.puck_radius / world.robot_radius"],
@@ -793,6 +807,7 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &ARENA_IN_ROBOT_RADII,
             &UNIT_MM,
             &ROBOT_RADIUS_UNITS,
+            &TIP_RADII,
             &PUCK_OVER_ROBOT_RADIUS,
             &PUCK_MASS_RATIO,
             &FORWARD_SPEED_RADII,

@@ -9,12 +9,14 @@
 
 pub mod actuation;
 pub mod disc_sensors;
+pub mod robot_shape;
 pub mod validate;
 
 use crate::base::ranges;
 use crate::base::vec2::Vec2;
 use crate::config::actuation::ActuationNoise;
 use crate::config::disc_sensors::DiscSensorConfig;
+use crate::config::robot_shape::RobotShape;
 use crate::config::validate::{check, positive, ConfigError};
 use crate::fields::{FieldFrame, FieldLayout, FieldSampling};
 use serde::{Deserialize, Serialize};
@@ -51,8 +53,10 @@ pub struct WorldConfig {
     pub innies: usize,
     /// Number of pucks (bodies `robots .. robots + pucks`).
     pub pucks: usize,
-    /// Robot radius, units.
+    /// Robot radius, units: the disc's, or the round back of a wedge.
     pub robot_radius: f64,
+    /// The robots' outline ([`RobotShape`]): the disc by default.
+    pub robot_shape: RobotShape,
     /// Puck radius, units.
     pub puck_radius: f64,
     /// Puck mass; `None` for the reference model's 10 x radius (the same
@@ -83,6 +87,7 @@ impl Default for WorldConfig {
             innies: 0,
             pucks: 250,
             robot_radius: 10.0,
+            robot_shape: RobotShape::Disc,
             puck_radius: 10.0,
             puck_mass: None,
             forward_speed: 2.0,
@@ -100,9 +105,16 @@ impl WorldConfig {
         self.robots + self.pucks
     }
 
-    /// The larger of the two radii.
+    /// The larger of the robots' and the pucks' bounding radii.
     pub(crate) fn max_radius(&self) -> f64 {
-        self.robot_radius.max(self.puck_radius)
+        self.robot_body_radius().max(self.puck_radius)
+    }
+
+    /// A robot body's radius: its outline's bounding radius (the disc's
+    /// radius, or a wedge's tip distance), which the neighbour search and
+    /// the cheap culls use.
+    pub fn robot_body_radius(&self) -> f64 {
+        self.robot_shape.bounding_radius(self.robot_radius)
     }
 
     /// The arena's width and height.
@@ -320,6 +332,7 @@ impl SimConfig {
             w.arena_height / r,
         )?;
         ranges::UNIT_MM.check(w.unit_mm)?;
+        w.robot_shape.validate(w.robot_radius)?;
         positive("world.puck_radius", w.puck_radius)?;
         ranges::PUCK_OVER_ROBOT_RADIUS.check(w.puck_radius / r)?;
         if let Some(mass) = w.puck_mass {
@@ -332,6 +345,12 @@ impl SimConfig {
             w.puck_radius,
             8.0 * w.puck_radius < short_side,
             "pucks start at least 4 radii from the walls, so 8 x radius must be less than the arena's shorter side",
+        )?;
+        check(
+            "world.robot_radius",
+            w.robot_radius,
+            2.0 * w.robot_body_radius() < short_side,
+            "a robot must fit in the arena",
         )?;
         if let Some(f) = &w.field_frame {
             positive("world.field_frame.width", f.width)?;

@@ -12,11 +12,21 @@
 //! index only narrows down which pairs are tested, so the grid and the
 //! all-pairs search give bit-identical results.
 //!
+//! Robots' bodies are the disc of their radius or, with
+//! [`crate::config::robot_shape::RobotShape::Wedge`], a round back with a
+//! pointed wedge ([`outline`]): then a robot's contacts with pucks, other
+//! robots and the walls take the outline's depth and normal where the discs
+//! take the centre line, and follow the same rules (separation by mass
+//! shares, the same elastic impulse along the normal, the walls as
+//! stand-ins of the body's own mass). Contacts move bodies by translation
+//! only; a robot's heading is its controller's alone.
+//!
 //! Room 4 of the simulator (`lib.rs`), the second stage of a step (world -> **physics** -> sensors -> control).
 
 pub mod body;
 pub(crate) mod broadphase;
 pub mod grid;
+pub mod outline;
 
 use crate::base::bitset::BitSet;
 use crate::base::rng::SimRng;
@@ -24,6 +34,7 @@ use crate::base::vec2::Vec2;
 use crate::config::{PhysicsConfig, Walls};
 use crate::physics::body::{Body, Robot};
 use crate::physics::broadphase::{Candidates, NeighbourIndex};
+use crate::physics::outline::Outline;
 use rand::RngExt;
 
 /// What the other side of a contact is.
@@ -126,12 +137,26 @@ pub(crate) struct StepContext<'a> {
     pub arena: Vec2,
     /// The largest body radius.
     pub max_radius: f64,
+    /// The robots' outline if they are wedges (`None`: discs).
+    pub outline: Option<Outline>,
     /// Neighbour index, kept up to date with every move.
     pub index: &'a mut NeighbourIndex,
     /// Generator for the coincident-centre nudge.
     pub rng: &'a mut SimRng,
     /// Reused buffers.
     pub scratch: &'a mut PhysicsScratch,
+}
+
+/// The four walls of a `w` x `h` arena in the order contacts meet them:
+/// (whether the wall is vertical, its coordinate, its inward normal).
+#[inline]
+fn walls(w: f64, h: f64) -> [(bool, f64, Vec2); 4] {
+    [
+        (false, 0.0, Vec2::new(0.0, 1.0)),
+        (true, w, Vec2::new(-1.0, 0.0)),
+        (false, h, Vec2::new(0.0, -1.0)),
+        (true, 0.0, Vec2::new(1.0, 0.0)),
+    ]
 }
 
 impl StepContext<'_> {
@@ -189,12 +214,18 @@ impl StepContext<'_> {
         while let Some(i) = self.scratch.pending.next_from(cursor) {
             cursor = i + 1;
             if self.config.walls == Walls::Segments {
-                self.resolve_walls(i);
+                match self.outline.filter(|_| i < self.robots.len()) {
+                    None => self.resolve_walls(i),
+                    Some(outline) => self.resolve_walls_outline(i, &outline),
+                }
             }
             if self.scratch.awake.contains(i) {
                 self.resolve_circles(i);
             }
-            self.clamp(i);
+            match self.outline.filter(|_| i < self.robots.len()) {
+                None => self.clamp(i),
+                Some(outline) => self.clamp_outline(i, &outline),
+            }
         }
     }
 
@@ -237,14 +268,7 @@ impl StepContext<'_> {
         if (p.x >= reach) & (p.x <= w - reach) & (p.y >= reach) & (p.y <= h - reach) {
             return; // farther than `reach` from every wall: no contact possible
         }
-        // (axis is x?, wall coordinate, inward normal)
-        let walls = [
-            (false, 0.0, Vec2::new(0.0, 1.0)),
-            (true, w, Vec2::new(-1.0, 0.0)),
-            (false, h, Vec2::new(0.0, -1.0)),
-            (true, 0.0, Vec2::new(1.0, 0.0)),
-        ];
-        for (vertical, at, inward) in walls {
+        for (vertical, at, inward) in walls(w, h) {
             let b = self.bodies[i];
             let across = if vertical { b.pos.x - at } else { b.pos.y - at };
             if across.abs() >= reach {
@@ -263,6 +287,43 @@ impl StepContext<'_> {
             }
             let normal = if d > 0.0 { delta * (1.0 / d) } else { inward };
             self.bodies[i].pos += normal * overlap;
+            self.relocated(i);
+            self.record_wall(i as u32, point, -b.vel);
+        }
+    }
+
+    /// The four walls against robot `i`'s outline, in the discs' order:
+    /// the outline reaches `support` towards a wall, so it overlaps the
+    /// wall by `support + wall_radius - across`, and is pushed out along
+    /// the wall's inward normal. The stand-in sits where the discs' does,
+    /// at the wall point nearest to the centre, so the impulse is along
+    /// the same normal.
+    fn resolve_walls_outline(&mut self, i: usize, outline: &Outline) {
+        let (w, h) = (self.arena.x, self.arena.y);
+        let reach = self.bodies[i].radius + self.config.wall_radius - self.config.overlap_threshold;
+        let p = self.bodies[i].pos;
+        if (p.x >= reach) & (p.x <= w - reach) & (p.y >= reach) & (p.y <= h - reach) {
+            return;
+        }
+        let direction = self.robots[i].direction;
+        for (vertical, at, inward) in walls(w, h) {
+            let b = self.bodies[i];
+            // The centre's distance from the wall, positive inside.
+            let across = if vertical {
+                (b.pos.x - at) * inward.x
+            } else {
+                (b.pos.y - at) * inward.y
+            };
+            let overlap = outline.support(direction, -inward) + self.config.wall_radius - across;
+            if overlap <= self.config.overlap_threshold {
+                continue;
+            }
+            let point = if vertical {
+                Vec2::new(at, b.pos.y.clamp(0.0, h))
+            } else {
+                Vec2::new(b.pos.x.clamp(0.0, w), at)
+            };
+            self.bodies[i].pos += inward * overlap;
             self.relocated(i);
             self.record_wall(i as u32, point, -b.vel);
         }
@@ -338,9 +399,21 @@ impl StepContext<'_> {
                 return false;
             }
         }
+        if let Some(outline) = self.outline {
+            if i.min(j) < self.robots.len() {
+                return self.separate_outline(i, j, &outline);
+            }
+        }
         let d = d2.sqrt();
-        let overlap = ri + rj - d;
-        let normal = delta * (1.0 / d);
+        self.push_apart(i, j, ri + rj - d, delta * (1.0 / d));
+        true
+    }
+
+    /// Moves bodies `i` and `j`, overlapping by `overlap`, apart along the
+    /// unit `normal` (from `i` to `j`) by shares of their masses, and
+    /// records the contact.
+    #[inline]
+    fn push_apart(&mut self, i: usize, j: usize, overlap: f64, normal: Vec2) {
         let (mi, mj) = (self.bodies[i].mass, self.bodies[j].mass);
         let total = mi + mj;
         self.bodies[i].pos -= normal * (overlap * mj / total);
@@ -349,7 +422,39 @@ impl StepContext<'_> {
         self.relocated(j);
         self.scratch.pending.insert(j);
         self.record_bodies(i as u32, j as u32);
+    }
+
+    /// [`Self::separate`] for a pair with a wedge robot: the outline's
+    /// depth and normal ([`StepContext::outline_contact`]) instead of the
+    /// centre line's, the same shares of the overlap.
+    fn separate_outline(&mut self, i: usize, j: usize, outline: &Outline) -> bool {
+        let (overlap, normal) = self.outline_contact(i, j, outline);
+        if overlap <= self.config.overlap_threshold {
+            return false;
+        }
+        self.push_apart(i, j, overlap, normal);
         true
+    }
+
+    /// How deep bodies `i` and `j` (one of them a robot) overlap and the
+    /// unit normal along which `j` leaves `i`: wedge against wedge, or a
+    /// wedge against a puck's circle.
+    fn outline_contact(&self, i: usize, j: usize, outline: &Outline) -> (f64, Vec2) {
+        let robots = self.robots.len();
+        let delta = self.bodies[j].pos - self.bodies[i].pos;
+        match (i < robots, j < robots) {
+            (true, true) => {
+                outline.pair_depth(self.robots[i].direction, self.robots[j].direction, delta)
+            }
+            (true, false) => {
+                outline.circle_depth(self.robots[i].direction, delta, self.bodies[j].radius)
+            }
+            _ => {
+                let (depth, n) =
+                    outline.circle_depth(self.robots[j].direction, -delta, self.bodies[i].radius);
+                (depth, -n)
+            }
+        }
     }
 
     fn clamp(&mut self, i: usize) {
@@ -365,6 +470,28 @@ impl StepContext<'_> {
         }
     }
 
+    /// [`Self::clamp`] for robot `i`'s outline: its reach along each axis
+    /// kept within the arena.
+    fn clamp_outline(&mut self, i: usize, outline: &Outline) {
+        let d = self.robots[i].direction;
+        let reach = |n: Vec2| outline.support(d, n);
+        let b = &mut self.bodies[i];
+        let clamped = Vec2::new(
+            b.pos.x.clamp(
+                reach(Vec2::new(-1.0, 0.0)),
+                self.arena.x - reach(Vec2::new(1.0, 0.0)),
+            ),
+            b.pos.y.clamp(
+                reach(Vec2::new(0.0, -1.0)),
+                self.arena.y - reach(Vec2::new(0.0, 1.0)),
+            ),
+        );
+        if clamped != b.pos {
+            b.pos = clamped;
+            self.relocated(i);
+        }
+    }
+
     /// Records that body `i`'s position changed during overlap resolution.
     #[inline]
     fn relocated(&mut self, i: usize) {
@@ -373,12 +500,20 @@ impl StepContext<'_> {
     }
 
     fn apply_impulses(&mut self) {
+        let robots = self.robots.len();
         for c in &self.scratch.contacts {
             match *c {
                 Contact::Bodies(a, b) => {
                     let (a, b) = (a as usize, b as usize);
                     let (mut x, mut y) = (self.bodies[a], self.bodies[b]);
-                    elastic_impulse(&mut x, &mut y);
+                    match self.outline.filter(|_| a.min(b) < robots) {
+                        None => elastic_impulse(&mut x, &mut y),
+                        Some(outline) => {
+                            // The contact's normal now, as the discs' centre line.
+                            let (_, n) = self.outline_contact(a, b, &outline);
+                            impulse_along(&mut x, &mut y, n);
+                        }
+                    }
                     self.bodies[a].vel = x.vel;
                     self.bodies[b].vel = y.vel;
                 }
@@ -419,7 +554,14 @@ pub fn elastic_impulse(a: &mut Body, b: &mut Body) {
     if d == 0.0 {
         return;
     }
-    let n = delta * (1.0 / d);
+    impulse_along(a, b, delta * (1.0 / d));
+}
+
+/// The elastic collision of two bodies along the unit normal `n` (from `a`
+/// towards `b`): [`elastic_impulse`]'s exchange with the contact's normal
+/// for the centre line.
+#[inline]
+pub fn impulse_along(a: &mut Body, b: &mut Body, n: Vec2) {
     let p = 2.0 * n.dot(a.vel - b.vel) / (a.mass + b.mass);
     a.vel -= n * (p * b.mass);
     b.vel += n * (p * a.mass);

@@ -25,6 +25,7 @@
 
 use crate::base::ranges;
 use crate::base::vec2::Vec2;
+use crate::config::robot_shape::RobotShape;
 use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, Walls};
 use crate::fields::source::{FieldError, FieldSource};
@@ -42,6 +43,46 @@ pub enum FieldFit {
     Stretch,
 }
 
+/// The robots' skirt on a screen, in millimetres: `robot_shape = "disc"` or
+/// `robot_shape = { wedge = { tip_mm = 85.0 } }` in an arena file.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum SkirtShape {
+    /// A round skirt of `robot_radius_mm`.
+    Disc,
+    /// A round skirt of `robot_radius_mm` with a pointed wedge whose tip is
+    /// `tip_mm` ahead of the centre, its faces tangent to the circle
+    /// ([`RobotShape::Wedge`]).
+    Wedge {
+        /// The tip's distance from the robot's centre, mm.
+        tip_mm: f64,
+    },
+}
+
+/// Where the tip of the thesis' wedge is on `tv75`'s robots, mm ahead of the robot's centre
+/// (`docs/robot-sensors.md`, "The skirt's outline"): as far as the skirt
+/// can reach and stay out of the Pixy's image. The camera's lowest ray
+/// (lens 80 mm high, 15 mm ahead, tilted 20 degrees, 47 degrees of view:
+/// 43.5 degrees down) passes the top of a 10 mm skirt (two layers of 5 mm
+/// foam board) 88.8 mm ahead of the centre; 85 mm leaves a 3.8 mm margin
+/// for mounting the camera a little lower or tilting it a little more.
+pub const TV75_TIP_MM: f64 = 85.0;
+
+/// The height of the skirt's top above the floor, mm: two layers of 5 mm
+/// foam board (an assumption; the thesis does not give it), for
+/// [`TV75_TIP_MM`]'s margin.
+pub const SKIRT_HEIGHT_MM: f64 = 10.0;
+
+impl SkirtShape {
+    /// The thesis' skirt on `tv75`'s robots: the wedge with its tip
+    /// [`TV75_TIP_MM`] ahead (`experiments/arenas/tv75-wedge.toml`).
+    pub fn thesis_wedge() -> SkirtShape {
+        SkirtShape::Wedge {
+            tip_mm: TV75_TIP_MM,
+        }
+    }
+}
+
 /// A screen arena and the bodies on it. Every field is optional in a file.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -57,8 +98,10 @@ pub struct ArenaSpec {
     /// The display's gamma: its light is `pixel ^ display_gamma` of full
     /// white (for measuring it, the display page shows grey patches).
     pub display_gamma: f64,
-    /// Robot radius, mm: the Zumo in its skirt.
+    /// Robot radius, mm: the Zumo in its skirt (a wedge's round back).
     pub robot_radius_mm: f64,
+    /// The skirt's outline.
+    pub robot_shape: SkirtShape,
     /// Puck radius, mm.
     pub puck_radius_mm: f64,
     /// A puck's mass over a robot's.
@@ -87,9 +130,11 @@ impl ArenaSpec {
 
     /// The thesis' hardware (section 1.4): a 75" LG TV (75UK6190PUB) lying
     /// flat, 1,650 x 928 mm visible, 3840 x 2160 pixels; a Zumo 32U4
-    /// (98 x 86 mm) in a round skirt of 65 mm radius, the least that
-    /// encloses it; 5 robots and 12 pucks as large and heavy as a robot (as
-    /// in the thesis, radius and mass equal); the thesis' forward speed of
+    /// (98 x 86 mm) in a round skirt of 65 mm radius, the least circle
+    /// around the chassis (the thesis' wedge-fronted skirt is
+    /// `experiments/arenas/tv75-wedge.toml`, with its tip [`TV75_TIP_MM`]
+    /// ahead of the centre); 5 robots and 12 pucks as large and heavy as a
+    /// robot (as in the thesis, radius and mass equal); the thesis' forward speed of
     /// 2 units (0.2 radii) per step; trials of 15,000 steps (5 minutes);
     /// images kept in their aspect; display gamma 2.2 (a TV's nominal). The
     /// counts, sizes and trial length are ours, from a sweep with the disc
@@ -103,6 +148,7 @@ impl ArenaSpec {
             fit: FieldFit::Contain,
             display_gamma: 2.2,
             robot_radius_mm: 65.0,
+            robot_shape: SkirtShape::Disc,
             puck_radius_mm: 65.0,
             puck_mass_ratio: 1.0,
             robots: 5,
@@ -147,12 +193,28 @@ impl ArenaSpec {
                 mm / self.robot_radius_mm,
             )?;
         }
+        if let SkirtShape::Wedge { tip_mm } = self.robot_shape {
+            ranges::TIP_RADII.check_as(
+                "arena.robot_shape.wedge.tip_mm / arena.robot_radius_mm",
+                tip_mm / self.robot_radius_mm,
+            )?;
+        }
         ranges::PUCK_MASS_RATIO.check(self.puck_mass_ratio)?;
         ranges::ROBOTS.check_count("arena.robots", self.robots as u64)?;
         ranges::PUCKS.check_count("arena.pucks", self.pucks as u64)?;
         ranges::FORWARD_SPEED.check(self.forward_speed)?;
         ranges::STUCK_LIMIT.check_count("arena.stuck_limit", self.stuck_limit)?;
         Ok(())
+    }
+
+    /// The skirt in the world's units.
+    pub fn robot_shape_units(&self) -> RobotShape {
+        match self.robot_shape {
+            SkirtShape::Disc => RobotShape::Disc,
+            SkirtShape::Wedge { tip_mm } => RobotShape::Wedge {
+                tip: tip_mm / self.unit_mm(),
+            },
+        }
     }
 
     /// Cells of the annulus generated for this screen: 64 across, as many
@@ -230,6 +292,7 @@ impl ArenaSpec {
         world.arena_height = size.y;
         world.unit_mm = unit;
         world.robot_radius = ROBOT_RADIUS_UNITS;
+        world.robot_shape = self.robot_shape_units();
         world.puck_radius = self.puck_radius_mm / unit;
         world.puck_mass = Some(
             self.puck_mass_ratio * crate::physics::body::Body::MASS_PER_RADIUS * ROBOT_RADIUS_UNITS,

@@ -100,7 +100,7 @@ impl SensorSetup {
                 SelectedSensors::Disc(DiscSensors::new(&discs, radius))
             }
             SensorSetup::Robot(robot) => {
-                SelectedSensors::Robot(Box::new(RobotSensors::new(robot, config.world.unit_mm)))
+                SelectedSensors::Robot(Box::new(RobotSensors::new(robot, &config.world)))
             }
             SensorSetup::Mixed {
                 field,

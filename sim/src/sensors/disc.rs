@@ -7,6 +7,7 @@ use crate::base::vec2::Vec2;
 use crate::config::disc_sensors::{DiscSensorConfig, ObstacleTargets, SensorDisc};
 use crate::fields::ScalarField;
 use crate::physics::body::RobotKind;
+use crate::physics::outline::Outline;
 use crate::sensors::{Footprint, FootprintKind, SensorModel};
 use crate::world::{disc_overlaps, World};
 use shared::SensorReading;
@@ -96,6 +97,8 @@ impl SensorModel for DiscSensors {
             ObstacleTargets::Robots => world.robots().len(),
             ObstacleTargets::AnyBody => world.bodies().len(),
         } as u32;
+        let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
+        let robots = world.robots().len() as u32;
         let mut witnesses = std::mem::take(&mut self.witnesses);
         witnesses.resize(world.robots().len(), [usize::MAX; 2]);
         for (i, ((robot, reading), witness)) in world
@@ -133,7 +136,14 @@ impl SensorModel for DiscSensors {
                         continue;
                     }
                     let counts = (b.body as usize != i) & (b.body < obstacles);
-                    let overlaps = |(c, r): (Vec2, f64)| disc_overlaps(c, r, b.pos, b.radius);
+                    // A wedge robot is seen where its outline is.
+                    let overlaps = |(c, r): (Vec2, f64)| match outline.filter(|_| b.body < robots) {
+                        None => disc_overlaps(c, r, b.pos, b.radius),
+                        Some(o) => {
+                            let facing = world.robots()[b.body as usize].direction;
+                            o.circle_depth(facing, c - b.pos, r).0 > 0.0
+                        }
+                    };
                     seen_left |= counts & overlaps(obstacle_left);
                     seen_right |= counts & overlaps(obstacle_right);
                 }

@@ -31,12 +31,16 @@ use crate::base::ranges;
 use crate::base::rng::SimRng;
 use crate::base::rounding;
 use crate::base::vec2::Vec2;
+use crate::config::robot_shape::RobotShape;
 use crate::config::validate::{check, ConfigError};
+use crate::config::WorldConfig;
 use crate::fields::{FieldLayout, ScalarField};
+use crate::physics::outline::Outline;
 use crate::sensors::robot_noise::RobotNoise;
 use serde::{Deserialize, Serialize};
 use shared::calibration::{LIGHT_GAMMA, RC_TICK_US, RC_TIMEOUT_TICKS};
 use shared::{FieldCalibration, FieldScales, FieldValue, SensorRange};
+use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_4};
 
 /// A point on the robot, millimetres from its centre.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -90,8 +94,10 @@ pub(crate) struct PhotoNoise<'a> {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PhotoSensorConfig {
-    /// Where the left, mid and right sensors (DN1, DN3, DN5) sit.
-    pub mounts: [MountPoint; 3],
+    /// Where the left, mid and right sensors (DN1, DN3, DN5) sit; unset
+    /// (the default), on the skirt's edge ([`PhotoSensorConfig::mounts_on`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mounts: Option<[MountPoint; 3]>,
     /// Each sensor's response.
     pub response: [PhotoResponse; 3],
     /// Projector gamma: light = value^gamma of full brightness.
@@ -104,8 +110,8 @@ pub struct PhotoSensorConfig {
 }
 
 impl Default for PhotoSensorConfig {
-    /// Photo-transistors on the skirt's edge (65 mm from the centre), wired
-    /// to the front array's DN1, DN3 and DN5 pins: left and right 45
+    /// Photo-transistors on the skirt's edge ([`PhotoSensorConfig::mounts_on`]),
+    /// wired to the front array's DN1, DN3 and DN5 pins: left and right 45
     /// degrees off the heading, mid straight ahead (chosen by the
     /// ablation and sweep in `docs/robot-sensors.md`: the front array's own
     /// spacing, 37.5 mm to each side, reads too little of the gradient);
@@ -115,14 +121,9 @@ impl Default for PhotoSensorConfig {
     /// [`shared::calibration::LIGHT_GAMMA`]; the firmware's latency as
     /// measured in simavr, 2.8 us (`docs/robot-sensors.md`).
     fn default() -> PhotoSensorConfig {
-        let side = 65.0 * std::f64::consts::FRAC_1_SQRT_2;
-        let mount = |forward_mm, right_mm| MountPoint {
-            forward_mm,
-            right_mm,
-        };
         let response = |bright_us, dark_us| PhotoResponse { bright_us, dark_us };
         PhotoSensorConfig {
-            mounts: [mount(side, -side), mount(65.0, 0.0), mount(side, side)],
+            mounts: None,
             response: [
                 response(150.0, 1700.0),
                 response(160.0, 1760.0),
@@ -150,7 +151,53 @@ pub(crate) fn quantise_us(us: f64) -> u16 {
 
 const NAMES: [&str; 3] = ["left", "mid", "right"];
 
+/// The round skirt's radius the photo-transistors sit on, mm: the least
+/// circle around the Zumo's 98 x 86 mm chassis (`tv75`'s robots), in every
+/// arena with disc robots.
+pub const ROUND_SKIRT_MM: f64 = 65.0;
+
+/// How far behind a wedge's tip the mid photo-transistor sits, mm: a
+/// 3 mm part in a hole with foam around it, where the default wedge is
+/// 12 mm wide.
+pub const TIP_INSET_MM: f64 = 5.0;
+
 impl PhotoSensorConfig {
+    /// Where the sensors sit on the robots of `world`: the configured
+    /// mounts, or on the skirt's edge. On a disc, the Zumo's round skirt
+    /// ([`ROUND_SKIRT_MM`]): left and right 45 degrees off the heading, mid
+    /// straight ahead. On a wedge, left and right where the outline meets
+    /// the bearings of 45 degrees (the round back, or a face if the wedge
+    /// reaches further back), mid [`TIP_INSET_MM`] behind the tip.
+    pub fn mounts_on(&self, world: &WorldConfig) -> [MountPoint; 3] {
+        if let Some(mounts) = self.mounts {
+            return mounts;
+        }
+        let mount = |forward_mm, right_mm| MountPoint {
+            forward_mm,
+            right_mm,
+        };
+        let (side, mid) = match world.robot_shape {
+            RobotShape::Disc => (ROUND_SKIRT_MM * FRAC_1_SQRT_2, ROUND_SKIRT_MM),
+            RobotShape::Wedge { tip } => {
+                let outline = Outline::new(world.robot_radius, tip);
+                let to_mm = world.unit_mm;
+                // The outline's distance from the centre along 45 degrees.
+                let bearing = FRAC_PI_4;
+                let tangent = (outline.radius() / outline.tip()).acos();
+                let reach = if bearing >= tangent {
+                    outline.radius()
+                } else {
+                    outline.radius() / (tangent - bearing).cos()
+                };
+                (
+                    reach * to_mm * FRAC_1_SQRT_2,
+                    outline.tip() * to_mm - TIP_INSET_MM,
+                )
+            }
+        };
+        [mount(side, -side), mount(mid, 0.0), mount(side, side)]
+    }
+
     /// Checks every position, time and the gamma; each sensor's bright and
     /// dark times must differ by at least one tick, or no calibration exists.
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -158,13 +205,14 @@ impl PhotoSensorConfig {
         let latency = self.poll_latency_us;
         ranges::POLL_LATENCY_US.check(latency)?;
         for (i, name) in NAMES.iter().enumerate() {
-            let m = self.mounts[i];
-            ranges::MOUNT_MM.check_as(
-                &format!("field.mounts[{i}].forward_mm ({name})"),
-                m.forward_mm,
-            )?;
-            ranges::MOUNT_MM
-                .check_as(&format!("field.mounts[{i}].right_mm ({name})"), m.right_mm)?;
+            if let Some(m) = self.mounts.map(|m| m[i]) {
+                ranges::MOUNT_MM.check_as(
+                    &format!("field.mounts[{i}].forward_mm ({name})"),
+                    m.forward_mm,
+                )?;
+                ranges::MOUNT_MM
+                    .check_as(&format!("field.mounts[{i}].right_mm ({name})"), m.right_mm)?;
+            }
             let r = self.response[i];
             ranges::DISCHARGE_US.check_as(
                 &format!("field.response[{i}].bright_us ({name})"),
@@ -223,12 +271,13 @@ pub(crate) struct PhotoSensors {
 }
 
 impl PhotoSensors {
-    /// The sensors of `config` in a world of `unit_mm` millimetres per unit.
-    pub fn new(config: &PhotoSensorConfig, unit_mm: f64) -> PhotoSensors {
+    /// The sensors of `config` on the robots of `world`.
+    pub fn new(config: &PhotoSensorConfig, world: &WorldConfig) -> PhotoSensors {
         let calibration = config.calibration();
+        let unit_mm = world.unit_mm;
         PhotoSensors {
             points: config
-                .mounts
+                .mounts_on(world)
                 .map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
             response: config.response,
             gamma: config.gamma,
@@ -346,7 +395,7 @@ mod tests {
                 dark: 425
             }
         );
-        let sensors = PhotoSensors::new(&config, 5.0);
+        let sensors = PhotoSensors::new(&config, &WorldConfig::default());
         let bright = ScalarField::new(1, 1, vec![1.0]).unwrap();
         let dark = ScalarField::new(1, 1, vec![0.0]).unwrap();
         // One cell over the whole arena: every point inside reads it.
@@ -363,7 +412,7 @@ mod tests {
     fn sensors_sit_where_configured_and_turn_with_the_robot() {
         // A field bright in its left column only (2 x 1 cells over 100 units).
         let field = ScalarField::new(2, 1, vec![1.0, 0.0]).unwrap();
-        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), 5.0);
+        let sensors = PhotoSensors::new(&PhotoSensorConfig::default(), &WorldConfig::default());
         // Facing down the screen (+y): the robot's right is -x, so its right
         // sensor is over the bright column at x < 25 (cell 0 by rounding).
         let r = sensors.read(

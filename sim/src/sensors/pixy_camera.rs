@@ -7,7 +7,10 @@
 //! with its kind's signature ([`CameraConfig`]: pucks 1, robots 2). Per
 //! frame, like the Pixy's own blob pipeline (`docs/robot-sensors.md`):
 //! 1. each body's silhouette is the bounding box of 2 x 12 points on its
-//!    bottom and top rims, clipped to the image; bodies beyond
+//!    bottom and top rims, clipped to the image (a wedge-fronted robot,
+//!    `crate::config::robot_shape::RobotShape::Wedge`, is a prism on its
+//!    outline: the rim points of its round back, its tangent points and
+//!    its tip, at the bottom and the top, [`PixyCamera::outline_silhouette`]); bodies beyond
 //!    `max_range`, or reaching behind the image plane, are not seen (only
 //!    the bodies in a box around the view cone are visited, and cheap
 //!    culls come before projecting);
@@ -38,6 +41,7 @@ use crate::base::ranges;
 use crate::base::vec2::Vec2;
 use crate::config::validate::{check, ConfigError};
 use crate::physics::grid::Neighbour;
+use crate::physics::outline::Outline;
 use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
@@ -422,12 +426,20 @@ impl PixyCamera {
         let (min, max) = self.search_box(&lens, world.config().max_radius());
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
+        let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
+        let robots = world.robots().len();
         world.any_body_in_box(min, max, |row| {
             for b in row {
-                let Some(c) = self.candidate(world.robots().len(), robot, &lens, b) else {
+                let Some(c) = self.candidate(robots, robot, &lens, b) else {
                     continue;
                 };
-                if let Some(rect) = self.silhouette(c.ahead, c.side, c.radius, c.height) {
+                let rect = match outline.filter(|_| c.index < robots) {
+                    None => self.silhouette(c.ahead, c.side, c.radius, c.height),
+                    Some(o) => {
+                        self.outline_silhouette(&c, &lens, world.robots()[c.index].direction, &o)
+                    }
+                };
+                if let Some(rect) = rect {
                     in_view.push(c.in_view(rect));
                 }
             }
@@ -561,6 +573,63 @@ impl PixyCamera {
             return unsafe { project_avx2(self, ahead, side, radius, height) };
         }
         project(self, ahead, side, radius, height)
+    }
+
+    /// The clipped pixel box of a wedge-fronted robot, candidate `c`,
+    /// facing `facing`: the prism on its outline, `c.height` tall, seen
+    /// through the pinhole as a cylinder is (the bounding box of its
+    /// points at the bottom and the top): the rim points of the cylinder
+    /// that lie on the round back, the two tangent points and the tip.
+    /// `None` if it is out of the image or reaches behind the image plane.
+    /// A robot or two a frame: one point at a time.
+    fn outline_silhouette(
+        &self,
+        c: &Candidate,
+        lens: &Lens,
+        facing: Vec2,
+        outline: &Outline,
+    ) -> Option<Rect> {
+        let right = Vec2::new(-facing.y, facing.x);
+        let r = outline.radius();
+        let t = outline.tangent_point();
+        let mut points = [Vec2::ZERO; RIM_POINTS + 3];
+        points[..3].copy_from_slice(&[Vec2::new(outline.tip(), 0.0), t, Vec2::new(t.x, -t.y)]);
+        let mut n = 3;
+        for k in 0..RIM_POINTS {
+            if self.rim_ahead[k] * r < t.x {
+                points[n] = Vec2::new(self.rim_ahead[k], self.rim_right[k]) * r;
+                n += 1;
+            }
+        }
+        let (mut min_x, mut max_x, mut min_y, mut max_y) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for z in [0.0, c.height] {
+            let up = z - self.height;
+            for p in &points[..n] {
+                let offset = facing * p.x + right * p.y;
+                let (pf, ps) = (
+                    c.ahead + offset.dot(lens.ahead),
+                    c.side + offset.dot(lens.right),
+                );
+                let depth = pf * self.cos_tilt - up * self.sin_tilt;
+                if depth < self.near {
+                    return None;
+                }
+                let down = -pf * self.sin_tilt - up * self.cos_tilt;
+                let (x, y) = (self.fx * ps / depth, self.fy * down / depth);
+                min_x = min_x.min(x);
+                max_x = max_x.max(x);
+                min_y = min_y.min(y);
+                max_y = max_y.max(y);
+            }
+        }
+        let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
+        let rect = Rect {
+            left: first_pixel(cx + min_x, IMAGE_WIDTH),
+            right: last_pixel(cx + max_x, IMAGE_WIDTH),
+            top: first_pixel(cy + min_y, IMAGE_HEIGHT),
+            bottom: last_pixel(cy + max_y, IMAGE_HEIGHT),
+        };
+        (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
     }
 
     /// Stage 2: each body's still visible part after the nearer ones'
@@ -879,10 +948,12 @@ mod reference;
 mod tests {
     use super::*;
     use crate::base::rng::SimRng;
+    use crate::config::robot_shape::RobotShape;
     use crate::config::SimConfig;
     use crate::physics::body::RobotKind;
     use rand::{RngExt, SeedableRng};
     use shared::ImageRegion;
+    use std::f64::consts::FRAC_PI_2;
     use std::sync::Arc;
 
     const R: f64 = 10.0;
@@ -1013,6 +1084,52 @@ mod tests {
             "{blocks:?}"
         );
         assert_eq!(blocks.last().map(|b| b.signature), Some(2));
+    }
+
+    /// Robot 0 at (400, 400) facing +x and robot 1 six radii ahead of it
+    /// facing +y (robot 0's right), both of `shape`: robot 0's frame.
+    fn side_on(shape: RobotShape) -> Vec<PixyBlock> {
+        let mut config = SimConfig::default();
+        config.world.robot_shape = shape;
+        config.world.robots = 2;
+        config.world.pucks = 0;
+        let scene = [
+            (Vec2::new(400.0, 400.0), 0.0, RobotKind::Outie),
+            (Vec2::new(460.0, 400.0), FRAC_PI_2, RobotKind::Outie),
+        ];
+        let world = World::scene(&config, &scene, &[], 1);
+        let mut camera = PixyCamera::new(&PixyCameraConfig::default(), 5.0);
+        let mut out = Vec::new();
+        camera.frame(&world, 0, &mut out);
+        out
+    }
+
+    #[test]
+    fn a_wedge_seen_side_on_reaches_to_its_tip_s_hand_computed_column() {
+        // The wedge's tip (13 units = 65 mm to the right of its centre,
+        // 57 units = 285 mm ahead of the lens) at the robot's top (60 mm;
+        // the lens is 80 mm up, tilted 20 degrees) is its rightmost point:
+        // depth 285 cos 20 + 20 sin 20 mm, column 160 + fx 65 / depth, fx
+        // = 160 / tan 37.5 degrees. The tangent points and the round back
+        // reach less far right (at most 38 / 236 of the depth against the
+        // tip's 65 / 285).
+        let t = 20f64.to_radians();
+        let depth = 285.0 * t.cos() + 20.0 * t.sin();
+        let fx = 160.0 / 37.5f64.to_radians().tan();
+        let right = (160.0 + fx * 65.0 / depth).ceil() as u16 - 1;
+        let wedge = side_on(RobotShape::Wedge { tip: 13.0 });
+        assert_eq!(wedge.len(), 1, "{wedge:?}");
+        let w = wedge[0];
+        assert_eq!(w.signature, 2);
+        assert_eq!(w.x - w.width / 2 + w.width, right, "{w:?}");
+        // Its round back is the disc's: the same rows, and on the left no
+        // further out than the disc's own edge (the back's rim is sampled
+        // from the robot's heading, the disc's from the lens).
+        let disc = side_on(RobotShape::Disc)[0];
+        assert_eq!((w.y, w.height), (disc.y, disc.height), "{w:?} {disc:?}");
+        let (left, disc_left) = (w.x - w.width / 2, disc.x - disc.width / 2);
+        assert!(left >= disc_left && left <= disc_left + 1, "{w:?} {disc:?}");
+        assert!(w.width > disc.width + 10, "{w:?} {disc:?}");
     }
 
     #[test]
@@ -1270,7 +1387,7 @@ mod tests {
             let unit = config.world.unit_mm;
             let sensors = crate::sensors::robot::RobotSensors::new(
                 &crate::sensors::robot::RobotSensorConfig::default(),
-                unit,
+                &config.world,
             );
             let field = Arc::new(crate::fields::ScalarField::annulus_of(64, 36));
             let mut sim =

@@ -26,6 +26,7 @@
 
 use crate::base::noise::{self, Purpose};
 use crate::config::validate::ConfigError;
+use crate::config::WorldConfig;
 use crate::fields::ScalarField;
 use crate::sensors::camera_memory::CameraMemory;
 use crate::sensors::photo::PhotoNoise;
@@ -106,12 +107,13 @@ pub struct RobotSensors {
 }
 
 impl RobotSensors {
-    /// The model of `config` in a world of `unit_mm` millimetres per unit
-    /// (validate the config first: [`RobotSensorConfig::validate`]).
-    pub fn new(config: &RobotSensorConfig, unit_mm: f64) -> RobotSensors {
+    /// The model of `config` on the robots of `world` (its millimetres per
+    /// unit, the robots' outline; validate the config first:
+    /// [`RobotSensorConfig::validate`]).
+    pub fn new(config: &RobotSensorConfig, world: &WorldConfig) -> RobotSensors {
         RobotSensors {
-            photo: PhotoSensors::new(&config.field, unit_mm),
-            camera: PixyCamera::new(&config.camera, unit_mm),
+            photo: PhotoSensors::new(&config.field, world),
+            camera: PixyCamera::new(&config.camera, world.unit_mm),
             latency_frames: config.camera.latency_frames,
             noise: config.noise.clone(),
             brightness: None,
@@ -269,7 +271,7 @@ mod tests {
             .collect();
         let world = World::scene(&config, &robots, &pucks, 1);
         let field = ScalarField::annulus();
-        let mut model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
+        let mut model = RobotSensors::new(&RobotSensorConfig::default(), &config.world);
         let mut readings = vec![SensorReading::default(); 2];
         // One frame of latency: the first period's frame arrives in the second.
         model.sense(&world, &field, &mut readings);
@@ -293,7 +295,7 @@ mod tests {
         let with_puck = World::scene(&config, &robot, &[Vec2::new(240.0, 400.0)], 1);
         let empty = World::scene(&config, &robot, &[], 1);
         let mut readings = [SensorReading::default()];
-        let mut model = RobotSensors::new(&RobotSensorConfig::default(), 5.0);
+        let mut model = RobotSensors::new(&RobotSensorConfig::default(), &config.world);
         let mut seen = |world: &World, model: &mut RobotSensors| {
             model.sense(world, &field, &mut readings);
             readings[0].puck_left
@@ -311,7 +313,7 @@ mod tests {
         );
         let mut ideal = RobotSensorConfig::default();
         ideal.camera.latency_frames = 0;
-        let mut model = RobotSensors::new(&ideal, 5.0);
+        let mut model = RobotSensors::new(&ideal, &config.world);
         assert_eq!(
             [
                 seen(&with_puck, &mut model),

@@ -14,6 +14,7 @@ use crate::config::{PhysicsConfig, SimConfig, WorldConfig};
 use crate::physics::body::{Body, Robot, RobotKind};
 use crate::physics::broadphase::NeighbourIndex;
 use crate::physics::grid::Neighbour;
+use crate::physics::outline::Outline;
 use crate::physics::{candidate_reach, PhysicsScratch, StepContext};
 use rand::{RngExt, SeedableRng};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -100,10 +101,7 @@ impl World {
         seed: u64,
     ) -> World {
         let c = &config.world;
-        let mut bodies: Vec<Body> = robots
-            .iter()
-            .map(|&(p, _, _)| Body::new(p, c.robot_radius))
-            .collect();
+        let mut bodies: Vec<Body> = robots.iter().map(|&(p, _, _)| robot_body(p, c)).collect();
         bodies.extend(pucks.iter().map(|&p| puck(Body::new(p, c.puck_radius), c)));
         let robot_state = robots
             .iter()
@@ -166,6 +164,7 @@ impl World {
             config: &s.physics,
             arena: s.config.arena(),
             max_radius: s.config.max_radius(),
+            outline: Outline::of(s.config.robot_shape, s.config.robot_radius),
             index: &mut self.index,
             rng: &mut s.rng,
             scratch: &mut self.scratch,
@@ -330,18 +329,31 @@ fn index_of(state: &WorldState) -> NeighbourIndex {
     )
 }
 
-/// Robots uniformly in `[r, side - r)`, then pucks in `[4r, side - 4r)`,
-/// on each axis (x drawn before y).
+/// Robots uniformly in `[r, side - r)` (`r` their bodies' radius: a
+/// wedge's tip distance), then pucks in `[4r, side - 4r)`, on each axis (x
+/// drawn before y).
 fn start_positions(c: &WorldConfig, rng: &mut SimRng) -> Vec<Body> {
-    let mut place = |r: f64, margin: f64| {
+    let mut place = |margin: f64| {
         let x = rng.random_range(margin..c.arena_width - margin);
         let y = rng.random_range(margin..c.arena_height - margin);
-        Body::new(Vec2::new(x, y), r)
+        Vec2::new(x, y)
     };
     let mut bodies = Vec::with_capacity(c.bodies());
-    bodies.extend((0..c.robots).map(|_| place(c.robot_radius, c.robot_radius)));
-    bodies.extend((0..c.pucks).map(|_| puck(place(c.puck_radius, 4.0 * c.puck_radius), c)));
+    bodies.extend((0..c.robots).map(|_| robot_body(place(c.robot_body_radius()), c)));
+    bodies.extend(
+        (0..c.pucks).map(|_| puck(Body::new(place(4.0 * c.puck_radius), c.puck_radius), c)),
+    );
     bodies
+}
+
+/// A robot's body at rest: its outline's bounding radius, and the mass of
+/// a disc of the robot radius whatever the outline (a foam skirt weighs
+/// next to nothing).
+fn robot_body(pos: Vec2, c: &WorldConfig) -> Body {
+    Body {
+        radius: c.robot_body_radius(),
+        ..Body::new(pos, c.robot_radius)
+    }
 }
 
 /// A puck body with the configured mass, if one is set.

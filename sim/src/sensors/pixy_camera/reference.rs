@@ -3,6 +3,7 @@
 //! kept as the reference the faster stages must match block for block.
 
 use super::{Blob, InView, Lens, PixyCamera, Rect};
+use crate::physics::outline::Outline;
 use crate::world::World;
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::PixyBlock;
@@ -23,12 +24,21 @@ pub(super) fn frame(camera: &PixyCamera, world: &World, robot: usize) -> Vec<Pix
 fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
     let lens = Lens::of(world, robot, camera.forward);
     let mut in_view = Vec::new();
+    let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
+    let robots = world.robots().len();
     world.any_body_near(lens.pos, camera.max_range, |row| {
         for b in row {
-            let Some(c) = camera.candidate(world.robots().len(), robot, &lens, b) else {
+            let Some(c) = camera.candidate(robots, robot, &lens, b) else {
                 continue;
             };
-            if let Some(rect) = silhouette(camera, c.ahead, c.side, c.radius, c.height) {
+            // A wedge's prism has one way of projecting, the stages' own.
+            let rect = match outline.filter(|_| c.index < robots) {
+                None => silhouette(camera, c.ahead, c.side, c.radius, c.height),
+                Some(o) => {
+                    camera.outline_silhouette(&c, &lens, world.robots()[c.index].direction, &o)
+                }
+            };
+            if let Some(rect) = rect {
                 in_view.push(c.in_view(rect));
             }
         }
