@@ -472,6 +472,14 @@ impl PyBatch {
         Ok(PyArray1::from_vec(py, out))
     }
 
+    /// The sensor model and arena, as a policy blob records what it was
+    /// trained for.
+    #[getter]
+    fn trained_for(&self) -> (String, String) {
+        let t = &self.batch.settings().trained_for;
+        (t.sensors.as_str().to_string(), t.arena.as_str().to_string())
+    }
+
     /// Values in [`PyBatch::state`]: 5 per robot, 3 per puck.
     #[getter]
     fn state_size(&self) -> usize {
@@ -500,16 +508,19 @@ impl PyBatch {
     }
 }
 
-/// Encodes a greedy table (one action per state) as policy blob bytes.
+/// Encodes a greedy table (`table`: one action per state) or each state's
+/// best actions (`sets`: bit masks) as policy blob bytes, with the sensor
+/// model and arena trained for if given.
 #[pyfunction]
-#[pyo3(signature = (table, *, hasher, actions, forward_speed, field, name, trainer_steps, seed))]
+#[pyo3(signature = (*, table = None, sets = None, hasher, actions, forward_speed, field, name, trainer_steps, seed, trained_for = None))]
 #[allow(
     clippy::too_many_arguments,
     reason = "each argument is a Python keyword argument of the function"
 )]
 fn encode_policy<'py>(
     py: Python<'py>,
-    table: Vec<i64>,
+    table: Option<Vec<i64>>,
+    sets: Option<Vec<i64>>,
     hasher: &str,
     actions: Vec<f32>,
     forward_speed: f32,
@@ -517,6 +528,7 @@ fn encode_policy<'py>(
     name: &str,
     trainer_steps: u64,
     seed: u64,
+    trained_for: Option<(String, String)>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let header = PolicyHeader {
         hasher,
@@ -526,14 +538,22 @@ fn encode_policy<'py>(
         name,
         trainer_steps,
         seed,
+        trained_for: trained_for
+            .as_ref()
+            .map(|(sensors, arena)| (sensors.as_str(), arena.as_str())),
     };
-    let bytes = policy_codec::encode(&table, &header).map_err(value_error)?;
+    let choices = match (&table, &sets) {
+        (Some(table), None) => policy_codec::Choices::Table(table),
+        (None, Some(sets)) => policy_codec::Choices::Sets(sets),
+        _ => return Err(value_error("give either table or sets")),
+    };
+    let bytes = policy_codec::encode(choices, &header).map_err(value_error)?;
     Ok(PyBytes::new(py, &bytes))
 }
 
 /// Decodes policy blob bytes read from `path` (named in errors) into a
-/// dict: hasher, actions, forward_speed, table, field, name,
-/// trainer_steps, seed.
+/// dict: hasher, actions, forward_speed, table, sets, field, name,
+/// trainer_steps, seed, trained_for ((sensors, arena) or None), version.
 #[pyfunction]
 fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Bound<'py, PyDict>> {
     let blob =
@@ -551,6 +571,13 @@ fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Boun
     d.set_item("name", p.name.as_str())?;
     d.set_item("trainer_steps", p.trainer_steps)?;
     d.set_item("seed", p.seed)?;
+    d.set_item("sets", PyArray1::from_vec(py, policy_codec::sets_of(&blob)))?;
+    d.set_item(
+        "trained_for",
+        blob.trained_for()
+            .map(|t| (t.sensors.as_str().to_string(), t.arena.as_str().to_string())),
+    )?;
+    d.set_item("version", blob.version())?;
     Ok(d)
 }
 

@@ -167,6 +167,9 @@ pub struct EnvSettings {
     /// The action table (for continuous actions, its largest magnitude is
     /// the bound).
     pub actions: ActionTable,
+    /// The sensor model and arena, as a policy blob records what it was
+    /// trained for.
+    pub trained_for: shared::TrainedFor,
 }
 
 fn count(name: &str, value: i64, min: i64) -> Result<usize, ArgumentError> {
@@ -336,6 +339,11 @@ impl EnvArgs {
             })?)),
         };
 
+        // The arena's name, as `host train` records it in a blob.
+        let arena_name = match &arena {
+            Arena::Square(_) => "thesis".to_string(),
+            Arena::Screen(spec) => spec.name.clone(),
+        };
         // Random is the controller whose settings leave every robot an
         // outie, as the trainer has them; the environment never uses it.
         let scenario = Scenario {
@@ -386,6 +394,13 @@ impl EnvArgs {
         config
             .validate()
             .map_err(|e| SettingsError::Scenario(ScenarioError::Config(e)))?;
+        let trained_for = shared::TrainedFor::new(&self.sensors, &arena_name).map_err(|e| {
+            ArgumentError::new(
+                "sensors, arena",
+                format!("{:?}", self.sensors),
+                e.to_string(),
+            )
+        })?;
         Ok(EnvSettings {
             prepared,
             seed,
@@ -394,6 +409,7 @@ impl EnvArgs {
             observation,
             action,
             actions,
+            trained_for,
         })
     }
 }

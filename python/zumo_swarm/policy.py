@@ -17,19 +17,26 @@ from zumo_swarm import _native
 
 @dataclass(frozen=True)
 class Policy:
-    """A decoded policy blob: the greedy action of every state."""
+    """A decoded policy blob: every state's best actions (``sets``, bit
+    masks: bit ``a`` for action ``a``; the robot picks among them with its
+    generator, docs/flashed.md), the lowest of them (``table``), and what it
+    was trained for (``trained_for``: ``(sensors, arena)``, ``None`` for a
+    blob of format version 1)."""
 
     hasher: str
     actions: tuple[float, ...]
     forward_speed: float
     table: np.ndarray
+    sets: np.ndarray
     field: str
     name: str
     trainer_steps: int
     seed: int
+    trained_for: tuple[str, str] | None
+    version: int
 
     def act(self, states: Any) -> np.ndarray:
-        """The greedy actions of hashed states (any shape)."""
+        """Each hashed state's lowest best action (any shape)."""
         return self.table[np.asarray(states)]
 
 
@@ -41,17 +48,24 @@ def load_policy(path: str | os.PathLike) -> Policy:
     return Policy(**fields)
 
 
-def _greedy(table: Any) -> np.ndarray:
+def _choices(table: Any) -> dict[str, list[int]]:
+    """``table`` as :func:`_native.encode_policy` takes it: a Q-table's
+    best actions per state as bit masks (every action equal to the state's
+    greatest value: the learner's choice among equals, kept for the robot),
+    or one action per state."""
     t = np.asarray(table)
     if t.ndim == 2:
         if not np.issubdtype(t.dtype, np.number) or not np.all(np.isfinite(t)):
             raise ValueError("table: a Q-table (states x actions) must hold finite numbers")
-        # The first best action, as the trainer's greedy policy picks it.
-        return np.argmax(t, axis=1).astype(np.int64)
+        if t.shape[1] > 4:
+            raise ValueError(f"table: a Q-table has at most 4 actions, got {t.shape[1]}")
+        best = t == t.max(axis=1, keepdims=True)
+        masks = (best * (1 << np.arange(t.shape[1]))).sum(axis=1)
+        return {"sets": [int(m) for m in masks]}
     if t.ndim == 1:
         if not np.issubdtype(t.dtype, np.integer):
             raise TypeError(f"table: a greedy table holds action indices (integers), got dtype {t.dtype}")
-        return t.astype(np.int64)
+        return {"table": [int(a) for a in t]}
     raise ValueError(f"table: expected a Q-table (states x actions) or one action per state, got shape {t.shape}")
 
 
@@ -71,12 +85,17 @@ def export_policy(
     """Writes ``table`` as a policy blob at ``path`` (atomically: a reader
     sees the old file or the new one) and returns the path.
 
-    ``table`` is a Q-table (states x actions: its greedy policy, the first
-    best action of each state) or one action index per state. The hasher,
-    actions, forward speed and field default to ``env``'s (any environment
-    of this package built with ``observation="state"``), else to the
-    thesis' (``original``, the four default actions at speed 2, annulus);
-    ``name`` to the file's stem.
+    ``table`` is a Q-table (states x actions: each state's best actions,
+    all of them where several are equal, which the robot picks among as the
+    learner did) or one action index per state. The hasher, actions,
+    forward speed and field default to ``env``'s (any environment of this
+    package built with ``observation="state"``), else to the thesis'
+    (``original``, the four default actions at speed 2, annulus); ``name``
+    to the file's stem. With ``env`` the blob records its sensor model and
+    arena (``host run`` and ``host render`` warn, ``host flash`` refuses,
+    on a mismatch). The blob is of format version 2 when a state has
+    several best actions or the blob records what it was trained for,
+    else version 1.
     """
     path = Path(path)
     batch = getattr(getattr(env, "unwrapped", env), "_batch", None) if env is not None else None
@@ -92,7 +111,8 @@ def export_policy(
     if field is None:
         field = env_settings.get("field", "annulus")
     data = _native.encode_policy(
-        [int(a) for a in _greedy(table)],
+        **_choices(table),
+        trained_for=batch.trained_for if batch is not None else None,
         hasher=hasher,
         actions=[float(a) for a in actions],
         forward_speed=float(forward_speed),
