@@ -63,6 +63,17 @@ pub const PIXY_SYNC_CC: u16 = 0xAA56;
 /// See [`PIXY_SYNC`].
 pub const PIXY_SYNC_SWAPPED: u16 = 0x55AA;
 
+/// A puck (signature 1) near, in the left half of the image: the left
+/// puck sensor's bit.
+pub const PUCK_LEFT: PixyBlock = PixyBlock {
+    signature: 1,
+    x: 60,
+    y: 150,
+    width: 20,
+    height: 14,
+    angle: 0,
+};
+
 /// One camera frame as the Pixy sends it, written here from the protocol
 /// (not with the firmware's encoder): an extra sync starts the frame, then
 /// each block: its sync, the checksum (wrapping sum of the data words),

@@ -12,7 +12,7 @@ use firmware::decision::Decider;
 use firmware::embedded;
 use shared::{Faults, FieldCalibration, LogFrame, MotorCommand, PixyBlock, RunMode, SensorRange};
 use tests::zumo::{
-    pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED,
+    pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED, PUCK_LEFT,
 };
 
 const CALIBRATION: FieldCalibration = FieldCalibration {
@@ -23,14 +23,6 @@ const CALIBRATION: FieldCalibration = FieldCalibration {
 };
 /// Left 0.35, mid 0.6 (bin 9 of 16), right 0.725.
 const SENSOR_TICKS: [Option<u16>; 3] = [Some(300), Some(200), Some(150)];
-const PUCK_LEFT: PixyBlock = PixyBlock {
-    signature: 1,
-    x: 60,
-    y: 150,
-    width: 20,
-    height: 14,
-    angle: 0,
-};
 const ROBOT_RIGHT: PixyBlock = PixyBlock {
     signature: 2,
     x: 250,
