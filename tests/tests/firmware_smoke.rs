@@ -352,14 +352,36 @@ fn usb_streaming(z: &mut Zumo) {
 /// near their timeout, and frames of eight colour-code blocks; with the
 /// USB port streaming ([`usb_streaming`]) or no cable.
 fn heaviest_periods(usb: bool) -> Zumo {
-    let mut z = calibrated_zumo();
-    z.run_ms(40);
+    heaviest_periods_of(
+        Zumo::boot(),
+        &CALIBRATION,
+        [Some(490), Some(495), Some(499)],
+        usb,
+        400,
+    )
+}
+
+/// The heaviest periods ([`heaviest_periods`]) of the firmware booted in
+/// `z`, calibrated with `calibration`, the sensors at `ticks`, for `ms`;
+/// the stack painted from the start.
+fn heaviest_periods_of(
+    mut z: Zumo,
+    calibration: &FieldCalibration,
+    ticks: [Option<u16>; 3],
+    usb: bool,
+    ms: u64,
+) -> Zumo {
+    z.write_eeprom(0, &calibration_record::encode(calibration));
+    z.set_sensor_ticks(SENSOR_TICKS);
+    z.run_ms(1);
+    z.paint_stack();
+    z.run_ms(39);
     if usb {
         usb_streaming(&mut z);
     }
     z.press_a();
     z.set_wheel_counts_per_second([6_000, 6_000]);
-    z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
+    z.set_sensor_ticks(ticks);
     let cc = |i: u16| PixyBlock {
         signature: 0o12,
         x: 10 + 30 * i,
@@ -369,7 +391,7 @@ fn heaviest_periods(usb: bool) -> Zumo {
         angle: -45,
     };
     z.show(&(0..8).map(cc).collect::<Vec<_>>());
-    z.run_ms(400);
+    z.run_ms(ms);
     z
 }
 
@@ -571,7 +593,9 @@ fn usb_sizes(elf: &std::path::Path) -> (u64, u64) {
 
 #[test]
 fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
-    use tests::figures::{compiler_of, thousands, Figures, Outcome};
+    use shared::PolicyBlob;
+    use tests::equivalence::TIED;
+    use tests::figures::{compiler_of, thousands, workspace, Figures, Outcome};
     use tests::zumo::{firmware_elf, firmware_elf_in};
     const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
     let elf = firmware_elf();
@@ -698,6 +722,121 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
             quiet_work as f64 / 16_000.0
         ),
         &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+
+    // The tied policy's firmware (robot 3), calibrated so that the
+    // heaviest periods' sensor times (near the timeout) hash to state 140,
+    // one with four best actions: every period draws, among four.
+    let tied_elf = firmware_elf_in(TIED.elf_dir, TIED.build);
+    let tied =
+        PolicyBlob::decode(&std::fs::read(workspace().join("policies").join(TIED.policy)).unwrap())
+            .unwrap();
+    let (tied_flash, tied_ram) = sizes(&tied_elf);
+    let drawing = |usb: bool| {
+        let z = Zumo::boot_elf(&tied_elf);
+        let narrow = FieldCalibration {
+            ranges: [SensorRange {
+                bright: 470,
+                dark: 500,
+            }; 3],
+        };
+        let mut z = heaviest_periods_of(z, &narrow, [Some(490), Some(484), Some(499)], usb, 1_100);
+        let frames = decoded(&mut z);
+        let driving: Vec<usize> = (0..frames.len())
+            .filter(|&i| frames[i].mode == RunMode::Driving)
+            .collect();
+        assert!(driving.len() >= 50, "{} periods driving", driving.len());
+        for &i in &driving {
+            let f = &frames[i];
+            assert_eq!(
+                (
+                    f.state.0,
+                    tied.sets().mask(f.state).count_ones(),
+                    f.choice.is_some()
+                ),
+                (140, 4, true),
+                "period {}: every period draws among four",
+                f.tick
+            );
+        }
+        assert!(
+            driving.iter().any(|&i| frames[i].calibration.is_some()),
+            "no frame carried the calibration and a draw (the longest frames)"
+        );
+        if usb {
+            assert!(z.usb_background().1 > 0, "no control request answered");
+        }
+        // period i's decision and work are the i-th marker spans since boot
+        let (decisions, work) = (z.decision_cycles(), z.period_work_cycles());
+        assert!(decisions.len() >= frames.len() && work.len() >= frames.len());
+        let max_of = |spans: &[u64]| driving.iter().map(|&i| spans[i]).max().unwrap();
+        let min_decision = driving.iter().map(|&i| decisions[i]).min().unwrap();
+        (
+            min_decision,
+            max_of(&decisions),
+            max_of(&work),
+            z.stack_low_water(),
+        )
+    };
+    let (draw_min, draw_max, draw_work, draw_low) = drawing(true);
+    let (quiet_draw_min, quiet_draw_max, quiet_draw_work, quiet_draw_low) = drawing(false);
+    assert!(
+        draw_max <= BUDGET_CYCLES && quiet_draw_max <= BUDGET_CYCLES,
+        "a decision with a draw took {draw_max} cycles"
+    );
+    assert!(
+        draw_work <= period && quiet_draw_work <= period,
+        "the heaviest period with a draw took {draw_work} cycles with USB, {quiet_draw_work} without, of {period}"
+    );
+    assert!(
+        draw_low >= STACK_FLOOR && quiet_draw_low >= STACK_FLOOR,
+        "drawing, the stack reached {:#06x}: less than 256 bytes above the bootloader key",
+        draw_low.min(quiet_draw_low)
+    );
+    figures.compiled(&[
+        "tied policy (`robot-annulus-8bit-tied`, robot 3): flash, static RAM",
+        &format!(
+            "{} bytes, {} bytes",
+            thousands(tied_flash),
+            thousands(tied_ram)
+        ),
+        "28,672; 1,536",
+        "`scripts/build-firmware`",
+    ]);
+    figures.compiled(&[
+        "one decision with a draw among four tied actions (tied policy, the heaviest periods, USB streaming)",
+        &format!(
+            "{} to {} cycles; no cable: {} to {}",
+            thousands(draw_min),
+            thousands(draw_max),
+            thousands(quiet_draw_min),
+            thousands(quiet_draw_max)
+        ),
+        "2,000",
+        "this test",
+    ]);
+    figures.compiled(&[
+        "a period's work, heaviest, with a draw among four in every period and the longest frames (calibration and draw) (tied policy; USB streaming)",
+        &format!(
+            "{} cycles ({:.1} ms); no cable: {} ({:.1} ms)",
+            thousands(draw_work),
+            draw_work as f64 / 16_000.0,
+            thousands(quiet_draw_work),
+            quiet_draw_work as f64 / 16_000.0
+        ),
+        &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+    figures.compiled(&[
+        "stack, deepest, drawing in the heaviest periods (tied policy; USB streaming)",
+        &format!(
+            "{} bytes (down to {draw_low:#06X}, {} bytes above the key); no cable: {} bytes",
+            0x0B00 - draw_low,
+            draw_low - 0x0802,
+            0x0B00 - quiet_draw_low
+        ),
+        "256 bytes above the key (down to 0x0902)",
         "this test",
     ]);
 

@@ -13,10 +13,12 @@ use host::robot::replay::{replay, Stage};
 use shared::{LogFrame, PixyBlock, PolicyBlob, Role, State};
 use sim::sensors::robot::{RobotSensorConfig, RobotSensors};
 use std::collections::HashMap;
+use std::path::PathBuf;
 use std::sync::OnceLock;
 use tests::equivalence::{
     check_elf_embeds, cycles_of_ticks, follow_log, nudge, read_policy, Decided, Expectation, TIED,
 };
+use tests::figures::{compiler_of, thousands, Figures, Outcome};
 use tests::playback::{
     driving_zumo, frames_of_stream, frames_since_boot, play, Observed, Stimulus,
 };
@@ -33,6 +35,8 @@ const PUCK_RIGHT: PixyBlock = PixyBlock {
 /// What one simavr session of the tied firmware did.
 struct Run {
     policy: PolicyBlob,
+    /// The firmware's ELF.
+    elf: PathBuf,
     /// Each played period's stimulus state and what the firmware did.
     periods: Vec<(State, Observed)>,
     /// Every decision since boot, as the simulator's robot 3 makes it.
@@ -131,6 +135,7 @@ fn run() -> &'static Run {
             differ,
             stream: z.uart_bytes().to_vec(),
             policy,
+            elf,
         }
     })
 }
@@ -209,21 +214,67 @@ fn uniformity(r: &Run) -> Vec<(u32, usize, Vec<usize>, f64, f64)> {
 
 #[test]
 fn the_firmwares_draws_are_uniform_among_tied_actions_within_the_stated_bound() {
+    const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test tied_choice";
     let r = run();
+    let mut figures = Figures::new(&compiler_of(&r.elf));
+    figures.fixed(&[
+        "periods played",
+        &format!(
+            "{} ({ROUNDS} rounds of every state)",
+            thousands(r.periods.len() as u64)
+        ),
+        "-",
+    ]);
+    let mut failures = Vec::new();
     for (n, total, counts, chi, worst) in uniformity(r) {
         let p = 1.0 / f64::from(n);
         let bound = 4.0 * (p * (1.0 - p) / total as f64).sqrt();
+        let chi_bound = CHI_SQUARE_999[n as usize - 2];
         println!(
-            "sets of {n}: {total} draws, positions {counts:?}, chi-square {chi:.2} (bound {}), \
-             largest share deviation {worst:.4} (bound {bound:.4})",
-            CHI_SQUARE_999[n as usize - 2]
+            "sets of {n}: {total} draws, positions {counts:?}, chi-square {chi:.2} (bound {chi_bound}), \
+             largest share deviation {worst:.4} (bound {bound:.4})"
         );
-        assert!(total >= 300, "only {total} draws in sets of {n}");
-        assert!(
-            chi <= CHI_SQUARE_999[n as usize - 2],
-            "sets of {n}: {counts:?}"
-        );
-        assert!(worst <= bound, "sets of {n}: {counts:?}");
+        if total < 300 || chi > chi_bound || worst > bound {
+            failures.push(format!("sets of {n}: {total} draws, positions {counts:?}"));
+        }
+        figures.fixed(&[
+            &format!("draws among {n} tied actions"),
+            &thousands(total as u64),
+            "at least 300",
+        ]);
+        figures.compiled(&[
+            &format!("sets of {n}: draws of each position (lowest action first)"),
+            &counts
+                .iter()
+                .map(|c| thousands(*c as u64))
+                .collect::<Vec<_>>()
+                .join(", "),
+            "-",
+        ]);
+        figures.compiled(&[
+            &format!("sets of {n}: chi-square, df = {}", n - 1),
+            &format!("{chi:.2}"),
+            &format!("{chi_bound} (0.999 quantile)"),
+        ]);
+        figures.compiled(&[
+            &format!("sets of {n}: largest deviation of a share from 1/{n}"),
+            &format!("{worst:.4}"),
+            &format!("{bound:.4} (4 sd)"),
+        ]);
+    }
+    assert!(
+        failures.is_empty(),
+        "not uniform within the bound: {failures:#?}"
+    );
+    match figures.check(
+        "docs/equivalence.md",
+        "tied-choice",
+        &["figure", "value", "bound"],
+        REGENERATE,
+    ) {
+        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
+        Ok(_) => {}
+        Err(e) => panic!("{e:#}"),
     }
 }
 
