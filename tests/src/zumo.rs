@@ -1040,6 +1040,18 @@ impl Zumo {
         self.marker_spans(4, 3)
     }
 
+    /// Cycles from each period's start (marker 4) to its decision (marker
+    /// 1): buttons, the field sensors' RC timing and the camera's read.
+    pub fn sensing_cycles(&self) -> Vec<u64> {
+        self.marker_spans(4, 1)
+    }
+
+    /// Cycles from each decision's end (marker 2) to the end of its log
+    /// frame (marker 3): EEPROM, LEDs, the frame on USART1 and into USB.
+    pub fn logging_cycles(&self) -> Vec<u64> {
+        self.marker_spans(2, 3)
+    }
+
     /// Cycles between consecutive period starts.
     pub fn period_cycles(&self) -> Vec<u64> {
         let starts: Vec<u64> = self
