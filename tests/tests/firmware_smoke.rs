@@ -890,7 +890,7 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
     figures.compiled(&[
         "a period's work, heaviest over 1.1 s (the heaviest periods and a frame carrying the calibration), a draw among four in every period (tied policy; USB streaming)",
         &format!(
-            "{} cycles ({:.1} ms, {}: sensors and camera {}, decision {}, log frame of {} bytes {}); no cable: {} ({:.1} ms, {})",
+            "{} cycles ({:.1} ms, {}: sensors and camera {}, decision {}, log frame of {} bytes {}); no cable: {} ({:.1} ms, {}: {}, {}, {} bytes {})",
             thousands(draw_work),
             draw_work as f64 / 16_000.0,
             against(draw_work),
@@ -900,7 +900,11 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
             thousands(loud.split[2]),
             thousands(quiet_draw_work),
             quiet_draw_work as f64 / 16_000.0,
-            against(quiet_draw_work)
+            against(quiet_draw_work),
+            thousands(quiet.split[0]),
+            thousands(quiet.split[1]),
+            quiet.frame_len,
+            thousands(quiet.split[2])
         ),
         &format!("{} (20 ms)", thousands(period)),
         "this test",
