@@ -2,14 +2,18 @@
 //! sampled from simulated episodes with the robot sensor model, the
 //! stimulus each one puts on the robot's pins and bus, what the firmware
 //! must do with it (computed here from that stimulus and the simulator's
-//! model, never from the firmware's log), the nudging of stimuli away from
-//! quantisation edges, and the explanation of end-to-end disagreements.
+//! model, never from the firmware's log), the robot's choices among tied
+//! actions as the simulator's policy controller makes them, the nudging of
+//! stimuli away from quantisation edges, and the explanation of end-to-end
+//! disagreements.
 //! `docs/equivalence.md` describes the checks and their figures.
 
 use anyhow::{bail, Context, Result};
 use shared::{
-    ActionId, DriveOutputs, MotorCommand, PixyBlock, PolicyBlob, RobotProfile, Role, State,
+    ActionId, ChoiceRng, DriveOutputs, LogFrame, MotorCommand, PixyBlock, PolicyBlob, RobotProfile,
+    Role, State, StateHasher,
 };
+use sim::control::greedy::GreedyPolicy;
 use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::scenario::{Arena, ControllerChoice, Scenario};
 use sim::{
@@ -27,6 +31,63 @@ pub const CYCLES_PER_US: f64 = 16.0;
 pub const EDGE_MARGIN_TICKS: i32 = 2;
 /// How far the nudge may move each of the three times, in ticks.
 const NUDGE_REACH: i32 = 12;
+
+/// A firmware build the simavr tests run: a policy, built as one robot.
+pub struct Variant {
+    /// The policy's file in `policies/`.
+    pub policy: &'static str,
+    /// Directory under `target/avr-none` of the ELF built with that policy.
+    pub elf_dir: &'static str,
+    /// The policy's hasher.
+    pub hasher: StateHasher,
+    /// The firmware's robot id (its role: odd ids are innies).
+    pub robot_id: u8,
+    /// The command that builds it.
+    pub build: &'static str,
+}
+
+/// The 8-bit robot policy.
+pub const EIGHT_BIT: Variant = Variant {
+    policy: "robot-annulus-8bit.policy",
+    elf_dir: "robot-annulus-8bit",
+    hasher: StateHasher::Original,
+    robot_id: 0,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-8bit.policy FIRMWARE_OUT=target/avr-none/robot-annulus-8bit \
+            scripts/build-firmware",
+};
+
+/// The 10-bit robot policy.
+pub const TEN_BIT: Variant = Variant {
+    policy: "robot-annulus-10bit.policy",
+    elf_dir: "robot-annulus-10bit",
+    hasher: StateHasher::OriginalObstacle,
+    robot_id: 0,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-10bit.policy FIRMWARE_HASHER=original-obstacle \
+            FIRMWARE_OUT=target/avr-none/robot-annulus-10bit scripts/build-firmware",
+};
+
+/// A policy with ties (56 states with 2 best actions, 35 with 3, 42 with
+/// 4): the firmware draws; built as robot 3, so that the generator is the
+/// robot id's, not robot 0's.
+pub const TIED: Variant = Variant {
+    policy: "robot-annulus-8bit-tied.policy",
+    elf_dir: "robot-annulus-8bit-tied",
+    hasher: StateHasher::Original,
+    robot_id: 3,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-8bit-tied.policy FIRMWARE_ROBOT_ID=3 \
+            FIRMWARE_OUT=target/avr-none/robot-annulus-8bit-tied scripts/build-firmware",
+};
+
+/// The role policy in an innie's firmware (robot id 1), so that the role
+/// bit takes part.
+pub const ROLE: Variant = Variant {
+    policy: "robot-annulus-role.policy",
+    elf_dir: "robot-annulus-role",
+    hasher: StateHasher::OriginalRole,
+    robot_id: 1,
+    build: "FIRMWARE_POLICY=policies/robot-annulus-role.policy FIRMWARE_HASHER=original-role FIRMWARE_ROBOT_ID=1 \
+            FIRMWARE_OUT=target/avr-none/robot-annulus-role scripts/build-firmware",
+};
 
 /// One robot's state in a simulated episode, with its raw stimulus.
 #[derive(Clone, Debug)]
@@ -127,10 +188,17 @@ impl<'a> Expectation<'a> {
             .hash_as(&self.model.reading(ticks, frame), self.role)
     }
 
-    /// Everything the firmware must do with raw times and a frame.
-    pub fn expect(&self, ticks: &[u16; 3], frame: &[PixyBlock]) -> Expected {
+    /// Everything the firmware must do with raw times and a frame when its
+    /// choice generator stands at `choice` (the draw, if the state ties, is
+    /// made on a copy).
+    pub fn expect(&self, ticks: &[u16; 3], frame: &[PixyBlock], choice: ChoiceRng) -> Expected {
         let state = self.state(ticks, frame);
-        let action = self.policy.table().action(state);
+        let mut choice = choice;
+        self.outcome(state, choice.pick(self.policy.sets().mask(state)))
+    }
+
+    /// The motor commands and outputs of `action` in `state`.
+    pub fn outcome(&self, state: State, action: ActionId) -> Expected {
         let motors = RobotProfile::ZUMO.action_motors(self.policy.actions());
         Expected {
             state,
@@ -139,6 +207,78 @@ impl<'a> Expectation<'a> {
             outputs: motors.outputs(action),
         }
     }
+}
+
+/// One decision of a robot as the simulator makes it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Decided {
+    /// The period (the log frame's tick).
+    pub tick: u32,
+    /// The state decided on.
+    pub state: State,
+    /// The choice generator before the decision.
+    pub before: ChoiceRng,
+    /// The action taken.
+    pub action: ActionId,
+    /// Whether the decision drew (the state has two or more best actions).
+    pub drew: bool,
+}
+
+/// Follows every decision a firmware made since it booted with the
+/// simulator's policy controller ([`GreedyPolicy::act`]) acting for robot
+/// `robot_id`, so that each tied decision draws the next number of
+/// `ChoiceRng::for_robot(robot_id)`, as the firmware of that robot id must.
+/// `frames` are the log's frames from the first period on; each period is
+/// decided on `stimulus_state(tick)` where the test chose the stimulus,
+/// on the firmware's logged state otherwise (periods before the first
+/// stimulus, or held for the camera). Returns every decision and, for each
+/// frame whose logged action or draw differs from it, a description
+/// (empty when the firmware chose as the simulator does throughout).
+pub fn follow_log(
+    frames: &[LogFrame],
+    policy: &PolicyBlob,
+    robot_id: u8,
+    stimulus_state: impl Fn(u32) -> Option<State>,
+) -> Result<(Vec<Decided>, Vec<String>)> {
+    if frames.first().map(|f| f.tick) != Some(1) {
+        bail!("the log does not start at the firmware's first period");
+    }
+    if let Some(w) = frames.windows(2).find(|w| w[1].tick != w[0].tick + 1) {
+        bail!(
+            "the log misses periods {} to {}",
+            w[0].tick + 1,
+            w[1].tick - 1
+        );
+    }
+    let mut robot = GreedyPolicy::new(policy.clone());
+    let id = usize::from(robot_id);
+    let (mut decided, mut differ) = (Vec::with_capacity(frames.len()), Vec::new());
+    for f in frames {
+        let state = stimulus_state(f.tick).unwrap_or(f.state);
+        let before = robot.choice_rng(id);
+        let action = robot.act(id, state);
+        let drew = robot.choice_rng(id) != before;
+        let logged = drew.then_some(before.state());
+        if f.action != action || f.choice != logged {
+            differ.push(format!(
+                "period {}: state {state}, the simulator's robot {robot_id} takes {action:?} \
+                 (generator before {:#06x}, drew: {drew}); the firmware logged state {}, {:?}, draw {:?}",
+                f.tick,
+                before.state(),
+                f.state,
+                f.action,
+                f.choice
+            ));
+        }
+        decided.push(Decided {
+            tick: f.tick,
+            state,
+            before,
+            action,
+            drew,
+        });
+    }
+    Ok((decided, differ))
 }
 
 /// The same scene seen in a mirror: left and right times swapped, blocks

@@ -63,6 +63,17 @@ pub const PIXY_SYNC_CC: u16 = 0xAA56;
 /// See [`PIXY_SYNC`].
 pub const PIXY_SYNC_SWAPPED: u16 = 0x55AA;
 
+/// A puck (signature 1) near, in the left half of the image: the left
+/// puck sensor's bit.
+pub const PUCK_LEFT: PixyBlock = PixyBlock {
+    signature: 1,
+    x: 60,
+    y: 150,
+    width: 20,
+    height: 14,
+    angle: 0,
+};
+
 /// One camera frame as the Pixy sends it, written here from the protocol
 /// (not with the firmware's encoder): an extra sync starts the frame, then
 /// each block: its sync, the checksum (wrapping sum of the data words),
@@ -1027,6 +1038,18 @@ impl Zumo {
     /// frame (marker 3): the period's work, which must fit in 20 ms.
     pub fn period_work_cycles(&self) -> Vec<u64> {
         self.marker_spans(4, 3)
+    }
+
+    /// Cycles from each period's start (marker 4) to its decision (marker
+    /// 1): buttons, the field sensors' RC timing and the camera's read.
+    pub fn sensing_cycles(&self) -> Vec<u64> {
+        self.marker_spans(4, 1)
+    }
+
+    /// Cycles from each decision's end (marker 2) to the end of its log
+    /// frame (marker 3): EEPROM, LEDs, the frame on USART1 and into USB.
+    pub fn logging_cycles(&self) -> Vec<u64> {
+        self.marker_spans(2, 3)
     }
 
     /// Cycles between consecutive period starts.

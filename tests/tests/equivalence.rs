@@ -8,7 +8,12 @@
 //! delays on the three sensor pins) and bus (the camera frame served on
 //! I2C), one control period per state; the firmware's logged state and
 //! action and its OCR1A/OCR1B writes are compared with what the host
-//! computes from the stimulus:
+//! computes from the stimulus. Where a state has several best actions
+//! (the tied policy, `robot-annulus-8bit-tied`, a format version 2 blob)
+//! the firmware draws from its generator: the host follows every period
+//! since the firmware booted with the simulator's policy controller acting
+//! for the firmware's robot id, so both must make the same draw in every
+//! period and log it (`tests::equivalence::follow_log`).
 //! - exact check: times nudged at least two ticks from every quantisation
 //!   edge, 100 % agreement required;
 //! - negative controls: mirrored expectations and another policy disagree;
@@ -18,12 +23,8 @@
 //! The ELFs come from `scripts/test` (or `scripts/build-firmware` with
 //! `FIRMWARE_OUT`); a missing or stale one fails with the command to run.
 
-use firmware::calibration_record;
 use rand::{RngExt, SeedableRng};
-use shared::{
-    ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, RunMode, State,
-    StateHasher,
-};
+use shared::{ActionId, LogFrame, PixyBlock, PolicyBlob, PolicyTable, Role, State};
 use sim::{
     base::rng::SimRng, fields::letters::Letter, fields::source::FieldSource,
     sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors,
@@ -31,11 +32,13 @@ use sim::{
 use std::collections::HashMap;
 use std::time::Instant;
 use tests::equivalence::{
-    check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, mirrored, nudge, read_policy,
-    sample_states, Expectation, Expected, Sample,
+    check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, follow_log, mirrored, nudge,
+    read_policy, sample_states, Decided, Expectation, Expected, Sample, Variant, EIGHT_BIT, ROLE,
+    TEN_BIT, TIED,
 };
 use tests::figures::{compiler_of, thousands, Figures, Outcome};
-use tests::zumo::{firmware_elf_in, Zumo};
+use tests::playback::{driving_zumo, frames_since_boot, play, Observed, Stimulus};
+use tests::zumo::firmware_elf_in;
 
 /// The command that regenerates the figures in `docs/equivalence.md`.
 const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test equivalence";
@@ -45,139 +48,6 @@ const PER_FIELD: usize = 340;
 const WARMUP_STEPS: u64 = 400;
 const SAMPLE_EVERY: u64 = 37;
 const BUDGET_CYCLES: u64 = 2_000;
-
-struct Variant {
-    policy: &'static str,
-    /// Directory under `target/avr-none` of the ELF built with that policy.
-    elf_dir: &'static str,
-    hasher: StateHasher,
-    /// The firmware's robot id (its role: odd ids are innies).
-    robot_id: u8,
-    build: &'static str,
-}
-
-const EIGHT_BIT: Variant = Variant {
-    policy: "robot-annulus-8bit.policy",
-    elf_dir: "robot-annulus-8bit",
-    hasher: StateHasher::Original,
-    robot_id: 0,
-    build: "FIRMWARE_POLICY=policies/robot-annulus-8bit.policy FIRMWARE_OUT=target/avr-none/robot-annulus-8bit \
-            scripts/build-firmware",
-};
-
-const TEN_BIT: Variant = Variant {
-    policy: "robot-annulus-10bit.policy",
-    elf_dir: "robot-annulus-10bit",
-    hasher: StateHasher::OriginalObstacle,
-    robot_id: 0,
-    build: "FIRMWARE_POLICY=policies/robot-annulus-10bit.policy FIRMWARE_HASHER=original-obstacle \
-            FIRMWARE_OUT=target/avr-none/robot-annulus-10bit scripts/build-firmware",
-};
-
-/// The role policy in an innie's firmware (robot id 1), so that the role
-/// bit takes part.
-const ROLE: Variant = Variant {
-    policy: "robot-annulus-role.policy",
-    elf_dir: "robot-annulus-role",
-    hasher: StateHasher::OriginalRole,
-    robot_id: 1,
-    build: "FIRMWARE_POLICY=policies/robot-annulus-role.policy FIRMWARE_HASHER=original-role FIRMWARE_ROBOT_ID=1 \
-            FIRMWARE_OUT=target/avr-none/robot-annulus-role scripts/build-firmware",
-};
-
-/// One period's stimulus.
-struct Stimulus<'a> {
-    /// RC delays in CPU cycles after each pin becomes an input.
-    cycles: [u64; 3],
-    /// The camera frame.
-    frame: &'a [PixyBlock],
-}
-
-/// What the firmware did in the period of one stimulus.
-struct Observed {
-    frame: LogFrame,
-    duties: (u16, u16),
-    directions: (bool, bool),
-}
-
-/// A Zumo running `elf`, its USB serial port open and streaming to a host
-/// in the background, calibrated by the real procedure (button B, then
-/// the display's white and black screens as RC delays on the sensor pins:
-/// each sensor's model time at field 1.0 and at 0.0, placed mid-tick as in
-/// the exact check), driving, stopped right after a decision. Panics unless
-/// the stored calibration is the simulator's.
-fn driving_zumo(elf: &std::path::Path, model: &RobotSensors, latency_us: f64) -> Zumo {
-    let mut z = Zumo::boot_elf(elf);
-    z.run_ms(40);
-    // USB enumerated and streaming all along, a control request every 7 ms.
-    z.usb_open(4);
-    z.stream_usb_in_background(firmware::usb::IN_EP, 7_000);
-    let cal = model.calibration();
-    let screen = |ticks: [u16; 3]| ticks.map(|t| Some(cycles_of_ticks(t, latency_us)));
-    z.calibrate_cycles(
-        screen(cal.ranges.map(|r| r.bright)),
-        screen(cal.ranges.map(|r| r.dark)),
-    );
-    let record: [u8; calibration_record::RECORD_LEN] = z
-        .read_eeprom(0, calibration_record::RECORD_LEN)
-        .try_into()
-        .expect("a record's bytes");
-    let stored = calibration_record::decode(&record);
-    assert_eq!(
-        stored,
-        Ok(cal),
-        "the procedure must store the simulator's calibration (PhotoSensorConfig::calibration)"
-    );
-    z.press_a();
-    z.run_to_decision();
-    z
-}
-
-/// Plays one stimulus per control period and returns what the firmware did
-/// in each. A period whose camera frame is empty right after one that was
-/// not gets one more period first: the firmware uses a frame's blocks for
-/// two periods and the Pixy sends nothing when it sees nothing.
-fn play(z: &mut Zumo, stimuli: &[Stimulus<'_>], holding: &mut bool) -> Vec<Observed> {
-    let mut periods = Vec::with_capacity(stimuli.len());
-    // A period may be under way (after an earlier play's closing run), its
-    // sensors read with the earlier stimulus: finish it first.
-    z.run_to_decision();
-    for s in stimuli {
-        z.set_sensor_cycles(s.cycles.map(Some));
-        z.show(s.frame);
-        let mut tick = z.run_to_decision();
-        if s.frame.is_empty() && *holding {
-            tick = z.run_to_decision();
-        }
-        *holding = !s.frame.is_empty();
-        periods.push((tick, z.duties(), z.directions()));
-    }
-    z.run_ms(10);
-    let frames: HashMap<u64, LogFrame> = z
-        .frames()
-        .into_iter()
-        .map(|f| f.unwrap_or_else(|e| panic!("undecodable log frame: {e}")))
-        .map(|f| (u64::from(f.tick), f))
-        .collect();
-    periods
-        .into_iter()
-        .map(|(tick, duties, directions)| {
-            let frame = *frames
-                .get(&tick)
-                .unwrap_or_else(|| panic!("no log frame for period {tick}"));
-            assert_eq!(
-                (frame.mode, frame.faults),
-                (RunMode::Driving, Faults::NONE),
-                "period {tick}: {frame:?}"
-            );
-            Observed {
-                frame,
-                duties,
-                directions,
-            }
-        })
-        .collect()
-}
 
 /// Whether the firmware did exactly what was expected.
 fn matches(o: &Observed, e: &Expected) -> bool {
@@ -272,21 +142,8 @@ fn equivalence(v: &Variant) {
         .zip(&nudged)
         .filter(|(s, n)| s.observation.ticks != **n)
         .count();
-    let expected: Vec<Expected> = samples
-        .iter()
-        .zip(&nudged)
-        .map(|(s, t)| expectation.expect(t, &s.observation.frame))
-        .collect();
-    let mut histogram = [0usize; 4];
-    for e in &expected {
-        histogram[e.action.index()] += 1;
-    }
-    assert!(
-        histogram.iter().all(|&n| n > 0),
-        "the sample does not exercise all four actions: {histogram:?}"
-    );
 
-    let mut z = driving_zumo(&elf, &model, config.field.poll_latency_us);
+    let mut z = driving_zumo(&elf, &model, config.field.poll_latency_us, true);
     let mut holding = false;
     let stimuli: Vec<Stimulus<'_>> = samples
         .iter()
@@ -297,6 +154,51 @@ fn equivalence(v: &Variant) {
         })
         .collect();
     let observed = play(&mut z, &stimuli, &mut holding);
+    // End to end: the model's own discharge times, not nudged.
+    let stimuli: Vec<Stimulus<'_>> = samples
+        .iter()
+        .map(|s| Stimulus {
+            cycles: s.observation.discharge_us.map(cycles_of_us),
+            frame: &s.observation.frame,
+        })
+        .collect();
+    let observed_e2e = play(&mut z, &stimuli, &mut holding);
+
+    // Every period since boot decided by the simulator's robot of this
+    // firmware's id: the exact check's on its stimulus' state, the others
+    // on the state the firmware logged.
+    let stimulus_states: HashMap<u32, State> = samples
+        .iter()
+        .zip(&nudged)
+        .zip(&observed)
+        .map(|((s, t), o)| (o.frame.tick, expectation.state(t, &s.observation.frame)))
+        .collect();
+    let frames = frames_since_boot(&z);
+    let (decisions, differ) = follow_log(&frames, &policy, v.robot_id, |tick| {
+        stimulus_states.get(&tick).copied()
+    })
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    let decided: HashMap<u32, Decided> = decisions.iter().map(|d| (d.tick, *d)).collect();
+    let at = |o: &Observed| decided[&o.frame.tick];
+    let draws_since_boot = decisions.iter().filter(|d| d.drew).count();
+
+    // Exact check: nudged stimuli, mid-tick delays.
+    let expected: Vec<Expected> = observed
+        .iter()
+        .map(|o| {
+            let d = at(o);
+            expectation.outcome(d.state, d.action)
+        })
+        .collect();
+    let exact_draws = observed.iter().filter(|o| at(o).drew).count();
+    let mut histogram = [0usize; 4];
+    for e in &expected {
+        histogram[e.action.index()] += 1;
+    }
+    assert!(
+        histogram.iter().all(|&n| n > 0),
+        "the sample does not exercise all four actions: {histogram:?}"
+    );
     let mismatches: Vec<String> = observed
         .iter()
         .zip(&expected)
@@ -312,14 +214,15 @@ fn equivalence(v: &Variant) {
     let exact = samples.len() - mismatches.len();
     let exact_offsets = offsets_of(nudged.iter().zip(&observed).map(|(t, o)| (t, &o.frame)));
 
-    // Negative controls on the same firmware periods.
+    // Negative controls on the same firmware periods, each drawing (where
+    // its state ties) from the generator as it stood in that period.
     let mirror_mismatches = samples
         .iter()
         .zip(&nudged)
         .zip(&observed)
         .filter(|((s, t), o)| {
             let (mt, mf) = mirrored(t, &s.observation.frame);
-            !matches(o, &expectation.expect(&mt, &mf))
+            !matches(o, &expectation.expect(&mt, &mf, at(o).before))
         })
         .count();
     let other = random_policy(&policy, 99);
@@ -328,18 +231,14 @@ fn equivalence(v: &Variant) {
         .iter()
         .zip(&nudged)
         .zip(&observed)
-        .filter(|((s, t), o)| !matches(o, &other_expectation.expect(t, &s.observation.frame)))
+        .filter(|((s, t), o)| {
+            !matches(
+                o,
+                &other_expectation.expect(t, &s.observation.frame, at(o).before),
+            )
+        })
         .count();
 
-    // End to end: the model's own discharge times, not nudged.
-    let stimuli: Vec<Stimulus<'_>> = samples
-        .iter()
-        .map(|s| Stimulus {
-            cycles: s.observation.discharge_us.map(cycles_of_us),
-            frame: &s.observation.frame,
-        })
-        .collect();
-    let observed_e2e = play(&mut z, &stimuli, &mut holding);
     let (mut agree, mut explained, mut unexplained) = (0, Vec::new(), Vec::new());
     let offsets = offsets_of(
         samples
@@ -349,13 +248,9 @@ fn equivalence(v: &Variant) {
     );
     for (s, o) in samples.iter().zip(&observed_e2e) {
         let ticks = &s.observation.ticks;
-        // Whatever state the firmware reached, it must act on it as the policy says.
-        let own = expectation.expect(ticks, &s.observation.frame);
-        assert_eq!(
-            o.frame.action,
-            policy.table().action(o.frame.state),
-            "the firmware's action is not its state's"
-        );
+        // Whatever state the firmware reached, it acted on it as the
+        // simulator's robot does (`differ`, over every period).
+        let own = expectation.expect(ticks, &s.observation.frame, at(o).before);
         if o.frame.state == own.state {
             agree += 1;
         } else {
@@ -373,7 +268,7 @@ fn equivalence(v: &Variant) {
         .zip(&observed_e2e)
         .filter(|(s, o)| {
             expectation
-                .expect(&s.observation.ticks, &s.observation.frame)
+                .expect(&s.observation.ticks, &s.observation.frame, at(o).before)
                 .action
                 == o.frame.action
         })
@@ -394,6 +289,13 @@ fn equivalence(v: &Variant) {
         "exact check: {exact}/{n} match ({:.1} %), {nudged_count} stimuli nudged ({:.1} %)",
         percent(exact, n),
         percent(nudged_count, n)
+    );
+    println!(
+        "choices: {exact_draws}/{n} exact-check periods drew among tied actions; {} periods since boot followed, \
+         {draws_since_boot} draws, {} differ from the simulator's robot {}",
+        decisions.len(),
+        differ.len(),
+        v.robot_id
     );
     println!("exact check: firmware raw time minus stimulus ticks (per sensor reading): {exact_offsets:?}");
     println!(
@@ -444,11 +346,24 @@ fn equivalence(v: &Variant) {
     ]);
     figures.fixed(&["exact check", &pct(exact)]);
     figures.fixed(&["stimuli nudged", &pct(nudged_count)]);
+    figures.fixed(&[
+        "exact-check periods that drew among tied actions (the simulator's robot of the firmware's id drew the same)",
+        &pct(exact_draws),
+    ]);
     figures.fixed(&["mirrored expectations mismatch", &pct(mirror_mismatches)]);
     figures.fixed(&["another policy mismatches", &pct(other_mismatches)]);
     figures.compiled(&[
         "firmware raw time - stimulus ticks (exact check, per reading)",
         &offsets_text(&exact_offsets),
+    ]);
+    figures.compiled(&[
+        "periods since boot whose logged action and draw are the simulator's robot's",
+        &format!(
+            "{} of {} ({} draws)",
+            thousands((decisions.len() - differ.len()) as u64),
+            thousands(decisions.len() as u64),
+            thousands(draws_since_boot as u64)
+        ),
     ]);
     figures.compiled(&["end-to-end state agreement", &pct(agree)]);
     figures.compiled(&["end-to-end action agreement", &pct(e2e_action_agree)]);
@@ -491,6 +406,21 @@ fn equivalence(v: &Variant) {
     );
 
     assert!(
+        differ.is_empty(),
+        "{} of {} periods chose otherwise than the simulator's robot {}, first: {:#?}",
+        differ.len(),
+        decisions.len(),
+        v.robot_id,
+        &differ[..differ.len().min(5)]
+    );
+    let tied_states = (0..v.hasher.num_states() as u16)
+        .filter(|s| policy.sets().mask(State(*s)).count_ones() > 1)
+        .count();
+    assert!(
+        tied_states == 0 || exact_draws * 10 >= n,
+        "a policy with {tied_states} tied states drew in only {exact_draws} of {n} periods: the check does not exercise the draw"
+    );
+    assert!(
         mismatches.is_empty(),
         "{} of {n} periods differ, first: {:#?}",
         mismatches.len(),
@@ -529,6 +459,11 @@ fn the_8bit_firmware_decides_as_the_simulator() {
 #[test]
 fn the_10bit_firmware_decides_as_the_simulator() {
     equivalence(&TEN_BIT);
+}
+
+#[test]
+fn the_firmware_of_a_tied_policy_draws_as_the_simulators_robot_of_its_id() {
+    equivalence(&TIED);
 }
 
 #[test]

@@ -12,7 +12,7 @@ use firmware::decision::Decider;
 use firmware::embedded;
 use shared::{Faults, FieldCalibration, LogFrame, MotorCommand, PixyBlock, RunMode, SensorRange};
 use tests::zumo::{
-    pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED,
+    pixy_bytes, pixy_frame_words, Zumo, CYCLES_PER_TICK, PIXY_SYNC, PIXY_SYNC_SWAPPED, PUCK_LEFT,
 };
 
 const CALIBRATION: FieldCalibration = FieldCalibration {
@@ -23,14 +23,6 @@ const CALIBRATION: FieldCalibration = FieldCalibration {
 };
 /// Left 0.35, mid 0.6 (bin 9 of 16), right 0.725.
 const SENSOR_TICKS: [Option<u16>; 3] = [Some(300), Some(200), Some(150)];
-const PUCK_LEFT: PixyBlock = PixyBlock {
-    signature: 1,
-    x: 60,
-    y: 150,
-    width: 20,
-    height: 14,
-    angle: 0,
-};
 const ROBOT_RIGHT: PixyBlock = PixyBlock {
     signature: 2,
     x: 250,
@@ -359,15 +351,52 @@ fn usb_streaming(z: &mut Zumo) {
 /// (about 0.8 m/s on 75:1 motors, faster than a Zumo drives), the sensors
 /// near their timeout, and frames of eight colour-code blocks; with the
 /// USB port streaming ([`usb_streaming`]) or no cable.
+/// What [`heaviest_periods_of`] over 1.1 s measured in its driving periods.
+struct LongRun {
+    /// One decision's cycles, fewest and most.
+    decisions: (u64, u64),
+    /// The heaviest period's work, in cycles.
+    work: u64,
+    /// That period's sensing (start to decision), decision, and logging
+    /// (decision's end to the log frame's end), in cycles.
+    split: [u64; 3],
+    /// That period's log frame, bytes with its delimiter.
+    frame_len: usize,
+    /// The stack's lowest address.
+    low: usize,
+}
+
 fn heaviest_periods(usb: bool) -> Zumo {
-    let mut z = calibrated_zumo();
-    z.run_ms(40);
+    heaviest_periods_of(
+        Zumo::boot(),
+        &CALIBRATION,
+        [Some(490), Some(495), Some(499)],
+        usb,
+        400,
+    )
+}
+
+/// The heaviest periods ([`heaviest_periods`]) of the firmware booted in
+/// `z`, calibrated with `calibration`, the sensors at `ticks`, for `ms`;
+/// the stack painted from the start.
+fn heaviest_periods_of(
+    mut z: Zumo,
+    calibration: &FieldCalibration,
+    ticks: [Option<u16>; 3],
+    usb: bool,
+    ms: u64,
+) -> Zumo {
+    z.write_eeprom(0, &calibration_record::encode(calibration));
+    z.set_sensor_ticks(SENSOR_TICKS);
+    z.run_ms(1);
+    z.paint_stack();
+    z.run_ms(39);
     if usb {
         usb_streaming(&mut z);
     }
     z.press_a();
     z.set_wheel_counts_per_second([6_000, 6_000]);
-    z.set_sensor_ticks([Some(490), Some(495), Some(499)]);
+    z.set_sensor_ticks(ticks);
     let cc = |i: u16| PixyBlock {
         signature: 0o12,
         x: 10 + 30 * i,
@@ -377,7 +406,7 @@ fn heaviest_periods(usb: bool) -> Zumo {
         angle: -45,
     };
     z.show(&(0..8).map(cc).collect::<Vec<_>>());
-    z.run_ms(400);
+    z.run_ms(ms);
     z
 }
 
@@ -579,7 +608,9 @@ fn usb_sizes(elf: &std::path::Path) -> (u64, u64) {
 
 #[test]
 fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
-    use tests::figures::{compiler_of, thousands, Figures, Outcome};
+    use shared::PolicyBlob;
+    use tests::equivalence::TIED;
+    use tests::figures::{compiler_of, thousands, workspace, Figures, Outcome};
     use tests::zumo::{firmware_elf, firmware_elf_in};
     const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
     let elf = firmware_elf();
@@ -706,6 +737,202 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
             quiet_work as f64 / 16_000.0
         ),
         &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+
+    // The tied policy's firmware (robot 3) in the heaviest periods, every
+    // period drawing among four best actions: the right sensor's time at
+    // 499 ticks as in the heaviest periods (the RC poll lasts until the
+    // last pin), the others the latest times whose state has four best
+    // actions and keeps it when the left or mid time moves by up to 4 ticks
+    // (at 6,000 counts/s the encoders' interrupts delay some polls by a few
+    // ticks).
+    let tied_elf = firmware_elf_in(TIED.elf_dir, TIED.build);
+    let tied =
+        PolicyBlob::decode(&std::fs::read(workspace().join("policies").join(TIED.policy)).unwrap())
+            .unwrap();
+    let (tied_flash, tied_ram) = sizes(&tied_elf);
+    let scales = CALIBRATION.scales();
+    let state_of = |t: [u16; 3]| {
+        let reading = shared::SensorReading::from_parts(scales.values(&t), CAMERA.classify(&[]));
+        TIED.hasher
+            .hash_as(&reading, shared::Role::of_robot_id(TIED.robot_id))
+    };
+    let four = |t: [u16; 3]| {
+        let s = state_of(t);
+        let steady = (0..2).all(|i| {
+            (t[i] - 4..=t[i] + 4).all(|v| {
+                let mut m = t;
+                m[i] = v;
+                state_of(m) == s
+            })
+        });
+        (steady && tied.sets().mask(s).count_ones() == 4).then_some(s)
+    };
+    let (drawing_ticks, drawing_state) = (40..=440u16)
+        .rev()
+        .flat_map(|mid| (40..=490u16).rev().map(move |left| [left, mid, 499]))
+        .find_map(|t| four(t).map(|s| (t, s)))
+        .expect("times near the timeout in a state with four best actions");
+    // 1.1 s of the heaviest periods, so that a frame carrying the
+    // calibration (every 50th) falls among them: the longest frames. With
+    // `draws`, every driving period must draw in that state.
+    let long_run =
+        |elf: &std::path::Path, ticks: [u16; 3], draws: Option<shared::State>, usb: bool| {
+            let mut z = heaviest_periods_of(
+                Zumo::boot_elf(elf),
+                &CALIBRATION,
+                ticks.map(Some),
+                usb,
+                1_100,
+            );
+            let frames = decoded(&mut z);
+            let driving: Vec<usize> = (0..frames.len())
+                .filter(|&i| frames[i].mode == RunMode::Driving)
+                .collect();
+            assert!(driving.len() >= 50, "{} periods driving", driving.len());
+            // the first driving periods read the times from before A was
+            // pressed (the right one 150 ticks, not 499)
+            let stale = |i: &&usize| frames[**i].raw_times[2] < 490;
+            for &i in driving.iter().skip_while(stale).filter(|_| draws.is_some()) {
+                let f = &frames[i];
+                assert_eq!(
+                    (Some(f.state), f.choice.is_some()),
+                    (draws, true),
+                    "period {}: every period draws among four (times {ticks:?}, read {:?})",
+                    f.tick,
+                    f.raw_times
+                );
+            }
+            assert!(
+                driving.iter().any(|&i| frames[i].calibration.is_some()),
+                "no driving frame carried the calibration (the longest frames)"
+            );
+            if usb {
+                assert!(z.usb_background().1 > 0, "no control request answered");
+            }
+            // period i's spans are the i-th marker spans since boot
+            let (decisions, work) = (z.decision_cycles(), z.period_work_cycles());
+            let (sensing, logging) = (z.sensing_cycles(), z.logging_cycles());
+            assert!([&decisions, &work, &sensing, &logging]
+                .iter()
+                .all(|spans| spans.len() >= frames.len()));
+            let heaviest = *driving.iter().max_by_key(|&&i| work[i]).unwrap();
+            LongRun {
+                decisions: (
+                    driving.iter().map(|&i| decisions[i]).min().unwrap(),
+                    driving.iter().map(|&i| decisions[i]).max().unwrap(),
+                ),
+                work: work[heaviest],
+                split: [sensing[heaviest], decisions[heaviest], logging[heaviest]],
+                frame_len: frames[heaviest].encode(&mut [0; LogFrame::MAX_ENCODED_LEN]),
+                low: z.stack_low_water(),
+            }
+        };
+    let drawing = |usb: bool| long_run(&tied_elf, drawing_ticks, Some(drawing_state), usb);
+    let (loud, quiet) = (drawing(true), drawing(false));
+    let default_long = long_run(&elf, [490, 495, 499], None, true);
+    let (draw_min, draw_max, draw_work, draw_low) =
+        (loud.decisions.0, loud.decisions.1, loud.work, loud.low);
+    let (quiet_draw_min, quiet_draw_max, quiet_draw_work, quiet_draw_low) =
+        (quiet.decisions.0, quiet.decisions.1, quiet.work, quiet.low);
+    assert!(
+        draw_max <= BUDGET_CYCLES && quiet_draw_max <= BUDGET_CYCLES,
+        "a decision with a draw took {draw_max} cycles"
+    );
+    // Met without a cable; with USB streaming the period that carries the
+    // calibration overruns (docs/firmware.md, "Measured"): reported, and
+    // held to no more than that overrun's 10 % of the period, so that it
+    // cannot grow unnoticed.
+    assert!(
+        quiet_draw_work <= period,
+        "the heaviest period with a draw took {quiet_draw_work} cycles without a cable, of {period}"
+    );
+    assert!(
+        draw_work.max(default_long.work) <= period + period / 10,
+        "the heaviest period took {draw_work} cycles with a draw and {} without, with USB, of {period}",
+        default_long.work
+    );
+    assert!(
+        draw_low >= STACK_FLOOR && quiet_draw_low >= STACK_FLOOR,
+        "drawing, the stack reached {:#06x}: less than 256 bytes above the bootloader key",
+        draw_low.min(quiet_draw_low)
+    );
+    let against = |work: u64| {
+        if work <= period {
+            format!("within by {}", thousands(period - work))
+        } else {
+            format!("OVER by {}", thousands(work - period))
+        }
+    };
+    figures.compiled(&[
+        "tied policy (`robot-annulus-8bit-tied`, robot 3): flash, static RAM",
+        &format!(
+            "{} bytes, {} bytes",
+            thousands(tied_flash),
+            thousands(tied_ram)
+        ),
+        "28,672; 1,536",
+        "`scripts/build-firmware`",
+    ]);
+    figures.compiled(&[
+        "one decision with a draw among four tied actions (tied policy, the heaviest periods, USB streaming)",
+        &format!(
+            "{} to {} cycles; no cable: {} to {}",
+            thousands(draw_min),
+            thousands(draw_max),
+            thousands(quiet_draw_min),
+            thousands(quiet_draw_max)
+        ),
+        "2,000",
+        "this test",
+    ]);
+    figures.compiled(&[
+        "a period's work, heaviest over 1.1 s (the heaviest periods and a frame carrying the calibration), a draw among four in every period (tied policy; USB streaming)",
+        &format!(
+            "{} cycles ({:.1} ms, {}: sensors and camera {}, decision {}, log frame of {} bytes {}); no cable: {} ({:.1} ms, {}: {}, {}, {} bytes {})",
+            thousands(draw_work),
+            draw_work as f64 / 16_000.0,
+            against(draw_work),
+            thousands(loud.split[0]),
+            thousands(loud.split[1]),
+            loud.frame_len,
+            thousands(loud.split[2]),
+            thousands(quiet_draw_work),
+            quiet_draw_work as f64 / 16_000.0,
+            against(quiet_draw_work),
+            thousands(quiet.split[0]),
+            thousands(quiet.split[1]),
+            quiet.frame_len,
+            thousands(quiet.split[2])
+        ),
+        &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+    figures.compiled(&[
+        "the same over 1.1 s, default policy (no draw; USB streaming)",
+        &format!(
+            "{} cycles ({:.1} ms, {}: sensors and camera {}, decision {}, log frame of {} bytes {})",
+            thousands(default_long.work),
+            default_long.work as f64 / 16_000.0,
+            against(default_long.work),
+            thousands(default_long.split[0]),
+            thousands(default_long.split[1]),
+            default_long.frame_len,
+            thousands(default_long.split[2])
+        ),
+        &format!("{} (20 ms)", thousands(period)),
+        "this test",
+    ]);
+    figures.compiled(&[
+        "stack, deepest, drawing in the heaviest periods (tied policy; USB streaming)",
+        &format!(
+            "{} bytes (down to {draw_low:#06X}, {} bytes above the key); no cable: {} bytes",
+            0x0B00 - draw_low,
+            draw_low - 0x0802,
+            0x0B00 - quiet_draw_low
+        ),
+        "256 bytes above the key (down to 0x0902)",
         "this test",
     ]);
 

@@ -14,22 +14,14 @@ use host::robot::log_file::{self, SourceKind};
 use host::robot::monitor::{self, MonitorEvent, MonitorOptions, SerialOpener};
 use host::robot::replay::{replay, ModeCounts, ReplayReport, Stage};
 use serialport::{SerialPort, TTYPort};
-use shared::{ActionId, Faults, LogFrame, PixyBlock, PolicyBlob, PolicyTable, RunMode};
+use shared::{ActionId, Faults, LogFrame, PolicyBlob, PolicyTable, RunMode};
 use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::sync::mpsc::{channel, Receiver};
 use std::time::Duration;
-use tests::zumo::Zumo;
+use tests::zumo::{Zumo, PUCK_LEFT};
 
-const PUCK_LEFT: PixyBlock = PixyBlock {
-    signature: 1,
-    x: 60,
-    y: 150,
-    width: 20,
-    height: 14,
-    angle: 0,
-};
 /// A guard against a hung test, not a timing assertion.
 const EVENT_TIMEOUT: Duration = Duration::from_secs(60);
 

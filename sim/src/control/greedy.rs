@@ -2,7 +2,7 @@
 
 use crate::base::rng::SimRng;
 use crate::control::{Controller, Perception};
-use shared::{ChoiceRng, PolicyBlob};
+use shared::{ActionId, ChoiceRng, PolicyBlob, State};
 
 /// Hashes each reading with the blob's hasher, looks the state's best
 /// actions up and turns by the action's angular speed: exactly what the
@@ -43,20 +43,28 @@ impl GreedyPolicy {
 
 impl Controller for GreedyPolicy {
     fn decide(&mut self, p: &Perception<'_>, turns: &mut [f32], _rng: &mut SimRng) {
-        while self.choices.len() < turns.len() {
+        let hasher = self.blob.hasher();
+        let robots = turns.iter_mut().zip(p.readings).zip(p.robots);
+        for (i, ((turn, reading), robot)) in robots.enumerate() {
+            let action = self.act(i, hasher.hash_as(reading, robot.kind.role()));
+            // A decoded blob names only existing actions, so the lookup
+            // cannot miss; 0 keeps the robot straight if it ever did.
+            *turn = self.blob.actions().angular(action).unwrap_or(0.0);
+        }
+    }
+}
+
+impl GreedyPolicy {
+    /// Robot `robot`'s action in `state`: the state's best action, or the
+    /// one robot `robot`'s generator picks among several (one draw). What
+    /// [`Controller::decide`] does for each robot; the firmware
+    /// equivalence tests follow a robot's decisions with it.
+    pub fn act(&mut self, robot: usize, state: State) -> ActionId {
+        while self.choices.len() <= robot {
             self.choices
                 .push(ChoiceRng::for_robot(self.choices.len() as u8));
         }
-        let (hasher, sets, actions) = (self.blob.hasher(), self.blob.sets(), self.blob.actions());
-        let robots = turns.iter_mut().zip(p.readings).zip(p.robots);
-        for (((turn, reading), robot), choice) in robots.zip(&mut self.choices) {
-            let state = hasher.hash_as(reading, robot.kind.role());
-            // A decoded blob names only existing actions, so the lookup
-            // cannot miss; 0 keeps the robot straight if it ever did.
-            *turn = actions
-                .angular(choice.pick(sets.mask(state)))
-                .unwrap_or(0.0);
-        }
+        self.choices[robot].pick(self.blob.sets().mask(state))
     }
 }
 
@@ -65,7 +73,7 @@ mod tests {
     use super::*;
     use crate::control::policy_file;
     use crate::scenario::Scenario;
-    use shared::{ActionSets, ActionTable, Provenance, State, StateHasher};
+    use shared::{ActionSets, ActionTable, Provenance, StateHasher};
     use std::path::Path;
 
     /// The policy controller as it was before blob format version 2: each
