@@ -46,7 +46,7 @@ class SB3VecEnv(VecEnv):
         self._actions = np.asarray(actions)
 
     def step_wait(self):
-        obs, rewards, terminated, truncated, info = self.venv.step(self._actions)
+        obs, _, terminated, truncated, info = self.venv.step(self._actions)
         dones = terminated | truncated
         infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         for i in np.flatnonzero(dones):
@@ -54,7 +54,7 @@ class SB3VecEnv(VecEnv):
             infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
         for i, world in enumerate(infos):
             world["eval"] = float(info["eval"][i])
-        return obs, rewards[:, 0].astype(np.float32), dones, infos
+        return obs, info["world_reward"].astype(np.float32), dones, infos
 
     def close(self) -> None:
         self.venv.close()
