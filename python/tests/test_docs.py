@@ -20,3 +20,11 @@ def test_the_throughput_tables_are_rendered_from_the_measured_results(repo):
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
     for doc in ["python.md", "performance.md"]:
         assert table in (repo / "docs" / doc).read_text(), f"docs/{doc} does not hold the rendered table"
+
+
+def test_the_learning_table_is_rendered_from_the_measured_results(repo):
+    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
+    learning = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(learning)
+    table = learning.render(json.loads((repo / "docs" / "python-learning.json").read_text()))
+    assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered learning table"
