@@ -28,3 +28,19 @@ def test_the_learning_table_is_rendered_from_the_measured_results(repo):
     spec.loader.exec_module(learning)
     table = learning.render(json.loads((repo / "docs" / "python-learning.json").read_text()))
     assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered learning table"
+
+
+def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results(repo):
+    rows = json.loads((repo / "docs" / "python-learning.json").read_text())["rows"]
+    by = {(r["learner"].split(" (")[0], r["reward"]): r for r in rows}
+    still, random = by[("robots standing still", None)], by[("random actions", None)]
+    tabular = by[("tabular Q", "reference")]
+    assert tabular["trained_formations"] > 0 and tabular["exported_formations"] > 0 and tabular["formations"] > 0
+    assert tabular["final_eval"] > max(still["final_eval"], random["final_eval"])
+    assert by[("tabular Q", "thesis")]["formations"] == by[("tabular Q", "success-shaped")]["formations"] == 0
+    ppo = [r for (learner, _), r in by.items() if "PPO" in learner]
+    assert ppo and all(r["formations"] == r["trained_formations"] == 0 for r in ppo)
+    assert all(abs(r["final_eval"] - still["final_eval"]) < 0.01 and r["final_eval"] > random["final_eval"] for r in ppo)
+    shared = lambda reward: by[("shared-policy PPO", reward)]["final_eval"]
+    assert shared("success-shaped") > shared("reference") and shared("per-robot") > shared("reference")
+    assert random["final_eval"] < still["final_eval"]
