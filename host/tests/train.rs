@@ -226,6 +226,29 @@ fn decaying_exploration_is_the_same_per_seed_and_resumes_exactly_from_a_format_5
 }
 
 #[test]
+fn the_rewards_for_deep_learners_resume_exactly_from_a_format_6_checkpoint_and_change_the_run() {
+    let with = |reward: Reward| TrainConfig {
+        learn: host::learn::LearnConfig {
+            reward,
+            ..Default::default()
+        },
+        ..small(23)
+    };
+    let table = |reward: Reward| {
+        let mut t = trainer(with(reward));
+        t.run(3000);
+        t.learner().table().clone()
+    };
+    let thesis = table(Reward::Thesis);
+    for reward in [Reward::PerRobot, Reward::Success, Reward::SuccessShaped] {
+        assert_eq!(resumes_exactly(with(reward), 1300, 2600), 6, "{reward}");
+        assert_ne!(table(reward), thesis, "{reward} is not the thesis reward");
+    }
+    // the thesis' own rewards keep the formats earlier builds read
+    assert!(resumes_exactly(with(Reward::Thesis), 1300, 2600) <= 5);
+}
+
+#[test]
 fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5_checkpoint() {
     let arena = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../experiments/arenas/tv75-wedge.toml");

@@ -3,8 +3,8 @@ import numpy as np
 import zumo_swarm
 
 
-def train(steps=200_000, seed=1, alpha=0.2, gamma=0.9):
-    env = zumo_swarm.gym_env(observation="state", hasher="original", seed=seed)
+def train(steps=200_000, seed=1, alpha=0.2, gamma=0.9, reward="reference"):
+    env = zumo_swarm.gym_env(observation="state", hasher="original", seed=seed, reward=reward, gamma=gamma)
     q = np.ones((env.batch.num_states, len(env.batch.angular_speeds)))
     rng = np.random.default_rng(seed)
     states, _ = env.reset(seed=seed)

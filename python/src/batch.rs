@@ -86,6 +86,8 @@ pub struct StepOutput {
     pub observations: Observations,
     /// Every world's step.
     pub steps: Vec<WorldStep>,
+    /// Every robot's reward, world after world.
+    pub robot_rewards: Vec<f64>,
     /// With same-step autoreset, when an episode ended in this step: the
     /// last observations of the worlds whose episode ended (zeros for the
     /// others; the new episode's first are in `observations`).
@@ -260,8 +262,10 @@ impl Batch {
         let kind = self.settings.observation;
         let per_world = T::per_robot(kind) * robots;
         let mut observations = vec![T::default(); per_world * self.worlds.len()];
+        let mut robot_rewards = vec![0.0; robots * self.worlds.len()];
         let (settings, autoreset) = (&self.settings, self.autoreset);
-        let one = |(i, (world, obs)): (usize, (&mut WorldEnv, &mut [T]))| {
+        type Slot<'w, T> = (&'w mut WorldEnv, (&'w mut [T], &'w mut [f64]));
+        let one = |(i, (world, (obs, rewards))): (usize, Slot<'_, T>)| {
             let own = match actions {
                 Actions::Discrete(a) => WorldActions::Discrete(&a[i * robots..(i + 1) * robots]),
                 Actions::Continuous(a) => {
@@ -273,6 +277,7 @@ impl Batch {
             } else {
                 world.advance(settings, own)
             };
+            rewards.copy_from_slice(world.robot_rewards());
             let ended_now = autoreset == Autoreset::SameStep && step.ended();
             // A world that ended with same-step autoreset leaves its last
             // observation here; it is moved aside and replaced below.
@@ -283,7 +288,11 @@ impl Batch {
             Some(pool) => pool.install(|| {
                 self.worlds
                     .par_iter_mut()
-                    .zip(observations.par_chunks_exact_mut(per_world))
+                    .zip(
+                        observations
+                            .par_chunks_exact_mut(per_world)
+                            .zip(robot_rewards.par_chunks_exact_mut(robots)),
+                    )
                     .enumerate()
                     .map(one)
                     .collect()
@@ -291,7 +300,11 @@ impl Batch {
             None => self
                 .worlds
                 .iter_mut()
-                .zip(observations.chunks_exact_mut(per_world))
+                .zip(
+                    observations
+                        .chunks_exact_mut(per_world)
+                        .zip(robot_rewards.chunks_exact_mut(robots)),
+                )
                 .enumerate()
                 .map(one)
                 .collect(),
@@ -316,6 +329,7 @@ impl Batch {
         StepOutput {
             observations: T::wrap(observations),
             steps,
+            robot_rewards,
             final_observations,
             final_mask,
         }

@@ -89,7 +89,7 @@ impl PyBatch {
     #[pyo3(signature = (
         num_worlds = 1, *, field = "annulus".to_string(), robots = None, pucks = None, sensors = "disc".to_string(),
         robot_config = None, seed = 1, max_steps = None, thresholds = None, reward = "reference".to_string(),
-        observation = "reading".to_string(), hasher = "original".to_string(), action = "discrete".to_string(),
+        gamma = settings::DEFAULT_GAMMA, observation = "reading".to_string(), hasher = "original".to_string(), action = "discrete".to_string(),
         actions = None, forward_speed = ActionTable::DEFAULT_FORWARD_SPEED, autoreset = "next-step".to_string(),
         threads = None, arena = None
     ))]
@@ -109,6 +109,7 @@ impl PyBatch {
         max_steps: Option<i64>,
         thresholds: Option<(f64, f64)>,
         reward: String,
+        gamma: f64,
         observation: String,
         hasher: String,
         action: String,
@@ -129,6 +130,7 @@ impl PyBatch {
             max_steps,
             thresholds,
             reward,
+            gamma,
             observation,
             hasher,
             action,
@@ -323,9 +325,10 @@ impl PyBatch {
 
     /// One step of every world with a flat array of worlds x robots
     /// actions (int64 indices or float64 angular speeds). Returns
-    /// (observations, reward per world, terminated, truncated, info), info
-    /// a dict of per-world arrays; with same-step autoreset it holds
-    /// `final_obs` (zeros for worlds that did not end) and `_final_obs`.
+    /// (observations, reward per world, terminated, truncated, info,
+    /// reward per robot (worlds x robots)), info a dict of per-world
+    /// arrays; with same-step autoreset it holds `final_obs` (zeros for
+    /// worlds that did not end) and `_final_obs`.
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -401,7 +404,9 @@ impl PyBatch {
             out.steps.iter().map(|s| s.truncated).collect::<Vec<bool>>(),
         );
         let obs = observations_array(py, out.observations, &shape)?;
-        Ok((obs, rewards, terminated, truncated, info)
+        let robots = self.batch.settings().robots();
+        let robot_rewards = PyArray1::from_vec(py, out.robot_rewards).reshape([n, robots])?;
+        Ok((obs, rewards, terminated, truncated, info, robot_rewards)
             .into_pyobject(py)?
             .into_any())
     }
@@ -581,6 +586,26 @@ fn decode_policy<'py>(py: Python<'py>, data: &[u8], path: &str) -> PyResult<Boun
     Ok(d)
 }
 
+/// The world's reward `reward` gives a step whose signal (Eval) goes from
+/// `before` to `after`, `formed` when the step forms the shape; `gamma` is
+/// the discount of `success-shaped`'s shaping. The very function the
+/// environments and `host train` use.
+#[pyfunction]
+#[pyo3(signature = (reward, before, after, formed = false, gamma = settings::DEFAULT_GAMMA))]
+fn reward_value(reward: &str, before: f64, after: f64, formed: bool, gamma: f64) -> PyResult<f64> {
+    let reward: Reward = reward
+        .parse()
+        .map_err(|e: String| value_error(format!("reward = {reward:?}: {e}")))?;
+    Ok(reward.reward(
+        sim::episodes::reward::Transition {
+            before,
+            after,
+            formed,
+        },
+        gamma,
+    ))
+}
+
 /// The native module.
 #[pymodule]
 #[pyo3(name = "_native")]
@@ -588,6 +613,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyBatch>()?;
     m.add_function(wrap_pyfunction!(encode_policy, m)?)?;
     m.add_function(wrap_pyfunction!(decode_policy, m)?)?;
+    m.add_function(wrap_pyfunction!(reward_value, m)?)?;
     m.add(
         "HASHERS",
         StateHasher::ALL

@@ -90,6 +90,10 @@ pub enum Autoreset {
     SameStep,
 }
 
+/// The default discount of `success-shaped`'s shaping: what PPO and most
+/// deep learners use.
+pub const DEFAULT_GAMMA: f64 = 0.99;
+
 /// The keyword arguments as given (Python's types, not yet checked).
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvArgs {
@@ -114,6 +118,8 @@ pub struct EnvArgs {
     pub thresholds: Option<(f64, f64)>,
     /// `reward`: a [`Reward`] name.
     pub reward: String,
+    /// `gamma`: the learner's discount, for `success-shaped`'s shaping.
+    pub gamma: f64,
     /// `observation`: `reading` or `state`.
     pub observation: String,
     /// `hasher`: a [`StateHasher`] name, for `observation="state"`.
@@ -140,6 +146,7 @@ impl Default for EnvArgs {
             max_steps: None,
             thresholds: None,
             reward: "reference".into(),
+            gamma: DEFAULT_GAMMA,
             observation: "reading".into(),
             hasher: "original".into(),
             action: "discrete".into(),
@@ -160,6 +167,8 @@ pub struct EnvSettings {
     pub max_steps: Option<u64>,
     /// The reward every robot receives.
     pub reward: Reward,
+    /// The discount of `success-shaped`'s shaping.
+    pub gamma: f64,
     /// What a robot observes.
     pub observation: ObservationKind,
     /// How a robot acts.
@@ -269,6 +278,11 @@ impl EnvArgs {
             .reward
             .parse()
             .map_err(|e: String| ArgumentError::new("reward", format!("{:?}", self.reward), e))?;
+        if !(0.0..=1.0).contains(&self.gamma) {
+            return Err(
+                ArgumentError::new("gamma", self.gamma, "must be a discount in [0, 1]").into(),
+            );
+        }
         let observation = match self.observation.as_str() {
             "reading" => ObservationKind::Reading,
             "state" => {
@@ -406,6 +420,7 @@ impl EnvArgs {
             seed,
             max_steps,
             reward,
+            gamma: self.gamma,
             observation,
             action,
             actions,

@@ -5,6 +5,7 @@
 
 use crate::settings::EnvSettings;
 use shared::{ActionId, SensorReading};
+use sim::episodes::reward::{robot_credit, Transition};
 use sim::episodes::EpisodeEnd;
 use sim::scenario::sensor_setup::SelectedSensors;
 use sim::scenario::ScenarioError;
@@ -13,7 +14,8 @@ use sim::simulation::{Simulation, Totals};
 /// What one step of one world produced, besides its observation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WorldStep {
-    /// The global reward every robot receives.
+    /// The world's reward: every robot's, except with `per-robot`
+    /// ([`WorldEnv::robot_rewards`]).
     pub reward: f64,
     /// The episode ended in a formation.
     pub terminated: bool,
@@ -51,6 +53,10 @@ pub enum WorldActions<'a> {
 pub struct WorldEnv {
     sim: Simulation<SelectedSensors>,
     turns: Vec<f32>,
+    /// Each robot's reward of the last step.
+    robot_rewards: Vec<f64>,
+    /// The `per-robot` reward's scratch space.
+    touching: Vec<u32>,
     /// The reward signal (Eval or Eval') of the world before the next step.
     signal: f64,
     /// The last step ended the episode, and it has not been reset since.
@@ -68,6 +74,8 @@ impl WorldEnv {
         let mut world = WorldEnv {
             sim,
             turns,
+            robot_rewards: vec![0.0; settings.robots()],
+            touching: Vec::new(),
             signal: 0.0,
             ended: false,
             fresh: true,
@@ -100,6 +108,7 @@ impl WorldEnv {
     /// with reward 0.
     pub fn start_episode(&mut self, settings: &EnvSettings) -> WorldStep {
         self.sim.reset_episode();
+        self.robot_rewards.fill(0.0);
         self.ended = false;
         self.fresh = false;
         let eval = self.sim.eval();
@@ -134,9 +143,24 @@ impl WorldEnv {
         let report = self.sim.advance(&self.turns, true);
         let eval = report.eval.unwrap_or_else(|| self.sim.eval());
         let signal = self.measure_signal(settings, Some(eval));
-        let reward = settings.reward.reward(self.signal, signal);
-        self.signal = signal;
         let terminated = report.end == Some(EpisodeEnd::Formed);
+        let transition = Transition {
+            before: self.signal,
+            after: signal,
+            formed: terminated,
+        };
+        let reward = settings.reward.reward(transition, settings.gamma);
+        if settings.reward.per_robot() {
+            robot_credit(
+                self.sim.world(),
+                self.sim.puck_changes(),
+                &mut self.robot_rewards,
+                &mut self.touching,
+            );
+        } else {
+            self.robot_rewards.fill(reward);
+        }
+        self.signal = signal;
         let truncated = !terminated
             && (report.end == Some(EpisodeEnd::Stuck)
                 || settings.max_steps.is_some_and(|m| report.episode_step >= m));
@@ -156,6 +180,11 @@ impl WorldEnv {
         settings
             .reward
             .signal(self.sim.world(), self.sim.field(), self.sim.config(), eval)
+    }
+
+    /// Each robot's reward of the last step (0 after a reset).
+    pub fn robot_rewards(&self) -> &[f64] {
+        &self.robot_rewards
     }
 
     /// Whether the last step ended the episode and no reset followed.

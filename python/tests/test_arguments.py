@@ -106,6 +106,21 @@ def test_a_non_finite_continuous_action_is_named():
         env.step(np.array([0.1, np.nan]))
 
 
+@pytest.mark.parametrize(("settings", "robots", "pucks"), [
+    ({}, 8, 250),
+    ({"sensors": "disc"}, 8, 250),
+    ({"sensors": "disc-thesis"}, 8, 250),
+    ({"sensors": "robot"}, 5, 12),  # the settings table: the TV's counts, as tv75 is the robot's default arena
+    ({"sensors": "robot", "arena": "thesis"}, 8, 250),
+    ({"arena": "tv75"}, 5, 12),
+])
+def test_the_settings_tables_default_counts_hold_for_every_sensor_model(settings, robots, pucks):
+    env = zumo_swarm.parallel_env(**settings)
+    env.reset()
+    assert len(env.possible_agents) == robots
+    assert env.state().shape == (5 * robots + 3 * pucks,), "5 values a robot, 3 a puck"
+
+
 def test_the_tv_arena_is_the_robot_senses_default_and_brings_its_own_counts():
     robot = zumo_swarm.parallel_env(sensors="robot")
     assert len(robot.possible_agents) == 5

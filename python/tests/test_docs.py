@@ -20,3 +20,44 @@ def test_the_throughput_tables_are_rendered_from_the_measured_results(repo):
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
     for doc in ["python.md", "performance.md"]:
         assert table in (repo / "docs" / doc).read_text(), f"docs/{doc} does not hold the rendered table"
+
+
+def test_the_learning_table_is_rendered_from_the_measured_results(repo):
+    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
+    learning = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(learning)
+    table = learning.render(json.loads((repo / "docs" / "python-learning.json").read_text()))
+    assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered learning table"
+
+
+def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results(repo):
+    rows = json.loads((repo / "docs" / "python-learning.json").read_text())["rows"]
+    by = {(r["learner"].split(" (")[0], r["reward"]): r for r in rows}
+    still, random = by[("robots standing still", None)], by[("random actions", None)]
+    tabular = by[("tabular Q", "reference")]
+    assert tabular["trained_formations"] > 0 and tabular["exported_formations"] > 0 and tabular["formations"] > 0
+    assert tabular["final_eval"] > max(still["final_eval"], random["final_eval"])
+    assert by[("tabular Q", "thesis")]["formations"] == by[("tabular Q", "success-shaped")]["formations"] == 0
+    ppo = [r for (learner, _), r in by.items() if "PPO" in learner]
+    assert ppo and all(r["formations"] == r["trained_formations"] == 0 for r in ppo)
+    assert all(abs(r["final_eval"] - still["final_eval"]) < 0.01 and r["final_eval"] > random["final_eval"] for r in ppo)
+    shared = lambda reward: by[("shared-policy PPO", reward)]["final_eval"]
+    assert shared("success-shaped") > shared("reference") and shared("per-robot") > shared("reference")
+    assert random["final_eval"] < still["final_eval"]
+
+
+def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
+    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
+    learning = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(learning)
+    results = json.loads((repo / "docs" / "python-learning-1m.json").read_text())
+    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
+    still, random = by[("robots standing still", None)], by[("random actions", None)]
+    tabular = by[("tabular Q", "reference")]
+    assert tabular["exported_formations"] >= 0.9 * tabular["trained_formations"] > 0
+    ppo = [r for (learner, _), r in by.items() if "PPO" in learner]
+    assert ppo and all(r["formations"] == r["trained_formations"] == 0 for r in ppo)
+    sb3 = by[("SB3 PPO", "success-shaped")]
+    assert sb3["final_eval"] > still["final_eval"] > random["final_eval"]
+    assert all(abs(r["final_eval"] - still["final_eval"]) < 0.001 for (learner, _), r in by.items() if learner == "shared-policy PPO")

@@ -32,8 +32,12 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   50,000 on letters and images);
 - ``thresholds=None``: ``(outie, innie)`` field thresholds of the target
   shape (default 0.6, 0.8 on the annulus, 1, 1 on letters);
-- ``reward="reference"``: ``"reference"``, ``"thesis"``, ``"collision"`` or
-  ``"collision-spread"`` (docs/training.md);
+- ``reward="reference"``: ``"reference"``, ``"thesis"``, ``"collision"``,
+  ``"collision-spread"`` (docs/training.md), ``"per-robot"`` (each robot
+  the Eval change of the pucks it touched), ``"success"`` (1 when the
+  shape forms) or ``"success-shaped"`` (success plus potential-based
+  shaping on Eval, discounted by ``gamma=0.99``); docs/python.md says
+  which to use for what (:func:`reward_value` computes one step's);
 - ``observation="reading"``: ``"reading"`` (7 floats per robot: field
   left, mid, right, then puck left/right and obstacle left/right as 0/1)
   or ``"state"`` (the reading hashed by ``hasher``, a discrete state);
@@ -57,11 +61,11 @@ from typing import Any
 
 import gymnasium
 
-from zumo_swarm._native import DEFAULT_ANGULAR, DEFAULT_FORWARD_SPEED, HASHERS, READING_FIELDS, REWARDS
+from zumo_swarm._native import DEFAULT_ANGULAR, DEFAULT_FORWARD_SPEED, HASHERS, READING_FIELDS, REWARDS, reward_value
 from zumo_swarm.parallel import SwarmParallelEnv
 from zumo_swarm.policy import Policy, export_policy, load_policy
 from zumo_swarm.single import SwarmEnv
-from zumo_swarm.vector import SingleAgentVectorEnv, SwarmVectorEnv
+from zumo_swarm.vector import RecordRobotEpisodeStatistics, SingleAgentVectorEnv, SwarmVectorEnv
 
 __all__ = [
     "DEFAULT_ANGULAR",
@@ -70,6 +74,7 @@ __all__ = [
     "READING_FIELDS",
     "REWARDS",
     "Policy",
+    "RecordRobotEpisodeStatistics",
     "SingleAgentVectorEnv",
     "SwarmEnv",
     "SwarmParallelEnv",
@@ -78,6 +83,7 @@ __all__ = [
     "gym_env",
     "load_policy",
     "parallel_env",
+    "reward_value",
     "vector_env",
 ]
 

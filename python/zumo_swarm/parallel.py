@@ -80,8 +80,9 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         if any(a.size != 1 for a in ordered):
             raise ValueError("actions: each agent's action must be one number (an action index or an angular speed)")
         stacked = np.concatenate(ordered).reshape(1, len(self.possible_agents))
-        obs, rewards, terminated, truncated, info = self._batch.step(flat_actions(self._batch, stacked, stacked.shape))
-        reward = float(rewards[0])
+        obs, _, terminated, truncated, info, robot_rewards = self._batch.step(
+            flat_actions(self._batch, stacked, stacked.shape)
+        )
         term, trunc = bool(terminated[0]), bool(truncated[0])
         scalars = world_info(info, 0)
         agents = self.agents
@@ -89,7 +90,7 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
             self.agents = []
         return (
             self._observations(obs[0]),
-            {agent: reward for agent in agents},
+            {agent: float(r) for agent, r in zip(agents, robot_rewards[0])},
             {agent: term for agent in agents},
             {agent: trunc for agent in agents},
             {agent: dict(scalars) for agent in agents},

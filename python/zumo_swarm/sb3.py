@@ -28,13 +28,15 @@ from zumo_swarm.vector import SwarmVectorEnv
 
 class SB3VecEnv(VecEnv):
     """``num_worlds`` worlds as an SB3 ``VecEnv``; keyword arguments as
-    :func:`zumo_swarm.vector_env`'s (``autoreset_mode`` is the adapter's)."""
+    :func:`zumo_swarm.vector_env`'s (``autoreset_mode`` is the adapter's).
+    ``formations``: the shapes every world formed since it was built."""
 
     def __init__(self, num_worlds: int, **settings: Any) -> None:
         self.venv = SwarmVectorEnv(num_worlds, autoreset_mode="same-step", **settings)
         self.render_mode = self.venv.render_mode
         super().__init__(num_worlds, self.venv.single_observation_space, self.venv.single_action_space)
         self._actions: np.ndarray | None = None
+        self.formations = 0
 
     def reset(self) -> np.ndarray:
         seeds = None if all(s is None for s in self._seeds) else [0 if s is None else s for s in self._seeds]
@@ -46,15 +48,16 @@ class SB3VecEnv(VecEnv):
         self._actions = np.asarray(actions)
 
     def step_wait(self):
-        obs, rewards, terminated, truncated, info = self.venv.step(self._actions)
+        obs, _, terminated, truncated, info = self.venv.step(self._actions)
         dones = terminated | truncated
+        self.formations = int(info["formations"].sum())
         infos: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
         for i in np.flatnonzero(dones):
             infos[i]["terminal_observation"] = info["final_obs"][i]
             infos[i]["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
         for i, world in enumerate(infos):
             world["eval"] = float(info["eval"][i])
-        return obs, rewards[:, 0].astype(np.float32), dones, infos
+        return obs, info["world_reward"].astype(np.float32), dones, infos
 
     def close(self) -> None:
         self.venv.close()

@@ -52,6 +52,6 @@ class SwarmEnv(OneWorld, gym.Env):
 
     def step(self, action):
         flat = flat_actions(self._batch, action, self.action_space.shape)
-        obs, rewards, terminated, truncated, info = self._batch.step(flat)
+        obs, rewards, terminated, truncated, info, _ = self._batch.step(flat)
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), world_info(info, 0)
 

@@ -8,6 +8,7 @@ from typing import Any, Sequence
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from gymnasium.vector.utils import batch_space
+from gymnasium.wrappers.vector import RecordEpisodeStatistics
 
 from zumo_swarm._settings import (
     check_render,
@@ -29,8 +30,11 @@ class SwarmVectorEnv(VectorEnv):
       indices, or angular speeds with ``action="continuous"``); returns
       observations ``(worlds, robots, 7)`` float32 (or ``(worlds, robots)``
       hashed states), rewards ``(worlds, robots)`` float64 (every robot of
-      a world the same global reward), terminations and truncations
-      ``(worlds,)``, and ``infos``, a dict of ``(worlds,)`` arrays (``eval``,
+      a world the same global reward, except with ``reward="per-robot"``),
+      terminations and truncations
+      ``(worlds,)``, and ``infos``, a dict of ``(worlds,)`` arrays
+      (``world_reward``: the world's reward, which the single-agent view
+      returns; ``eval``,
       ``episode_step``, ``robot_contacts``, ``formations``,
       ``stuck_episodes``, ``total_steps``, ``mean_eval``,
       ``collisions_per_1000``, ``reset``), each with its ``_key`` mask.
@@ -48,7 +52,10 @@ class SwarmVectorEnv(VectorEnv):
       episode. Before any reset, world ``i`` holds seed ``seed + i``.
 
     :meth:`single_agent_view` gives the Gymnasium-convention view: one
-    environment per world, rewards of shape ``(worlds,)``.
+    environment per world, rewards of shape ``(worlds,)``. Gymnasium's
+    reward wrappers expect that shape: on this per-robot env use
+    :class:`RecordRobotEpisodeStatistics` instead of
+    ``RecordEpisodeStatistics``.
     Keyword arguments: see :func:`zumo_swarm.vector_env`.
     """
 
@@ -101,10 +108,11 @@ class SwarmVectorEnv(VectorEnv):
 
     def step(self, actions):
         flat = flat_actions(self._batch, actions, self._action_shape)
-        obs, rewards, terminated, truncated, info = self._batch.step(flat)
+        obs, world_rewards, terminated, truncated, info, robot_rewards = self._batch.step(flat)
+        info["world_reward"] = world_rewards
         for key in [k for k in info if not k.startswith("_") and k != "final_obs"]:
             info["_" + key] = self._every_world
-        return obs, np.repeat(rewards[:, None], self._batch.robots, axis=1), terminated, truncated, info
+        return obs, robot_rewards, terminated, truncated, info
 
     def render(self):
         """Every world as ``host render`` draws it (``render_mode="rgb_array"``)."""
@@ -121,11 +129,57 @@ class SingleAgentVectorEnv(VectorWrapper):
     """A :class:`SwarmVectorEnv` as one Gymnasium environment per world:
     observations and actions stack every robot's (``single_observation_space``
     and ``single_action_space`` are :class:`zumo_swarm.single.SwarmEnv`'s),
-    the reward is the world's global reward, shape ``(worlds,)``."""
+    the reward is the world's reward (``infos["world_reward"]``), shape
+    ``(worlds,)``."""
+
+    def step(self, actions):
+        obs, _, terminated, truncated, info = self.env.step(actions)
+        return obs, info["world_reward"].copy(), terminated, truncated, info
+
+
+class _WorldReward(VectorWrapper):
+    """Rewards of shape ``(worlds,)``, each world's mean over its robots;
+    the robots' own in ``infos["robot_rewards"]``."""
 
     def step(self, actions):
         obs, rewards, terminated, truncated, info = self.env.step(actions)
-        return obs, rewards[:, 0].copy(), terminated, truncated, info
+        info["robot_rewards"] = rewards
+        return obs, rewards.mean(axis=1), terminated, truncated, info
+
+
+class RecordRobotEpisodeStatistics(VectorWrapper):
+    """Gymnasium's ``RecordEpisodeStatistics`` for the per-robot
+    :class:`SwarmVectorEnv`: the wrapped env's steps are unchanged (rewards
+    ``(worlds, robots)``), and a world's ended episode is reported as
+    Gymnasium reports it, in ``infos["episode"]`` (``r``: the return, per
+    world the mean over its robots of their returns, which is the global
+    return when every robot gets the same reward; ``l``: the length;
+    ``t``: the time) masked by ``infos["_episode"]``, with
+    ``return_queue``, ``length_queue`` and ``episode_count``. Gymnasium's
+    own wrapper does the bookkeeping, for both autoreset modes."""
+
+    def __init__(self, env: SwarmVectorEnv, buffer_length: int = 100, stats_key: str = "episode") -> None:
+        super().__init__(env)
+        self.statistics = RecordEpisodeStatistics(_WorldReward(env), buffer_length=buffer_length, stats_key=stats_key)
+
+    @property
+    def return_queue(self):
+        return self.statistics.return_queue
+
+    @property
+    def length_queue(self):
+        return self.statistics.length_queue
+
+    @property
+    def episode_count(self) -> int:
+        return self.statistics.episode_count
+
+    def reset(self, *, seed=None, options=None):
+        return self.statistics.reset(seed=seed, options=options)
+
+    def step(self, actions):
+        obs, _, terminated, truncated, info = self.statistics.step(actions)
+        return obs, info.pop("robot_rewards"), terminated, truncated, info
 
 
 def make_single_agent_vector_env(

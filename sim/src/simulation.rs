@@ -27,7 +27,7 @@ use crate::base::rng::SimRng;
 use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, SuccessSignal};
 use crate::control::{Controller, Perception};
-use crate::episodes::eval::{eval, eval_prime, EvalPrime, EvalTracker};
+use crate::episodes::eval::{eval, eval_prime, EvalPrime, EvalTracker, PuckChange};
 use crate::episodes::{EpisodeEnd, EpisodeStart, StepOutcome};
 use crate::fields::ScalarField;
 use crate::sensors::disc::DiscSensors;
@@ -234,6 +234,13 @@ impl<S: SensorModel> Simulation<S> {
         &self.state.readings
     }
 
+    /// The pucks whose distance to the band changed in the last step that
+    /// measured Eval, each with its change of Eval (none right after a
+    /// reset): what the `per-robot` reward credits the robots with.
+    pub fn puck_changes(&self) -> &[PuckChange] {
+        self.evaluation.changes()
+    }
+
     /// Eval of the current world.
     pub fn eval(&self) -> f64 {
         eval(
@@ -275,6 +282,7 @@ impl<S: SensorModel> Simulation<S> {
             field: &self.field,
             config: &s.config,
             readings: &s.readings,
+            puck_changes: self.evaluation.changes(),
         });
         if report.end.is_some() {
             self.reset_episode();

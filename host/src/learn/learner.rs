@@ -4,8 +4,9 @@ use super::qtable::{QParams, QTable};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
-use sim::episodes::reward::Reward;
-use sim::{base::rng::SimRng, episodes::EpisodeStart, episodes::StepOutcome};
+use sim::base::rng::SimRng;
+use sim::episodes::reward::{robot_credit, Reward, Transition};
+use sim::episodes::{EpisodeEnd, EpisodeStart, StepOutcome};
 use sim::{control::Controller, control::Perception};
 
 /// What the learner is and how it learns.
@@ -31,8 +32,10 @@ pub struct LearnConfig {
     /// Initial Q-value of every (state, action) [default: 1].
     #[arg(long, required = false)]
     pub initial_q: f64,
-    /// Reward: reference, thesis, collision, collision-spread [default:
-    /// reference].
+    /// Reward: reference, thesis, collision, collision-spread, per-robot
+    /// (each robot the Eval change of the pucks it touched), success (1 when
+    /// the shape forms), success-shaped (success plus potential-based
+    /// shaping on Eval with --gamma) [default: reference].
     #[arg(long, required = false)]
     pub reward: Reward,
 }
@@ -207,6 +210,12 @@ pub struct QLearner {
     /// Batched updates' TD errors of the step in flight.
     #[serde(skip)]
     errors: Vec<f64>,
+    /// Each robot's reward of the step in flight, and the `per-robot`
+    /// reward's scratch space: derived every step.
+    #[serde(skip)]
+    rewards: Vec<f64>,
+    #[serde(skip)]
+    touching: Vec<u32>,
     /// The exploration probability of a decaying schedule, set by the
     /// trainer from the run's step count ([`QLearner::set_exploration`]);
     /// `None` for the config's `epsilon`. Derived, so not part of a
@@ -227,6 +236,8 @@ impl QLearner {
             last_signal: 0.0,
             rules: LearnerRules::default(),
             errors: Vec::new(),
+            rewards: Vec::new(),
+            touching: Vec::new(),
             exploration: None,
         })
     }
@@ -322,7 +333,24 @@ impl Controller for QLearner {
             self.config
                 .reward
                 .signal(outcome.world, outcome.field, outcome.config, outcome.eval);
-        let reward = self.config.reward.reward(self.last_signal, signal);
+        let reward = self.config.reward;
+        let step = Transition {
+            before: self.last_signal,
+            after: signal,
+            formed: outcome.end == Some(EpisodeEnd::Formed),
+        };
+        self.rewards.clear();
+        self.rewards.resize(outcome.readings.len(), 0.0);
+        if reward.per_robot() {
+            robot_credit(
+                outcome.world,
+                outcome.puck_changes,
+                &mut self.rewards,
+                &mut self.touching,
+            );
+        } else {
+            self.rewards.fill(reward.reward(step, self.config.gamma));
+        }
         let hasher = self.q.hasher();
         let params = self.config.params();
         let robots = outcome.world.robots();
@@ -333,14 +361,14 @@ impl Controller for QLearner {
             .map(|(reading, robot)| hasher.hash_as(reading, robot.kind.role()));
         match self.rules.updates {
             Updates::Sequential => {
-                for (&(s, a), s2) in self.chosen.iter().zip(next) {
-                    self.q.update(s, a, reward, s2, params);
+                for ((&(s, a), s2), &r) in self.chosen.iter().zip(next).zip(&self.rewards) {
+                    self.q.update(s, a, r, s2, params);
                 }
             }
             Updates::Batched => {
                 self.errors.clear();
-                for (&(s, a), s2) in self.chosen.iter().zip(next) {
-                    self.errors.push(self.q.td_error(s, a, reward, s2, params));
+                for ((&(s, a), s2), &r) in self.chosen.iter().zip(next).zip(&self.rewards) {
+                    self.errors.push(self.q.td_error(s, a, r, s2, params));
                 }
                 for (&(s, a), &error) in self.chosen.iter().zip(&self.errors) {
                     self.q.apply(s, a, error, params);
@@ -406,6 +434,7 @@ mod tests {
             field: &field,
             config: &config,
             readings: &readings,
+            puck_changes: &[],
         });
         (turns, learner, s)
     }

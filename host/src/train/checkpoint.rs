@@ -6,16 +6,17 @@
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1 to 5), u16                         |
+//! | 8      | 2    | format version (1 to 6), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
-//! Format 5's body is the [`TrainingState`]; formats 1 to 4 are the
+//! Formats 5 and 6 have the [`TrainingState`] as body (6 for the rewards
+//! added since, which earlier builds cannot decode); formats 1 to 4 are the
 //! state without the settings added since ([`super::format1`],
 //! [`super::format2`], [`super::format3`], [`super::format4`]). A state is
 //! written in the oldest format that holds it, byte for byte what earlier
-//! builds wrote; all five are read.
+//! builds wrote; all six are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
@@ -44,8 +45,10 @@ pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// senses' memory. 4: the arena's border (`walls`) and the learner's
 /// rules (`rules`). 5: the robots' outline (`robot_shape`: a wedge) and
 /// decaying exploration (`epsilon_decay`); disc states of constant
-/// exploration keep format 4 or older.
-pub const VERSION: u16 = 5;
+/// exploration keep format 4 or older. 6: the rewards `per-robot`,
+/// `success` and `success-shaped` (the same layout as 5, with reward
+/// variants format 5's readers do not know).
+pub const VERSION: u16 = 6;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
@@ -121,7 +124,10 @@ impl std::error::Error for CheckpointError {}
 
 /// Encodes a training state into `w`.
 pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
-    let (version, body) = if let Some(v1) = StateV1::of(state) {
+    // Format 6 added the rewards beyond the thesis' four.
+    let (version, body) = if !state.config.learn.reward.from_thesis() {
+        (VERSION, postcard::to_stdvec(state))
+    } else if let Some(v1) = StateV1::of(state) {
         (1u16, postcard::to_stdvec(&v1))
     } else if let Some(v2) = StateV2::of(state) {
         (2, postcard::to_stdvec(&v2))
@@ -130,7 +136,7 @@ pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()>
     } else if let Some(v4) = StateV4::of(state) {
         (4, postcard::to_stdvec(&v4))
     } else {
-        (VERSION, postcard::to_stdvec(state))
+        (5, postcard::to_stdvec(state))
     };
     let body = body.map_err(std::io::Error::other)?;
     let mut head = Vec::with_capacity(HEADER_LEN);

@@ -89,11 +89,27 @@ impl Distances {
 
 /// Eval from the sum of the pucks' fixed-point distances.
 fn eval_of(total: u64, pucks: usize, t: &Thresholds) -> f64 {
+    1.0 - eval_loss(total as f64, pucks, t)
+}
+
+/// What a fixed-point distance (summed, or one puck's change) takes off
+/// Eval.
+fn eval_loss(distance: f64, pucks: usize, t: &Thresholds) -> f64 {
     let scale = t.outie.max(1.0 - t.innie);
     if pucks == 0 || scale <= 0.0 {
-        return 1.0;
+        return 0.0;
     }
-    1.0 - total as f64 / DISTANCE_ONE / pucks as f64 / scale
+    distance / DISTANCE_ONE / pucks as f64 / scale
+}
+
+/// One puck whose band distance changed in the last Eval update, and by
+/// how much that changed Eval (the changes of one update sum to Eval's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PuckChange {
+    /// The puck's body index.
+    pub body: u32,
+    /// Its change of Eval: positive when it moved towards the band.
+    pub eval_change: f64,
 }
 
 /// Eval of the pucks' positions, 1 when every puck is in the band.
@@ -119,6 +135,8 @@ pub(crate) struct EvalTracker {
     distances: Vec<u64>,
     total: u64,
     lookup: Distances,
+    /// The pucks whose distance the last update changed.
+    changes: Vec<PuckChange>,
 }
 
 impl EvalTracker {
@@ -129,6 +147,7 @@ impl EvalTracker {
             distances: vec![0; world.bodies().len()],
             total: 0,
             lookup,
+            changes: Vec::new(),
         };
         tracker.rebuild(world, field, t);
         tracker
@@ -137,6 +156,7 @@ impl EvalTracker {
     /// Looks every puck up again (after a reset), without allocating.
     pub fn rebuild(&mut self, world: &World, field: &ScalarField, t: &Thresholds) {
         self.distances.fill(0);
+        self.changes.clear();
         let layout = world.config().field_layout();
         for i in world.puck_range() {
             self.distances[i] = self.lookup.at(world.bodies()[i].pos, &layout, field, t);
@@ -148,14 +168,30 @@ impl EvalTracker {
     /// last update (the world's moved set, which this empties).
     pub fn update(&mut self, world: &mut World, field: &ScalarField, t: &Thresholds) {
         let (first_puck, layout) = (world.puck_range().start, world.config().field_layout());
+        let pucks = world.pucks().len();
         let (lookup, distances, total) = (&self.lookup, &mut self.distances, &mut self.total);
+        let changes = &mut self.changes;
+        changes.clear();
         world.drain_moved(|i, body| {
             if i >= first_puck {
                 let d = lookup.at(body.pos, &layout, field, t);
+                if d != distances[i] {
+                    let gain = distances[i] as f64 - d as f64;
+                    changes.push(PuckChange {
+                        body: i as u32,
+                        eval_change: eval_loss(gain, pucks, t),
+                    });
+                }
                 *total = *total - distances[i] + d;
                 distances[i] = d;
             }
         });
+    }
+
+    /// The pucks whose distance to the band the last update changed, in
+    /// body order (none after a rebuild).
+    pub fn changes(&self) -> &[PuckChange] {
+        &self.changes
     }
 
     /// Eval of the world as of the last update.

@@ -45,6 +45,10 @@ pub struct StepOutcome<'a> {
     /// Every robot's reading sensed after the step (before any reset): the
     /// states the robots reached.
     pub readings: &'a [SensorReading],
+    /// With Eval measured this step: the pucks whose distance to the band
+    /// changed, each with its change of Eval (the `per-robot` reward's
+    /// credit).
+    pub puck_changes: &'a [eval::PuckChange],
 }
 
 /// The fresh world of an episode, shown to the controller before its first

@@ -1,0 +1,176 @@
+"""Learning figures of the examples and the rewards (docs/python.md,
+"Examples that learn"): each learner trains for the same budget of
+world-steps on the standard annulus (8 robots, 250 pucks, disc sensors),
+its policy is exported as a policy blob, and the blob's greedy table is
+run on 10 evaluation seeds; random actions and robots standing still
+(forward speed 0) are run on the same seeds. Writes the runs as JSON;
+`--render` turns such a file into the table of docs/python.md.
+
+    scripts/test-python                                    # the wheel in target/python-venv
+    python3 -m venv /tmp/ml && /tmp/ml/bin/pip install stable-baselines3 target/wheels/zumo_swarm-*.whl
+    /tmp/ml/bin/python python/benchmarks/learning.py --host target/release/host --out docs/python-learning.json
+    python3 python/benchmarks/learning.py --render docs/python-learning.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+EVAL_SEEDS = list(range(1001, 1011))
+
+
+def evaluate(act, steps: int, **settings) -> dict:
+    """``act(states)`` (worlds x robots hashed states to action indices)
+    run for ``steps`` steps on each evaluation seed at once: formations in
+    all, the mean over seeds of the last Eval and of the mean Eval at the
+    formation checks."""
+    import numpy as np
+
+    import zumo_swarm
+
+    env = zumo_swarm.vector_env(len(EVAL_SEEDS), observation="state", **settings)
+    obs, _ = env.reset(seed=EVAL_SEEDS)
+    for _ in range(steps):
+        obs, _, _, _, info = env.step(act(obs))
+    return {
+        "formations": int(info["formations"].sum()),
+        "final_eval": float(info["eval"].mean()),
+        "mean_eval": float(info["mean_eval"].mean()),
+    }
+
+
+def host_formations(host: str, policy: Path, steps: int, seed: int) -> int:
+    """Formations of ``host run`` with the exported blob, as a robot would run it."""
+    out = subprocess.run(
+        [host, "run", "--controller", f"policy:{policy}", "--steps", str(steps), "--seed", str(seed), "--json"],
+        capture_output=True, text=True, check=True,
+    )
+    return json.loads(out.stdout)["formations"]
+
+
+def timed(f):
+    start, cpu = time.perf_counter(), time.process_time()
+    result = f()
+    return result, {"seconds": round(time.perf_counter() - start, 1), "cpu_seconds": round(time.process_time() - cpu, 1)}
+
+
+def run(args) -> dict:
+    import numpy as np
+
+    import zumo_swarm
+
+    sys.path.insert(0, str(HERE.parent / "examples"))
+    rng = np.random.default_rng(0)
+    random_act = lambda obs: rng.integers(0, 4, obs.shape)
+    rows = []
+    load = [os.getloadavg()[0]]
+    e = args.eval_steps
+
+    def baseline(name, **settings):
+        result, cost = timed(lambda: evaluate(random_act, e, **settings))
+        rows.append({"learner": name, "reward": None, "steps": 0, "trained_formations": None, "exported_formations": None, **result, **cost})
+        print(rows[-1], flush=True)
+
+    def learned(name, reward, train_and_table, extra=None):
+        (table, trained, env), cost = timed(train_and_table)
+        with tempfile.TemporaryDirectory() as d:
+            path = zumo_swarm.export_policy(Path(d) / "p.policy", table, env=env, trainer_steps=args.steps, seed=1)
+            policy = zumo_swarm.load_policy(path)
+            exported = host_formations(args.host, path, args.steps, 1) if args.host else None
+        result = evaluate(policy.act, e)
+        rows.append({"learner": name, "reward": reward, "steps": args.steps, "trained_formations": trained,
+                     "exported_formations": exported, **result, **cost, **(extra or {})})
+        print(rows[-1], flush=True)
+        load.append(os.getloadavg()[0])
+
+    baseline("robots standing still", forward_speed=0.0)
+    baseline("random actions")
+    import tabular_q
+
+    for reward in args.tabular_rewards:
+        def tabular(reward=reward):
+            q, formations, env = tabular_q.train(steps=args.steps, seed=1, reward=reward)
+            return q, int(formations), env
+        learned("tabular Q (tabular_q.py)", reward, tabular)
+    if args.neural:
+        import marl_ppo
+
+        for reward in args.marl_rewards:
+            def marl(reward=reward):
+                a = marl_ppo.parse(["--steps", str(args.steps), "--reward", reward, "--seed", "1"])
+                agent, env, log = marl_ppo.train(a)
+                return agent.table(), log["formations"], env
+            learned("shared-policy PPO (marl_ppo.py)", reward, marl)
+        import ppo_sb3
+
+        for reward in args.sb3_rewards:
+            def sb3(reward=reward):
+                model, env = ppo_sb3.train(steps=args.steps, seed=1, reward=reward)
+                formations = env.venv.formations  # counted before distil steps the worlds on
+                return ppo_sb3.distil(model, env), formations, env.venv.venv
+            learned("SB3 PPO (ppo_sb3.py)", reward, sb3)
+    return {
+        "date": datetime.date.today().isoformat(),
+        "machine": f"{platform.machine()}, {os.cpu_count()} cores",
+        "load_average": [round(x, 1) for x in load],
+        "budget_steps": args.steps,
+        "eval_seeds": EVAL_SEEDS,
+        "eval_steps": e,
+        "rows": rows,
+    }
+
+
+def render(results: dict) -> str:
+    """The markdown table of docs/python.md."""
+    head = (
+        f"Measured {results['date']} on {results['machine']} (1-minute load average {', '.join(map(str, results['load_average']))}), "
+        f"{results['budget_steps']:,} world-steps of training each, seed 1; every policy then run greedily for "
+        f"{results['eval_steps']:,} steps on each of {len(results['eval_seeds'])} evaluation seeds "
+        f"({results['eval_seeds'][0]} to {results['eval_seeds'][-1]}).\n\n"
+        "| learner | reward | formed while training | exported blob, `host run` same steps | formed on the evaluation seeds | final Eval (mean of seeds) | mean Eval at checks | training time (s) |\n"
+        "|---|---|---|---|---|---|---|---|\n"
+    )
+    show = lambda v: "" if v is None else str(v)
+    lines = [
+        f"| {r['learner']} | {show(r['reward'])} | {show(r['trained_formations'])} | {show(r['exported_formations'])} | "
+        f"{r['formations']} | {r['final_eval']:.4f} | {r['mean_eval']:.4f} | {r['seconds'] if r['steps'] else ''} |"
+        for r in results["rows"]
+    ]
+    return head + "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--render", metavar="JSON")
+    p.add_argument("--steps", type=int, default=200_000, help="training budget, world-steps")
+    p.add_argument("--eval-steps", type=int, default=20_000)
+    p.add_argument("--host", help="the host binary, to run each exported blob as a robot would")
+    p.add_argument("--tabular-rewards", nargs="*", default=["reference", "thesis", "success-shaped"])
+    p.add_argument("--marl-rewards", nargs="*", default=["reference", "per-robot", "success-shaped"])
+    p.add_argument("--sb3-rewards", nargs="*", default=["success-shaped"])
+    p.add_argument("--no-neural", dest="neural", action="store_false")
+    p.add_argument("--out", default="docs/python-learning.json")
+    args = p.parse_args()
+    if args.render:
+        print(render(json.loads(Path(args.render).read_text())), end="")
+        return
+    results = run(args)
+    out = Path(args.out)
+    tmp = out.with_suffix(".tmp")
+    tmp.write_text(json.dumps(results, indent=1) + "\n")
+    os.replace(tmp, out)
+    print(render(results), end="")
+
+
+if __name__ == "__main__":
+    main()
