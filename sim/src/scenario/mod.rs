@@ -233,12 +233,12 @@ impl Scenario {
     /// simulation and controller. Errors name the offending input.
     pub fn build(
         &self,
-    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
+    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller + Send>), ScenarioError> {
         if let ControllerChoice::Policy(path) = &self.controller {
             return self.build_with_policy(policy_file::read(path)?);
         }
         let prepared = self.prepare()?;
-        let controller: Box<dyn Controller> = match &self.controller {
+        let controller: Box<dyn Controller + Send> = match &self.controller {
             ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
             _ => Box::new(OrbitalConstruction::new(
                 OrbitalConfig::default(),
@@ -255,7 +255,7 @@ impl Scenario {
     pub fn build_with_policy(
         &self,
         blob: shared::PolicyBlob,
-    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
+    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller + Send>), ScenarioError> {
         let mut prepared = self.prepare()?;
         drive_with(prepared.config_mut(), &blob, &self.field);
         let sim = prepared.simulation(self.seed)?;
