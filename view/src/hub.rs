@@ -17,11 +17,13 @@ pub struct Hub {
 }
 
 impl Hub {
-    /// A new viewer, `first` waiting in its queue.
-    pub fn subscribe(&self, first: Utf8Bytes) -> Receiver<Utf8Bytes> {
+    /// A new viewer, `first` (at most [`QUEUE`] messages) waiting in its queue.
+    pub fn subscribe(&self, first: &[Utf8Bytes]) -> Receiver<Utf8Bytes> {
         let (tx, rx) = sync_channel(QUEUE);
-        // a fresh queue has room
-        let _ = tx.try_send(first);
+        for message in first.iter().take(QUEUE) {
+            // a fresh queue has room for these
+            let _ = tx.try_send(message.clone());
+        }
         self.lock().push(tx);
         rx
     }
@@ -58,8 +60,8 @@ mod tests {
     #[test]
     fn a_viewer_that_stops_reading_is_dropped_once_its_queue_is_full() {
         let hub = Hub::default();
-        let reader = hub.subscribe("hello".into());
-        let idle = hub.subscribe("hello".into());
+        let reader = hub.subscribe(&["hello".into()]);
+        let idle = hub.subscribe(&["hello".into()]);
         let mut dropped = 0;
         for k in 0..3 * QUEUE {
             dropped += hub.publish(&format!("frame {k}").into());

@@ -649,15 +649,13 @@ impl Shared {
         if http::accept_websocket(&mut stream, request).is_err() {
             return;
         }
-        let (first, latest) = {
+        let queue = {
+            // under the lock, so no frame is published between these and the queue
             let c = self.lock();
-            (c.hello.clone(), self.frame_message(&c))
+            self.hub
+                .subscribe(&[c.hello.clone(), self.frame_message(&c)])
         };
-        let queue = self.hub.subscribe(first);
         let mut socket = WebSocket::from_raw_socket(stream, Role::Server, None);
-        if socket.send(Message::Text(latest)).is_err() {
-            return;
-        }
         loop {
             let message = match queue.recv_timeout(Duration::from_secs(5)) {
                 Ok(text) => Message::Text(text),
