@@ -52,12 +52,17 @@ fn request(address: &str, method: &str, path: &str) -> (u16, String) {
     let mut reply = String::new();
     stream.read_to_string(&mut reply).unwrap();
     let (head, body) = reply.split_once("\r\n\r\n").unwrap();
-    (head.split(' ').nth(1).unwrap().parse().unwrap(), body.to_string())
+    (
+        head.split(' ').nth(1).unwrap().parse().unwrap(),
+        body.to_string(),
+    )
 }
 
 #[test]
 fn the_views_state_at_step_n_is_what_host_run_reports_after_n_steps() {
-    let world = ["--robots", "5", "--pucks", "60", "--seed", "3", "--field", "letter:L"];
+    let world = [
+        "--robots", "5", "--pucks", "60", "--seed", "3", "--field", "letter:L",
+    ];
     let served = serve(&world);
     let steps = 3000;
     let (status, body) = request(
@@ -83,8 +88,18 @@ fn the_views_state_at_step_n_is_what_host_run_reports_after_n_steps() {
         .unwrap();
     assert!(out.status.success());
     let run: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    for key in ["steps", "formations", "stuck", "mean_eval", "collisions_per_1000"] {
-        let ours = if key == "steps" { &frame["step"] } else { &frame[key] };
+    for key in [
+        "steps",
+        "formations",
+        "stuck",
+        "mean_eval",
+        "collisions_per_1000",
+    ] {
+        let ours = if key == "steps" {
+            &frame["step"]
+        } else {
+            &frame[key]
+        };
         assert_eq!(ours, &run[key], "{key}");
     }
     assert!(run["mean_eval"].as_f64().unwrap() > 0.0);

@@ -50,7 +50,11 @@ fn measure(settings: &ViewSettings, speed: Speed) -> (f64, f64) {
     page.wait_for("Number(document.documentElement.dataset.painted) > 20", 60);
     let sample = |page: &mut browser::Browser| {
         let v = page.eval("[Number(document.documentElement.dataset.painted), performance.now(), Number(document.documentElement.dataset.step)]");
-        (v[0].as_f64().unwrap_or(0.0), v[1].as_f64().unwrap_or(0.0), v[2].as_f64().unwrap_or(0.0))
+        (
+            v[0].as_f64().unwrap_or(0.0),
+            v[1].as_f64().unwrap_or(0.0),
+            v[2].as_f64().unwrap_or(0.0),
+        )
     };
     let (p0, t0, s0) = sample(&mut page);
     std::thread::sleep(Duration::from_secs(SECONDS));
@@ -99,7 +103,9 @@ fn run(out: &str) {
     });
     let text = serde_json::to_string_pretty(&results).expect("JSON") + "\n";
     let tmp = format!("{out}.tmp");
-    std::fs::write(&tmp, text).and_then(|()| std::fs::rename(&tmp, out)).unwrap_or_else(|e| panic!("cannot write {out}: {e}"));
+    std::fs::write(&tmp, text)
+        .and_then(|()| std::fs::rename(&tmp, out))
+        .unwrap_or_else(|e| panic!("cannot write {out}: {e}"));
     print!("{}", paint::render(&results));
 }
 
@@ -107,8 +113,10 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     match args.get(1..).unwrap_or_default() {
         [flag, file] if flag == "--render" => {
-            let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("cannot read {file}: {e}"));
-            let results: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| panic!("{file}: {e}"));
+            let text =
+                std::fs::read_to_string(file).unwrap_or_else(|e| panic!("cannot read {file}: {e}"));
+            let results: serde_json::Value =
+                serde_json::from_str(&text).unwrap_or_else(|e| panic!("{file}: {e}"));
             print!("{}", paint::render(&results));
         }
         [flag, file] if flag == "--out" => run(file),
