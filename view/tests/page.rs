@@ -33,6 +33,13 @@ fn the_page_loads_and_draws_non_blank_frames_of_robots_and_pucks() {
     assert!(pucks > 100, "{pucks} puck pixels");
     let painted: u64 = page.data("step").parse().unwrap();
     assert!(painted > 0);
+    // shown undistorted: its box on the page has the arena's shape
+    let shape = page.eval("(() => { const c = document.getElementById('world'); const r = c.getBoundingClientRect(); return [r.width / r.height, c.width / c.height]; })()");
+    let (shown, drawn) = (shape[0].as_f64().unwrap(), shape[1].as_f64().unwrap());
+    assert!(
+        (shown - drawn).abs() < 0.01 && (drawn - 1.0).abs() < 0.01,
+        "{shape}"
+    );
 }
 
 #[test]
@@ -78,7 +85,9 @@ fn reset_with_a_seed_reproduces_the_same_frames() {
         let (status, body) = request(address, "POST", "/control?action=step&steps=40", b"");
         assert_eq!(status, 200, "{body}");
         wait_for_step(address, 40);
-        page.wait_for("document.documentElement.dataset.step === '40'", 30);
+        page.wait_for("document.documentElement.dataset.step === '40' && document.documentElement.dataset.field === document.documentElement.dataset.generation", 30);
+        // painted after the field image came
+        std::thread::sleep(std::time::Duration::from_millis(200));
         page.eval("document.getElementById('world').toDataURL()")
             .as_str()
             .unwrap()
