@@ -9,6 +9,7 @@ use cli::learn::{ExperimentAction, ExperimentArgs, SearchArgs, TrainArgs};
 use cli::robot::{FlashArgs, MonitorArgs, ReplayArgs};
 use cli::screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
 use cli::simulate::{BenchArgs, RenderArgs, RunArgs};
+use cli::view::ViewArgs;
 use cli::{Cli, Command, FieldCommand, PolicyCommand};
 use host::run_summary::run_timed;
 use sim::base::ranges;
@@ -60,6 +61,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Field(FieldCommand::Export(args)) => export_field(args),
         Command::Display(args) => display(args),
         Command::Observe(args) => observe(args),
+        Command::View(args) => view(args),
     }
 }
 
@@ -271,6 +273,22 @@ fn display(args: DisplayArgs) -> Result<()> {
         .flush()
         .context("cannot write to stdout")?;
     display.serve();
+    Ok(())
+}
+
+fn view(args: ViewArgs) -> Result<()> {
+    warn_policy_mismatch(&args.scenario)?;
+    let view = view::View::start(args.options()?).map_err(anyhow::Error::msg)?;
+    let url = view.url();
+    // The first line names the address (scripts and tests read it).
+    println!("view: serving {url}");
+    println!(
+        "  keys: space play/pause, s step, 1 2 3 speed, r reset, n next seed, h help; Ctrl-C stops"
+    );
+    std::io::stdout()
+        .flush()
+        .context("cannot write to stdout")?;
+    view.serve();
     Ok(())
 }
 

@@ -52,16 +52,8 @@ impl Default for RenderOptions {
 /// Draws the simulation's current world.
 pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbImage {
     let world = sim.world();
-    let mut img = draw_field(world, sim.field(), options.size);
+    let mut img = draw_ground(sim, options);
     let scale = scale_of(world, options.size);
-    if options.band {
-        let layout = world.config().field_layout();
-        let thresholds = &sim.config().thresholds;
-        outline_region(&mut img, BAND, |x, y| {
-            let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
-            in_band(f64::from(sim.field().evaluate(p, &layout)), thresholds)
-        });
-    }
     draw_bodies(&mut img, world, scale);
     if !options.footprints {
         return img;
@@ -83,6 +75,23 @@ pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbI
                 outline_circle(&mut img, to_px(f.centre), r, colour);
             }
         }
+    }
+    img
+}
+
+/// What lies under the bodies: the field as grey and, with `options.band`,
+/// the target band's outline (the live view's background, `view`).
+pub fn draw_ground<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbImage {
+    let world = sim.world();
+    let mut img = draw_field(world, sim.field(), options.size);
+    if options.band {
+        let scale = scale_of(world, options.size);
+        let layout = world.config().field_layout();
+        let thresholds = &sim.config().thresholds;
+        outline_region(&mut img, BAND, |x, y| {
+            let p = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
+            in_band(f64::from(sim.field().evaluate(p, &layout)), thresholds)
+        });
     }
     img
 }

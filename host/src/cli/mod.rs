@@ -7,6 +7,7 @@ pub mod robot;
 pub mod scenario;
 pub mod screen;
 pub mod simulate;
+pub mod view;
 
 use clap::{Parser, Subcommand};
 use learn::{ExperimentArgs, SearchArgs, TrainArgs};
@@ -14,6 +15,7 @@ use robot::{FlashArgs, MonitorArgs, ReplayArgs};
 use screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
 use simulate::{BenchArgs, RenderArgs, RunArgs};
 use std::path::PathBuf;
+use view::ViewArgs;
 
 /// Simulate, train and inspect policies for Zumo puck-construction swarms;
 /// flash robots, record and replay their logs.
@@ -72,6 +74,10 @@ pub enum Command {
     /// Measure a run from a photo of the TV taken from above: the pucks,
     /// Eval and whether the shape is formed (docs/display.md).
     Observe(ObserveArgs),
+    /// Serve a live view of a simulation running in this process: the
+    /// world on a canvas, play, pause, step, speed, reset and settings
+    /// (docs/view.md).
+    View(ViewArgs),
 }
 
 #[derive(Subcommand)]

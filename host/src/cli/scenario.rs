@@ -6,6 +6,7 @@ use host::train::TrainConfig;
 use sim::config::{BroadPhase, Walls};
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::ScenarioChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::trained_for;
 use sim::scenario::{ControllerChoice, Scenario};
@@ -92,6 +93,14 @@ impl ScenarioArgs {
         let here = self.config().trained_for();
         Ok(trained_for::mismatch(blob.trained_for(), &here)
             .map(|why| format!("policy file {}: {why}", path.display())))
+    }
+
+    /// The world's settings by name, the controller as given.
+    pub fn choices(&self) -> ScenarioChoices {
+        ScenarioChoices {
+            controller: self.own.controller.clone(),
+            ..self.config().choices()
+        }
     }
 
     /// The training config of the world flags given.

@@ -107,7 +107,7 @@ pub enum Bind {
     Socket(SocketAddr),
 }
 
-fn parse_bind(s: &str) -> Result<Bind, String> {
+pub(crate) fn parse_bind(s: &str) -> Result<Bind, String> {
     s.parse::<SocketAddr>()
         .map(Bind::Socket)
         .or_else(|_| s.parse::<IpAddr>().map(Bind::Ip))

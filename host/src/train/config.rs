@@ -12,12 +12,13 @@ use serde::{Deserialize, Serialize};
 use shared::blob::name_prefix;
 use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::ScenarioChoices;
 use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
-    config::disc_sensors::ObstacleTargets, config::BroadPhase, config::SuccessSignal,
-    config::Walls, fields::source::FieldSource, scenario::ControllerChoice,
-    scenario::PreparedScenario, scenario::Scenario,
+    config::disc_sensors::ObstacleTargets, config::SuccessSignal, config::Walls,
+    fields::source::FieldSource, scenario::ControllerChoice, scenario::PreparedScenario,
+    scenario::Scenario,
 };
 use std::path::{Path, PathBuf};
 
@@ -251,9 +252,7 @@ impl TrainConfig {
 
     /// The arena the run uses.
     pub fn arena_choice(&self) -> ArenaChoice {
-        self.arena
-            .clone()
-            .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
+        self.choices().arena_choice()
     }
 
     /// The sensor model and arena the run trains for, as its policy blob
@@ -265,18 +264,22 @@ impl TrainConfig {
     /// The run as a scenario (arena and sensor files read and checked),
     /// without the settings only training has.
     pub fn scenario(&self) -> Result<Scenario> {
-        Ok(Scenario {
+        Ok(self.choices().scenario()?)
+    }
+
+    /// The world's settings by name, the controller random.
+    pub fn choices(&self) -> ScenarioChoices {
+        ScenarioChoices {
             field: self.field.clone(),
             controller: ControllerChoice::Random,
+            sensors: self.sensors.clone(),
+            arena: self.arena.clone(),
             robots: self.robots,
             pucks: self.pucks,
             seed: self.seed,
-            broad_phase: BroadPhase::Grid,
-            arena: self.arena_choice().arena()?,
-            sensors: self.sensors.setup()?,
             noise: self.noise,
             walls: self.walls,
-        })
+        }
     }
 
     /// Loads the field and derives the simulation settings: the field's

@@ -20,6 +20,19 @@ pub fn in_band(value: f64, t: &Thresholds) -> bool {
     band_distance(value, t) == 0.0
 }
 
+/// Whether each puck lies in the band, looked up as [`eval`] looks it up.
+pub fn pucks_in_band<'a>(
+    world: &'a World,
+    field: &'a ScalarField,
+    t: &'a Thresholds,
+) -> impl Iterator<Item = bool> + 'a {
+    let layout = world.config().field_layout();
+    world
+        .pucks()
+        .iter()
+        .map(move |p| fixed_distance(p.pos, &layout, field, t) == 0)
+}
+
 /// How far a field value lies outside the band `[T_o, T_i]`.
 pub(crate) fn band_distance(value: f64, t: &Thresholds) -> f64 {
     if value < t.outie {

@@ -6,6 +6,7 @@
 
 pub mod arena;
 pub mod arena_choice;
+pub mod choices;
 pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;
@@ -232,22 +233,33 @@ impl Scenario {
     /// simulation and controller. Errors name the offending input.
     pub fn build(
         &self,
-    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller>), ScenarioError> {
-        let mut prepared = self.prepare()?;
-        let controller: Box<dyn Controller> = match &self.controller {
-            ControllerChoice::Orbital => Box::new(OrbitalConstruction::new(
+    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller + Send>), ScenarioError> {
+        if let ControllerChoice::Policy(path) = &self.controller {
+            return self.build_with_policy(policy_file::read(path)?);
+        }
+        let prepared = self.prepare()?;
+        let controller: Box<dyn Controller + Send> = match &self.controller {
+            ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
+            _ => Box::new(OrbitalConstruction::new(
                 OrbitalConfig::default(),
                 &prepared.config().thresholds,
             )),
-            ControllerChoice::Random => Box::new(RandomTurns::new(ActionTable::default())),
-            ControllerChoice::Policy(path) => {
-                let blob = policy_file::read(path)?;
-                drive_with(prepared.config_mut(), &blob, &self.field);
-                Box::new(GreedyPolicy::new(blob))
-            }
         };
         let sim = prepared.simulation(self.seed)?;
         Ok((sim, controller))
+    }
+
+    /// Builds the simulation with `blob` driving the robots (a policy
+    /// already decoded, such as one uploaded to the live view), as
+    /// [`build`](Self::build) does for `policy:FILE`.
+    pub fn build_with_policy(
+        &self,
+        blob: shared::PolicyBlob,
+    ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller + Send>), ScenarioError> {
+        let mut prepared = self.prepare()?;
+        drive_with(prepared.config_mut(), &blob, &self.field);
+        let sim = prepared.simulation(self.seed)?;
+        Ok((sim, Box::new(GreedyPolicy::new(blob))))
     }
 
     /// Validates the arena and the sensor settings, loads the field once

@@ -1,0 +1,672 @@
+//! The server: one simulation stepped by its own thread at the chosen
+//! speed, its state published to every viewer's WebSocket, the page and
+//! the field image over plain HTTP, controls and settings as POSTs.
+//!
+//! Requests: `GET /` (the page), `GET /field.png`, `GET /state.json` (the
+//! current hello and frame, for scripts), `GET /stream` (WebSocket:
+//! `hello`, then `frame`s), `POST /control?action=play|pause|step|reset`
+//! (`&seed=N` with reset, `&steps=N` with step), `POST /control?speed=real|10x|max`,
+//! `POST /settings?KEY=VALUE...` (the settings of [`crate::settings::KEYS`]),
+//! `POST /policy?name=NAME` (a policy blob as the body). Refused settings
+//! answer 400 with the reason and change nothing.
+
+use crate::http::{self, Request};
+use crate::hub::Hub;
+use crate::session::{Frame, Hello, Policy, Session};
+use crate::settings::{self, valid_name, Allowed, ViewController, ViewSettings};
+use serde::Serialize;
+use sim::base::ranges;
+use sim::control::policy_file;
+use std::collections::BTreeMap;
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+use tungstenite::protocol::Role;
+use tungstenite::{Message, Utf8Bytes, WebSocket};
+
+/// The page, built in.
+const PAGE: &str = include_str!("page.html");
+
+/// Connections served at once; more are answered 503.
+pub const MAX_CONNECTIONS: usize = 512;
+
+/// Uploaded policies kept; the oldest goes first.
+pub const MAX_UPLOADS: usize = 16;
+
+/// Frames published a second, at most (a browser paints about 60).
+pub const FRAMES_PER_SECOND: f64 = 60.0;
+
+/// Steps a second in real time: the robot's 20 ms control period.
+pub const REAL_TIME: f64 = 50.0;
+
+/// Steps one `step` control may ask for.
+pub const MAX_STEPS_PER_CONTROL: u64 = 1_000_000;
+
+/// How fast the simulation runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Speed {
+    /// 50 steps a second.
+    Real,
+    /// 500 steps a second.
+    Ten,
+    /// As fast as it goes.
+    Max,
+}
+
+impl Speed {
+    fn rate(self) -> Option<f64> {
+        match self {
+            Speed::Real => Some(REAL_TIME),
+            Speed::Ten => Some(10.0 * REAL_TIME),
+            Speed::Max => None,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Speed::Real => "real",
+            Speed::Ten => "10x",
+            Speed::Max => "max",
+        }
+    }
+}
+
+impl std::str::FromStr for Speed {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Speed, String> {
+        match s {
+            "real" | "1x" => Ok(Speed::Real),
+            "10x" => Ok(Speed::Ten),
+            "max" => Ok(Speed::Max),
+            _ => Err(format!("speed {s:?}: expected real, 10x or max")),
+        }
+    }
+}
+
+/// How to start.
+#[derive(Clone, Debug)]
+pub struct ViewOptions {
+    /// Where to listen (port 0: any free one).
+    pub bind: SocketAddr,
+    /// The first settings.
+    pub settings: ViewSettings,
+    /// The folder whose policy files a browser may choose.
+    pub policies: Option<PathBuf>,
+    /// Files a browser may name.
+    pub allowed: Allowed,
+    /// Start paused.
+    pub paused: bool,
+    /// The first speed.
+    pub speed: Speed,
+}
+
+/// A view, listening, its simulation running.
+pub struct View {
+    address: SocketAddr,
+    listener: TcpListener,
+    shared: Arc<Shared>,
+}
+
+struct Shared {
+    control: Mutex<Control>,
+    wake: Condvar,
+    hub: Hub,
+    connections: AtomicUsize,
+    policies: Option<PathBuf>,
+    allowed: Allowed,
+}
+
+struct Control {
+    session: Session,
+    /// Bumped at every reset: the field image's and hello's version.
+    generation: u64,
+    hello: Utf8Bytes,
+    field_png: Arc<Vec<u8>>,
+    paused: bool,
+    speed: Speed,
+    /// Single steps asked for and not yet run.
+    pending: u64,
+    /// Paced runs count steps from here.
+    anchor: (Instant, u64),
+    last_publish: Option<Instant>,
+    /// Steps a second, measured over the last second.
+    meter: Vec<(Instant, u64)>,
+    uploads: BTreeMap<String, (u64, Vec<u8>)>,
+    uploads_made: u64,
+}
+
+/// A hello as browsers get it.
+#[derive(Serialize)]
+struct HelloMessage<'a> {
+    t: &'static str,
+    generation: u64,
+    #[serde(flatten)]
+    hello: &'a Hello,
+    history: &'a [[f64; 2]],
+    policies: Vec<String>,
+    uploads: Vec<String>,
+    arenas: Vec<String>,
+}
+
+/// A frame as browsers get it.
+#[derive(Serialize)]
+struct FrameMessage<'a> {
+    t: &'static str,
+    generation: u64,
+    paused: bool,
+    speed: &'static str,
+    steps_per_second: f64,
+    viewers: usize,
+    #[serde(flatten)]
+    frame: &'a Frame,
+}
+
+impl View {
+    /// Builds the first simulation and starts listening and stepping;
+    /// errors name the setting or the address.
+    pub fn start(options: ViewOptions) -> Result<View, String> {
+        let listener = TcpListener::bind(options.bind)
+            .map_err(|e| format!("cannot listen on {}: {e}", options.bind))?;
+        let address = listener
+            .local_addr()
+            .map_err(|e| format!("cannot read the address of {}: {e}", options.bind))?;
+        let policy = policy_for(
+            &options.settings,
+            options.policies.as_deref(),
+            &BTreeMap::new(),
+        )?;
+        let session = Session::build(options.settings, policy)?;
+        let field_png = Arc::new(session.field_png()?);
+        let shared = Arc::new(Shared {
+            control: Mutex::new(Control {
+                session,
+                generation: 0,
+                hello: Utf8Bytes::from_static(""),
+                field_png,
+                paused: options.paused,
+                speed: options.speed,
+                pending: 0,
+                anchor: (Instant::now(), 0),
+                last_publish: None,
+                meter: Vec::new(),
+                uploads: BTreeMap::new(),
+                uploads_made: 0,
+            }),
+            wake: Condvar::new(),
+            hub: Hub::default(),
+            connections: AtomicUsize::new(0),
+            policies: options.policies,
+            allowed: options.allowed,
+        });
+        {
+            let mut c = shared.lock();
+            c.hello = shared.hello_message(&c);
+        }
+        let stepper = shared.clone();
+        std::thread::Builder::new()
+            .name("view-sim".into())
+            .spawn(move || stepper.run())
+            .map_err(|e| format!("cannot start the simulation's thread: {e}"))?;
+        Ok(View {
+            address,
+            listener,
+            shared,
+        })
+    }
+
+    /// Where it listens.
+    pub fn address(&self) -> SocketAddr {
+        self.address
+    }
+
+    /// The page's address.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.address)
+    }
+
+    /// Answers connections until the process ends, each in its own thread.
+    pub fn serve(&self) {
+        for stream in self.listener.incoming() {
+            let Ok(stream) = stream else { continue };
+            let shared = self.shared.clone();
+            if shared.connections.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
+                shared.connections.fetch_sub(1, Ordering::SeqCst);
+                let mut stream = stream;
+                let _ = stream.set_write_timeout(Some(Duration::from_secs(1)));
+                http::respond(&mut stream, 503, "text/plain", b"too many connections\n");
+                continue;
+            }
+            let spawned = std::thread::Builder::new()
+                .name("view-conn".into())
+                .spawn(move || {
+                    shared.connection(stream);
+                    shared.connections.fetch_sub(1, Ordering::SeqCst);
+                });
+            if spawned.is_err() {
+                self.shared.connections.fetch_sub(1, Ordering::SeqCst);
+            }
+        }
+    }
+
+    /// Serves from a background thread (the caller goes on: a Python
+    /// environment, a test).
+    pub fn spawn(self) -> Result<SocketAddr, String> {
+        let address = self.address;
+        std::thread::Builder::new()
+            .name("view-accept".into())
+            .spawn(move || self.serve())
+            .map_err(|e| format!("cannot start the server's thread: {e}"))?;
+        Ok(address)
+    }
+}
+
+/// The policy `settings` names: a file of the policy folder or an upload.
+fn policy_for(
+    settings: &ViewSettings,
+    folder: Option<&Path>,
+    uploads: &BTreeMap<String, (u64, Vec<u8>)>,
+) -> Result<Option<Policy>, String> {
+    match &settings.controller {
+        ViewController::Orbital | ViewController::Random => Ok(None),
+        ViewController::Policy(name) => {
+            let folder = folder.ok_or("this server has no policy folder (--policies)")?;
+            let path = folder.join(name);
+            let blob = policy_file::read(&path).map_err(|e| e.to_string())?;
+            Ok(Some(Policy { path, blob }))
+        }
+        ViewController::Upload(name) => {
+            let (_, bytes) = uploads
+                .get(name)
+                .ok_or_else(|| format!("no uploaded policy is named {name:?}"))?;
+            let path = PathBuf::from(format!("upload:{name}"));
+            let blob = policy_file::decode(&path, bytes).map_err(|e| e.to_string())?;
+            Ok(Some(Policy { path, blob }))
+        }
+    }
+}
+
+/// The policy files of `folder`, by name.
+fn policy_names(folder: Option<&Path>) -> Vec<String> {
+    let Some(entries) = folder.and_then(|f| std::fs::read_dir(f).ok()) else {
+        return Vec::new();
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".policy") && valid_name(n))
+        .collect();
+    names.sort();
+    names
+}
+
+fn json<T: Serialize>(value: &T) -> Utf8Bytes {
+    // our own types, of numbers and strings, always encode
+    serde_json::to_string(value)
+        .unwrap_or_else(|e| format!("{{\"t\":\"error\",\"error\":\"{e}\"}}"))
+        .into()
+}
+
+fn error_json(message: &str) -> Vec<u8> {
+    serde_json::json!({ "error": message })
+        .to_string()
+        .into_bytes()
+}
+
+impl Shared {
+    fn lock(&self) -> MutexGuard<'_, Control> {
+        // the control is consistent between statements: a panic in a step
+        // leaves a world a reset replaces
+        self.control
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    fn hello_message(&self, c: &Control) -> Utf8Bytes {
+        let mut arenas = vec!["".to_string(), "thesis".to_string()];
+        arenas.extend(
+            sim::scenario::arena::ArenaSpec::NAMES
+                .split(", ")
+                .map(String::from),
+        );
+        arenas.extend(
+            self.allowed
+                .arena_files
+                .iter()
+                .map(|p| p.display().to_string()),
+        );
+        json(&HelloMessage {
+            t: "hello",
+            generation: c.generation,
+            hello: &c.session.hello(),
+            history: c.session.history(),
+            policies: policy_names(self.policies.as_deref()),
+            uploads: c.uploads.keys().cloned().collect(),
+            arenas,
+        })
+    }
+
+    fn frame_message(&self, c: &Control) -> Utf8Bytes {
+        let rate = match (c.meter.first(), c.meter.last()) {
+            (Some(a), Some(b)) if b.0 > a.0 => (b.1 - a.1) as f64 / (b.0 - a.0).as_secs_f64(),
+            _ => 0.0,
+        };
+        json(&FrameMessage {
+            t: "frame",
+            generation: c.generation,
+            paused: c.paused,
+            speed: c.speed.name(),
+            steps_per_second: (rate * 10.0).round() / 10.0,
+            viewers: self.hub.viewers(),
+            frame: &c.session.frame(),
+        })
+    }
+
+    fn publish(&self, c: &mut Control) {
+        c.session.record();
+        c.last_publish = Some(Instant::now());
+        let message = self.frame_message(c);
+        self.hub.publish(&message);
+    }
+
+    /// Replaces the simulation (a reset, new settings) and tells every viewer.
+    fn replace(&self, c: &mut Control, session: Session) -> Result<(), String> {
+        let png = session.field_png()?;
+        c.session = session;
+        c.field_png = Arc::new(png);
+        c.generation += 1;
+        c.anchor = (Instant::now(), 0);
+        c.meter.clear();
+        c.hello = self.hello_message(c);
+        self.hub.publish(&c.hello);
+        self.publish(c);
+        Ok(())
+    }
+
+    /// The simulation's thread: steps at the chosen speed, publishes.
+    fn run(&self) {
+        let frame_gap = Duration::from_secs_f64(1.0 / FRAMES_PER_SECOND);
+        let mut c = self.lock();
+        loop {
+            while c.paused && c.pending == 0 {
+                c = self
+                    .wake
+                    .wait(c)
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                c.anchor = (Instant::now(), 0);
+            }
+            let now = Instant::now();
+            let mut single = false;
+            let stepped;
+            if c.pending > 0 {
+                // single steps run in chunks, so controls stay answered
+                let n = c.pending.min(10_000);
+                for _ in 0..n {
+                    c.session.step();
+                }
+                c.pending -= n;
+                stepped = true;
+                single = c.pending == 0;
+            } else {
+                match c.speed.rate() {
+                    Some(rate) => {
+                        let (from, done) = c.anchor;
+                        let due = (now.duration_since(from).as_secs_f64() * rate) as u64;
+                        let mut n = due.saturating_sub(done);
+                        if n as f64 > rate / 10.0 {
+                            // behind by more than 0.1 s: start again from now
+                            n = 1;
+                            c.anchor = (now, due.saturating_sub(1));
+                        }
+                        for _ in 0..n {
+                            c.session.step();
+                        }
+                        c.anchor.1 += n;
+                        stepped = n > 0;
+                    }
+                    None => {
+                        let until = now + Duration::from_millis(8);
+                        while Instant::now() < until {
+                            c.session.step();
+                        }
+                        stepped = true;
+                    }
+                }
+            }
+            if stepped {
+                let steps = c.session.simulation().totals().steps;
+                c.meter.push((Instant::now(), steps));
+                let recent = Instant::now() - Duration::from_secs(1);
+                let old = c.meter.iter().take_while(|m| m.0 < recent).count();
+                let keep = c.meter.len().saturating_sub(2);
+                c.meter.drain(..old.min(keep));
+            }
+            let due = c.last_publish.is_none_or(|t| t.elapsed() >= frame_gap);
+            if stepped && (due || single) {
+                self.publish(&mut c);
+            }
+            // wait for the next step or frame, or a control
+            let wait = match (c.paused, c.pending, c.speed.rate()) {
+                (_, p, _) if p > 0 => Duration::ZERO,
+                (true, _, _) => Duration::ZERO,
+                (false, _, Some(rate)) => {
+                    let next = c.anchor.0 + Duration::from_secs_f64((c.anchor.1 + 1) as f64 / rate);
+                    next.saturating_duration_since(Instant::now())
+                        .min(frame_gap)
+                }
+                (false, _, None) => Duration::from_micros(200),
+            };
+            if !wait.is_zero() {
+                c = self
+                    .wake
+                    .wait_timeout(c, wait)
+                    .unwrap_or_else(std::sync::PoisonError::into_inner)
+                    .0;
+            }
+        }
+    }
+
+    /// One connection: one request, or a WebSocket's life.
+    fn connection(&self, mut stream: TcpStream) {
+        let _ = stream.set_read_timeout(Some(http::TIMEOUT));
+        let _ = stream.set_write_timeout(Some(http::TIMEOUT));
+        let limit = ranges::POLICY_FILE.max as usize;
+        let request = match http::read_request(&mut stream, limit) {
+            Ok(r) => r,
+            Err(e) => {
+                if let Some(status) = e.status {
+                    http::respond(
+                        &mut stream,
+                        status,
+                        "application/json",
+                        &error_json(&e.message),
+                    );
+                }
+                return;
+            }
+        };
+        if request.path == "/stream" && request.is_websocket() {
+            return self.stream(stream, &request);
+        }
+        let (status, kind, body) = self.answer(&request);
+        http::respond(&mut stream, status, kind, &body);
+    }
+
+    fn answer(&self, request: &Request) -> (u16, &'static str, Vec<u8>) {
+        const JSON: &str = "application/json";
+        let method = request.method.as_str();
+        let get = method == "GET" || method == "HEAD";
+        match (request.path.as_str(), get, method == "POST") {
+            ("/" | "/index.html", true, _) => {
+                (200, "text/html; charset=utf-8", PAGE.as_bytes().to_vec())
+            }
+            ("/field.png", true, _) => (200, "image/png", self.lock().field_png.to_vec()),
+            ("/state.json", true, _) => {
+                let c = self.lock();
+                let body = format!("{{\"hello\":{},\"frame\":{}}}", c.hello, self.frame_message(&c));
+                (200, JSON, body.into_bytes())
+            }
+            ("/control", _, true) => match self.control(&request.query) {
+                Ok(()) => (200, JSON, b"{\"ok\":true}".to_vec()),
+                Err(e) => (400, JSON, error_json(&e)),
+            },
+            ("/settings", _, true) => match self.settings(&request.query) {
+                Ok(()) => (200, JSON, b"{\"ok\":true}".to_vec()),
+                Err(e) => (400, JSON, error_json(&e)),
+            },
+            ("/policy", _, true) => match self.upload(&request.query, &request.body) {
+                Ok(name) => (200, JSON, serde_json::json!({ "ok": true, "name": name }).to_string().into_bytes()),
+                Err(e) => (400, JSON, error_json(&e)),
+            },
+            ("/" | "/index.html" | "/field.png" | "/state.json" | "/stream", _, _)
+            | ("/control" | "/settings" | "/policy", _, _) => (
+                405,
+                JSON,
+                error_json(&format!("{method} is not served at {}", request.path)),
+            ),
+            (path, _, _) => (
+                404,
+                JSON,
+                error_json(&format!(
+                    "not found: {path} (this server has /, /field.png, /state.json, /stream, /control, /settings and /policy)"
+                )),
+            ),
+        }
+    }
+
+    fn control(&self, query: &str) -> Result<(), String> {
+        let pairs = settings::query_pairs(query);
+        let get = |key: &str| {
+            pairs
+                .iter()
+                .find(|(k, _)| k == key)
+                .map(|(_, v)| v.as_str())
+        };
+        let mut c = self.lock();
+        if let Some(speed) = get("speed") {
+            c.speed = speed.parse()?;
+            c.anchor = (Instant::now(), 0);
+        }
+        match get("action") {
+            None if get("speed").is_some() => {}
+            Some("play") => {
+                c.paused = false;
+                c.pending = 0;
+                c.anchor = (Instant::now(), 0);
+            }
+            Some("pause") => {
+                c.paused = true;
+                c.pending = 0;
+                self.publish(&mut c);
+            }
+            Some("step") => {
+                let steps = match get("steps") {
+                    None => 1,
+                    Some(s) => {
+                        let n = s
+                            .parse::<u64>()
+                            .map_err(|_| format!("steps={s}: not a whole number"))?;
+                        ranges::RUN_STEPS
+                            .check_count("steps", n)
+                            .map_err(|e| e.to_string())?;
+                        n.min(MAX_STEPS_PER_CONTROL)
+                    }
+                };
+                c.paused = true;
+                c.pending += steps;
+            }
+            Some("reset") => {
+                let mut next = c.session.settings().clone();
+                if let Some(seed) = get("seed") {
+                    next.seed = seed.parse().map_err(|_| {
+                        format!("seed={seed}: not a whole number from 0 to 2^64 - 1")
+                    })?;
+                }
+                let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
+                let session = Session::build(next, policy)?;
+                self.replace(&mut c, session)?;
+            }
+            Some(other) => {
+                return Err(format!(
+                    "action={other}: expected play, pause, step or reset"
+                ))
+            }
+            None => return Err("no action= or speed= given".into()),
+        }
+        self.wake.notify_all();
+        Ok(())
+    }
+
+    fn settings(&self, query: &str) -> Result<(), String> {
+        let mut c = self.lock();
+        let next = c
+            .session
+            .settings()
+            .with_query(query, &self.allowed, &["speed", "paused"])?;
+        let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
+        let session = Session::build(next, policy)?;
+        self.replace(&mut c, session)?;
+        self.wake.notify_all();
+        Ok(())
+    }
+
+    fn upload(&self, query: &str, body: &[u8]) -> Result<String, String> {
+        let pairs = settings::query_pairs(query);
+        let name = pairs
+            .iter()
+            .find(|(k, _)| k == "name")
+            .map(|(_, v)| v.clone())
+            .ok_or("no name= given for the upload")?;
+        if !valid_name(&name) {
+            return Err(format!(
+                "name={name}: upload names are letters, digits, '.', '-' and '_'"
+            ));
+        }
+        policy_file::decode(Path::new(&name), body).map_err(|e| e.to_string())?;
+        let mut c = self.lock();
+        c.uploads_made += 1;
+        let order = c.uploads_made;
+        c.uploads.insert(name.clone(), (order, body.to_vec()));
+        if c.uploads.len() > MAX_UPLOADS {
+            let oldest = c
+                .uploads
+                .iter()
+                .min_by_key(|(_, (k, _))| *k)
+                .map(|(n, _)| n.clone());
+            if let Some(oldest) = oldest {
+                c.uploads.remove(&oldest);
+            }
+        }
+        c.hello = self.hello_message(&c);
+        self.hub.publish(&c.hello);
+        Ok(name)
+    }
+
+    /// A viewer's WebSocket: the hello and then every frame, until the
+    /// viewer goes away or is dropped for not keeping up.
+    fn stream(&self, mut stream: TcpStream, request: &Request) {
+        if http::accept_websocket(&mut stream, request).is_err() {
+            return;
+        }
+        let queue = {
+            // under the lock, so no frame is published between these and the queue
+            let c = self.lock();
+            self.hub
+                .subscribe(&[c.hello.clone(), self.frame_message(&c)])
+        };
+        let mut socket = WebSocket::from_raw_socket(stream, Role::Server, None);
+        loop {
+            let message = match queue.recv_timeout(Duration::from_secs(5)) {
+                Ok(text) => Message::Text(text),
+                Err(std::sync::mpsc::RecvTimeoutError::Timeout) => Message::Ping(Vec::new().into()),
+                Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => break,
+            };
+            if socket.send(message).is_err() {
+                return;
+            }
+        }
+        let _ = socket.close(None);
+        let _ = socket.flush();
+    }
+}

@@ -1,0 +1,290 @@
+//! One running simulation as the view shows it: built from the view's
+//! settings by the scenario code `host run` uses
+//! ([`sim::scenario::choices::ScenarioChoices`]), stepped by its
+//! controller, and described to browsers as a `hello` (what stays until
+//! the next reset: arena, bodies' sizes, the robots' outline, the field
+//! image, the settings) and `frame`s (what each step changes).
+
+use crate::settings::ViewSettings;
+use serde::Serialize;
+use shared::PolicyBlob;
+use sim::base::vec2::Vec2;
+use sim::control::Controller;
+use sim::episodes::eval::pucks_in_band;
+use sim::physics::outline::Outline;
+use sim::render::{self, RenderOptions};
+use sim::scenario::sensor_setup::SelectedSensors;
+use sim::simulation::Simulation;
+use std::path::PathBuf;
+
+/// Width of the field image, pixels.
+pub const FIELD_IMAGE_WIDTH: u32 = 800;
+
+/// Points of the Eval plot kept: past this, every other one is dropped.
+pub const HISTORY_POINTS: usize = 512;
+
+/// A running simulation and its controller.
+pub struct Session {
+    settings: ViewSettings,
+    sim: Simulation<SelectedSensors>,
+    controller: Box<dyn Controller + Send>,
+    history: Vec<[f64; 2]>,
+}
+
+/// A policy to drive the robots with, already read or decoded.
+pub struct Policy {
+    /// Where it came from (a file, or an upload's name).
+    pub path: PathBuf,
+    /// The blob.
+    pub blob: PolicyBlob,
+}
+
+/// What stays the same until the next reset.
+#[derive(Clone, Debug, Serialize)]
+pub struct Hello {
+    /// The arena's width and height, units.
+    pub arena: [f64; 2],
+    /// Robot radius (the round back of a wedge), units.
+    pub robot_radius: f64,
+    /// Puck radius, units.
+    pub puck_radius: f64,
+    /// A wedge robot's outline, points (forward, right) in units around
+    /// its centre; `None` for discs.
+    pub outline: Option<Vec<[f64; 2]>>,
+    /// The settings, as URL parameters.
+    pub settings: Vec<(&'static str, String)>,
+    /// Steps between formation checks.
+    pub check_interval: u64,
+}
+
+/// The state after a step.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Frame {
+    /// Steps run since the reset.
+    pub step: u64,
+    /// Steps of the current episode.
+    pub episode_step: u64,
+    /// Eval of the current world.
+    pub eval: f64,
+    /// Episodes that formed the shape.
+    pub formations: u64,
+    /// Episodes reset at the stuck limit.
+    pub stuck: u64,
+    /// Mean Eval at the formation checks so far.
+    pub mean_eval: f64,
+    /// Robot-robot collisions per 1000 steps.
+    pub collisions_per_1000: f64,
+    /// Each robot's x, y, and heading's unit vector x, y: 4 numbers a robot.
+    pub robots: Vec<f32>,
+    /// Each puck's x, y.
+    pub pucks: Vec<f32>,
+    /// Each puck: 1 in the target band, 0 outside.
+    pub in_band: Vec<u8>,
+}
+
+impl Session {
+    /// Builds the simulation of `settings`, driven by `policy` when the
+    /// controller is a policy. Errors name the setting.
+    pub fn build(settings: ViewSettings, policy: Option<Policy>) -> Result<Session, String> {
+        let path = policy.as_ref().map(|p| p.path.clone());
+        let scenario = settings
+            .choices(path)
+            .scenario()
+            .map_err(|e| e.to_string())?;
+        let built = match policy {
+            Some(p) => scenario.build_with_policy(p.blob),
+            None => scenario.build(),
+        };
+        let (sim, controller) = built.map_err(|e| e.to_string())?;
+        let mut session = Session {
+            settings,
+            sim,
+            controller,
+            history: Vec::new(),
+        };
+        session.record();
+        Ok(session)
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &ViewSettings {
+        &self.settings
+    }
+
+    /// The simulation.
+    pub fn simulation(&self) -> &Simulation<SelectedSensors> {
+        &self.sim
+    }
+
+    /// One step.
+    pub fn step(&mut self) {
+        self.sim.step(self.controller.as_mut());
+    }
+
+    /// Adds the current Eval to the plot's points.
+    pub fn record(&mut self) {
+        let point = [self.sim.totals().steps as f64, self.sim.eval()];
+        if self.history.last().is_some_and(|p| p[0] == point[0]) {
+            return;
+        }
+        if self.history.len() >= HISTORY_POINTS {
+            let mut k = 0;
+            self.history.retain(|_| {
+                k += 1;
+                k % 2 == 1
+            });
+        }
+        self.history.push(point);
+    }
+
+    /// The Eval plot's points: step, Eval.
+    pub fn history(&self) -> &[[f64; 2]] {
+        &self.history
+    }
+
+    /// What stays until the next reset.
+    pub fn hello(&self) -> Hello {
+        let world = self.sim.world().config();
+        let arena = world.arena();
+        Hello {
+            arena: [arena.x, arena.y],
+            robot_radius: world.robot_radius,
+            puck_radius: world.puck_radius,
+            outline: Outline::of(world.robot_shape, world.robot_radius).map(|o| boundary(&o)),
+            settings: self.settings.pairs(),
+            check_interval: self.sim.config().episode.check_interval,
+        }
+    }
+
+    /// The field as grey with the target band outlined, as a PNG
+    /// [`FIELD_IMAGE_WIDTH`] pixels wide.
+    pub fn field_png(&self) -> Result<Vec<u8>, String> {
+        let options = RenderOptions {
+            size: FIELD_IMAGE_WIDTH,
+            footprints: false,
+            band: true,
+        };
+        let image = render::draw_ground(&self.sim, options);
+        let mut png = Vec::new();
+        image::DynamicImage::ImageRgb8(image)
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .map_err(|e| format!("cannot encode the field image: {e}"))?;
+        Ok(png)
+    }
+
+    /// The current state.
+    pub fn frame(&self) -> Frame {
+        let sim = &self.sim;
+        let world = sim.world();
+        let totals = sim.totals();
+        let robots = world
+            .robots()
+            .iter()
+            .zip(world.bodies())
+            .flat_map(|(r, b)| [b.pos.x, b.pos.y, r.direction.x, r.direction.y])
+            .map(|v| v as f32)
+            .collect();
+        let pucks = world
+            .pucks()
+            .iter()
+            .flat_map(|p| [p.pos.x as f32, p.pos.y as f32])
+            .collect();
+        let in_band = pucks_in_band(world, sim.field(), &sim.config().thresholds)
+            .map(u8::from)
+            .collect();
+        Frame {
+            step: totals.steps,
+            episode_step: sim.state().episode_step,
+            eval: sim.eval(),
+            formations: totals.formations,
+            stuck: totals.stuck,
+            mean_eval: totals.mean_eval(),
+            collisions_per_1000: totals.collisions_per_1000(),
+            robots,
+            pucks,
+            in_band,
+        }
+    }
+}
+
+/// Points around a wedge robot's outline, (forward, right) in units: where
+/// each of 64 rays from the centre leaves it.
+fn boundary(outline: &Outline) -> Vec<[f64; 2]> {
+    const RAYS: usize = 64;
+    (0..RAYS)
+        .map(|k| {
+            let ray = Vec2::from_angle(k as f64 * std::f64::consts::TAU / RAYS as f64);
+            let (mut inside, mut outside) = (0.0, outline.tip() * 1.5);
+            for _ in 0..40 {
+                let mid = (inside + outside) / 2.0;
+                if outline.distance(ray * mid).0 <= 0.0 {
+                    inside = mid;
+                } else {
+                    outside = mid;
+                }
+            }
+            [ray.x * inside, ray.y * inside]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sim::config::robot_shape::RobotShape;
+
+    #[test]
+    fn a_sessions_frames_follow_host_runs_simulation_step_for_step() {
+        let settings = ViewSettings {
+            robots: Some(3),
+            pucks: Some(20),
+            seed: 5,
+            ..ViewSettings::default()
+        };
+        let mut session = Session::build(settings.clone(), None).unwrap();
+        let (mut sim, mut controller) = settings.choices(None).scenario().unwrap().build().unwrap();
+        for _ in 0..300 {
+            session.step();
+            sim.step(controller.as_mut());
+        }
+        let frame = session.frame();
+        assert_eq!(frame.step, 300);
+        assert_eq!(frame.robots.len(), 12);
+        assert_eq!(frame.pucks.len(), 40);
+        assert_eq!(frame.in_band.len(), 20);
+        let b = &sim.world().bodies()[2];
+        assert_eq!(
+            (frame.robots[8], frame.robots[9]),
+            (b.pos.x as f32, b.pos.y as f32)
+        );
+        assert_eq!(frame.eval, sim.eval());
+        assert_eq!(frame.mean_eval, sim.totals().mean_eval());
+    }
+
+    #[test]
+    fn the_wedges_outline_reaches_its_tip_ahead_and_its_radius_behind() {
+        let o = Outline::of(RobotShape::Wedge { tip: 15.0 }, 10.0).unwrap();
+        let points = boundary(&o);
+        assert!((points[0][0] - o.tip()).abs() < 1e-6, "{:?}", points[0]);
+        assert!((points[32][0] + 10.0).abs() < 1e-6, "{:?}", points[32]);
+    }
+
+    #[test]
+    fn the_plot_keeps_a_bounded_number_of_points() {
+        let mut session = Session::build(
+            ViewSettings {
+                robots: Some(2),
+                pucks: Some(5),
+                ..ViewSettings::default()
+            },
+            None,
+        )
+        .unwrap();
+        for _ in 0..3 * HISTORY_POINTS {
+            session.step();
+            session.record();
+        }
+        assert!(session.history().len() <= HISTORY_POINTS);
+        assert!(session.history().windows(2).all(|w| w[0][0] < w[1][0]));
+    }
+}

@@ -1,0 +1,388 @@
+//! The view's settings: the world's (controller, field, arena, sensors,
+//! noise, robots, pucks, seed) as URL parameters, parsed and limited to
+//! what a browser may choose: built-in fields and arenas, the arena files
+//! the server was started with, the policies of its policy folder and the
+//! ones uploaded. The values' ranges are checked where the scenario is
+//! built ([`sim::scenario::Scenario::prepare`]).
+
+use sim::fields::source::FieldSource;
+use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::ScenarioChoices;
+use sim::scenario::sensor_choice::SensorChoice;
+use sim::scenario::ControllerChoice;
+use std::fmt;
+use std::path::PathBuf;
+use std::str::FromStr;
+
+/// Which controller drives the robots.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ViewController {
+    /// Orbital construction.
+    Orbital,
+    /// Random turns.
+    Random,
+    /// A file of the server's policy folder, by name.
+    Policy(String),
+    /// A policy uploaded to this server, by name.
+    Upload(String),
+}
+
+impl fmt::Display for ViewController {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ViewController::Orbital => f.write_str("oc"),
+            ViewController::Random => f.write_str("random"),
+            ViewController::Policy(name) => write!(f, "policy:{name}"),
+            ViewController::Upload(name) => write!(f, "upload:{name}"),
+        }
+    }
+}
+
+impl FromStr for ViewController {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<ViewController, String> {
+        let named = |name: &str, what| {
+            if valid_name(name) {
+                Ok(name.to_string())
+            } else {
+                Err(format!(
+                    "controller {s:?}: {what} names are letters, digits, '.', '-' and '_'"
+                ))
+            }
+        };
+        match s {
+            "oc" => Ok(ViewController::Orbital),
+            "random" => Ok(ViewController::Random),
+            _ => {
+                if let Some(name) = s.strip_prefix("policy:") {
+                    named(name, "policy").map(ViewController::Policy)
+                } else if let Some(name) = s.strip_prefix("upload:") {
+                    named(name, "upload").map(ViewController::Upload)
+                } else {
+                    Err(format!(
+                        "unknown controller {s:?}: expected oc, random, policy:NAME or upload:NAME"
+                    ))
+                }
+            }
+        }
+    }
+}
+
+/// A file or upload name a browser may give: no paths.
+pub fn valid_name(name: &str) -> bool {
+    !name.is_empty()
+        && name.len() <= 100
+        && !name.starts_with('.')
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
+}
+
+/// The view's world settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewSettings {
+    /// The controller.
+    pub controller: ViewController,
+    /// The field.
+    pub field: FieldSource,
+    /// The arena; `None` for the sensor model's default.
+    pub arena: Option<ArenaChoice>,
+    /// The sensor model.
+    pub sensors: SensorChoice,
+    /// Noise, times the default.
+    pub noise: f64,
+    /// Robots; `None` for the arena's.
+    pub robots: Option<usize>,
+    /// Pucks; `None` for the arena's.
+    pub pucks: Option<usize>,
+    /// Seed.
+    pub seed: u64,
+}
+
+impl Default for ViewSettings {
+    /// The thesis' standard run.
+    fn default() -> ViewSettings {
+        ViewSettings::from_choices(&ScenarioChoices::default(), ViewController::Orbital)
+    }
+}
+
+/// The URL parameters of the settings, in the page's order.
+pub const KEYS: [&str; 8] = [
+    "controller",
+    "field",
+    "arena",
+    "sensors",
+    "noise",
+    "robots",
+    "pucks",
+    "seed",
+];
+
+/// What a browser may choose beyond the built-in fields and arenas.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Allowed {
+    /// Arena files the server was started with.
+    pub arena_files: Vec<PathBuf>,
+    /// A field image the server was started with.
+    pub field_file: Option<PathBuf>,
+    /// Sensor settings files the server was started with.
+    pub sensor_files: Vec<PathBuf>,
+}
+
+impl ViewSettings {
+    /// The view's settings of `choices` (its controller replaced by `controller`).
+    pub fn from_choices(choices: &ScenarioChoices, controller: ViewController) -> ViewSettings {
+        ViewSettings {
+            controller,
+            field: choices.field.clone(),
+            arena: choices.arena.clone(),
+            sensors: choices.sensors.clone(),
+            noise: choices.noise,
+            robots: choices.robots,
+            pucks: choices.pucks,
+            seed: choices.seed,
+        }
+    }
+
+    /// The world's settings by name; a policy controller is named by
+    /// `policy_path` (the caller has read or decoded it).
+    pub fn choices(&self, policy_path: Option<PathBuf>) -> ScenarioChoices {
+        let controller = match (&self.controller, policy_path) {
+            (ViewController::Orbital, _) => ControllerChoice::Orbital,
+            (ViewController::Random, _) => ControllerChoice::Random,
+            (_, Some(path)) => ControllerChoice::Policy(path),
+            (other, None) => ControllerChoice::Policy(PathBuf::from(other.to_string())),
+        };
+        ScenarioChoices {
+            field: self.field.clone(),
+            controller,
+            sensors: self.sensors.clone(),
+            arena: self.arena.clone(),
+            robots: self.robots,
+            pucks: self.pucks,
+            seed: self.seed,
+            noise: self.noise,
+            walls: None,
+        }
+    }
+
+    /// Each setting as its URL parameter's value ("" for the arena's own).
+    pub fn pairs(&self) -> Vec<(&'static str, String)> {
+        let or_own = |v: Option<usize>| v.map(|n| n.to_string()).unwrap_or_default();
+        vec![
+            ("controller", self.controller.to_string()),
+            ("field", self.field.to_string()),
+            (
+                "arena",
+                self.arena
+                    .as_ref()
+                    .map(|a| a.to_string())
+                    .unwrap_or_default(),
+            ),
+            ("sensors", self.sensors.to_string()),
+            ("noise", self.noise.to_string()),
+            ("robots", or_own(self.robots)),
+            ("pucks", or_own(self.pucks)),
+            ("seed", self.seed.to_string()),
+        ]
+    }
+
+    /// These settings with the URL parameters `query` applied (keys other
+    /// than [`KEYS`] are left to the caller: `ignore` lists those it
+    /// takes). Errors name the parameter and its value.
+    pub fn with_query(
+        &self,
+        query: &str,
+        allowed: &Allowed,
+        ignore: &[&str],
+    ) -> Result<ViewSettings, String> {
+        let mut s = self.clone();
+        for (key, value) in query_pairs(query) {
+            let bad = |why: String| format!("{key}={value}: {why}");
+            let count = |v: &str| -> Result<Option<usize>, String> {
+                if v.is_empty() {
+                    Ok(None)
+                } else {
+                    v.parse()
+                        .map(Some)
+                        .map_err(|_| bad("not a whole number of at least 0".into()))
+                }
+            };
+            match key.as_str() {
+                "controller" => s.controller = value.parse().map_err(bad)?,
+                "field" => s.field = field(&value, allowed).map_err(bad)?,
+                "arena" => s.arena = arena(&value, allowed).map_err(bad)?,
+                "sensors" => s.sensors = sensors(&value, allowed).map_err(bad)?,
+                "noise" => {
+                    s.noise = value
+                        .parse::<f64>()
+                        .ok()
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| bad("not a number".into()))?
+                }
+                "robots" => s.robots = count(&value)?,
+                "pucks" => s.pucks = count(&value)?,
+                "seed" => {
+                    s.seed = value
+                        .parse()
+                        .map_err(|_| bad("not a whole number from 0 to 2^64 - 1".into()))?
+                }
+                k if ignore.contains(&k) => {}
+                _ => {
+                    return Err(format!(
+                        "unknown setting {key:?}: expected {}",
+                        KEYS.join(", ")
+                    ))
+                }
+            }
+        }
+        Ok(s)
+    }
+}
+
+fn field(value: &str, allowed: &Allowed) -> Result<FieldSource, String> {
+    let field: FieldSource = value
+        .parse()
+        .map_err(|e: sim::fields::source::FieldError| e.to_string())?;
+    match &field {
+        FieldSource::Image(path) if allowed.field_file.as_ref() != Some(path) => Err(
+            "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z)"
+                .into(),
+        ),
+        _ => Ok(field),
+    }
+}
+
+fn arena(value: &str, allowed: &Allowed) -> Result<Option<ArenaChoice>, String> {
+    if value.is_empty() {
+        return Ok(None);
+    }
+    let arena: ArenaChoice = value.parse()?;
+    match &arena {
+        ArenaChoice::File(path) if !allowed.arena_files.contains(path) => {
+            Err("an arena file must be one the server was started with (--arena-file)".into())
+        }
+        _ => Ok(Some(arena)),
+    }
+}
+
+fn sensors(value: &str, allowed: &Allowed) -> Result<SensorChoice, String> {
+    let sensors: SensorChoice = value.parse()?;
+    fn files(s: &SensorChoice, out: &mut Vec<PathBuf>) {
+        match s {
+            SensorChoice::Robot(Some(path)) => out.push(path.clone()),
+            SensorChoice::Mixed(parts) => parts.iter().for_each(|p| files(p, out)),
+            _ => {}
+        }
+    }
+    let mut named = Vec::new();
+    files(&sensors, &mut named);
+    if named.iter().all(|p| allowed.sensor_files.contains(p)) {
+        Ok(sensors)
+    } else {
+        Err("a sensor settings file must be one the server was started with".into())
+    }
+}
+
+/// The `key=value` pairs of a URL query, percent-decoded (`+` a space).
+pub fn query_pairs(query: &str) -> Vec<(String, String)> {
+    query
+        .split('&')
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let (k, v) = p.split_once('=').unwrap_or((p, ""));
+            (decode(k), decode(v))
+        })
+        .collect()
+}
+
+fn decode(s: &str) -> String {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        match bytes[i] {
+            b'+' => out.push(b' '),
+            b'%' if i + 2 < bytes.len() => {
+                let hex = |c: u8| (c as char).to_digit(16);
+                match (hex(bytes[i + 1]), hex(bytes[i + 2])) {
+                    (Some(h), Some(l)) => {
+                        out.push((h * 16 + l) as u8);
+                        i += 2;
+                    }
+                    _ => out.push(b'%'),
+                }
+            }
+            b => out.push(b),
+        }
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// `pairs` as a URL query, percent-encoded.
+pub fn encode_query(pairs: &[(&str, String)]) -> String {
+    let encode = |s: &str| {
+        s.bytes()
+            .map(|b| match b {
+                b'A'..=b'Z' | b'a'..=b'z' | b'0'..=b'9' | b'-' | b'_' | b'.' | b'~' | b':' => {
+                    (b as char).to_string()
+                }
+                _ => format!("%{b:02X}"),
+            })
+            .collect::<String>()
+    };
+    pairs
+        .iter()
+        .map(|(k, v)| format!("{k}={}", encode(v)))
+        .collect::<Vec<_>>()
+        .join("&")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_round_trip_through_their_url_parameters() {
+        let s = ViewSettings::default()
+            .with_query(
+                "controller=random&field=letter%3AT&arena=tv75&sensors=robot&noise=0.5&robots=5&pucks=&seed=7",
+                &Allowed::default(),
+                &[],
+            )
+            .unwrap();
+        assert_eq!(s.robots, Some(5));
+        assert_eq!(s.pucks, None);
+        assert_eq!(s.field.to_string(), "letter:T");
+        let again = ViewSettings::default()
+            .with_query(&encode_query(&s.pairs()), &Allowed::default(), &[])
+            .unwrap();
+        assert_eq!(again, s);
+    }
+
+    #[test]
+    fn a_browser_cannot_name_files_the_server_was_not_started_with() {
+        let none = Allowed::default();
+        let d = ViewSettings::default();
+        for (query, says) in [
+            ("field=/etc/passwd", "field=/etc/passwd: a field image"),
+            ("arena=/tmp/x.toml", "arena=/tmp/x.toml: an arena file"),
+            ("sensors=robot:/tmp/x.json", "sensor settings file"),
+            ("controller=policy:../x", "controller=policy:../x"),
+            ("robots=-1", "robots=-1: not a whole number"),
+            ("noise=nan", "noise=nan: not a number"),
+            ("colour=red", "unknown setting \"colour\""),
+        ] {
+            let e = d.with_query(query, &none, &[]).unwrap_err();
+            assert!(e.contains(says), "{query}: {e}");
+        }
+        let allowed = Allowed {
+            arena_files: vec![PathBuf::from("/tmp/x.toml")],
+            ..Allowed::default()
+        };
+        assert!(d.with_query("arena=/tmp/x.toml", &allowed, &[]).is_ok());
+        assert!(d.with_query("speed=max", &none, &["speed"]).is_ok());
+    }
+}

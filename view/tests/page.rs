@@ -1,0 +1,146 @@
+//! The live view's page in headless Chromium: it draws the world, its
+//! controls pause, step and reset the simulation, URL parameters set it,
+//! and refused settings leave it as it was with a message on the page.
+
+mod browser;
+mod common;
+
+use browser::Browser;
+use common::{request, serve, small, state, wait_for_step};
+use view::Speed;
+
+const SIZE: (u32, u32) = (1100, 820);
+
+/// Pixels of the world's canvas whose colour is near `rgb`.
+fn pixels_like(browser: &mut Browser, rgb: [u8; 3]) -> u64 {
+    let [r, g, b] = rgb;
+    browser
+        .eval(&format!(
+            "(() => {{ const c = document.getElementById('world'); const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data; let n = 0; for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - {r}) < 8 && Math.abs(d[i + 1] - {g}) < 8 && Math.abs(d[i + 2] - {b}) < 8) n++; return n; }})()"
+        ))
+        .as_u64()
+        .unwrap()
+}
+
+#[test]
+fn the_page_loads_and_draws_non_blank_frames_of_robots_and_pucks() {
+    let address = serve(small(1), false, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("Number(document.documentElement.dataset.painted) > 10", 60);
+    let robots = pixels_like(&mut page, [0, 100, 200]);
+    let pucks = pixels_like(&mut page, [200, 44, 44]) + pixels_like(&mut page, [40, 180, 80]);
+    assert!(robots > 50, "{robots} robot pixels");
+    assert!(pucks > 100, "{pucks} puck pixels");
+    let painted: u64 = page.data("step").parse().unwrap();
+    assert!(painted > 0);
+    // shown undistorted: its box on the page has the arena's shape
+    let shape = page.eval("(() => { const c = document.getElementById('world'); const r = c.getBoundingClientRect(); return [r.width / r.height, c.width / c.height]; })()");
+    let (shown, drawn) = (shape[0].as_f64().unwrap(), shape[1].as_f64().unwrap());
+    assert!(
+        (shown - drawn).abs() < 0.01 && (drawn - 1.0).abs() < 0.01,
+        "{shape}"
+    );
+}
+
+#[test]
+fn pause_stops_the_step_counter_and_a_single_step_advances_it_by_exactly_one() {
+    let address = serve(small(2), false, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("Number(document.documentElement.dataset.step) > 5", 60);
+    page.eval("window.dispatchEvent(new KeyboardEvent('keydown', { key: ' ' }))");
+    page.wait_for("document.documentElement.dataset.paused === 'true'", 30);
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    let paused: u64 = page.data("step").parse().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(600));
+    assert_eq!(
+        page.data("step").parse::<u64>().unwrap(),
+        paused,
+        "the step moved while paused"
+    );
+    assert_eq!(
+        state(address)["frame"]["step"],
+        paused,
+        "the page shows the server's step"
+    );
+    page.eval("window.dispatchEvent(new KeyboardEvent('keydown', { key: 's' }))");
+    page.wait_for(
+        &format!(
+            "Number(document.documentElement.dataset.step) === {}",
+            paused + 1
+        ),
+        30,
+    );
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(page.data("step").parse::<u64>().unwrap(), paused + 1);
+}
+
+#[test]
+fn reset_with_a_seed_reproduces_the_same_frames() {
+    let address = serve(small(3), true, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+    let mut picture = |seed: u64| {
+        page.eval(&format!("document.getElementById('resetSeed').value = '{seed}'; document.getElementById('reset').click()"));
+        page.wait_for("document.documentElement.dataset.step === '0'", 30);
+        let (status, body) = request(address, "POST", "/control?action=step&steps=40", b"");
+        assert_eq!(status, 200, "{body}");
+        wait_for_step(address, 40);
+        page.wait_for("document.documentElement.dataset.step === '40' && document.documentElement.dataset.field === document.documentElement.dataset.generation", 30);
+        // painted after the field image came
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        page.eval("document.getElementById('world').toDataURL()")
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    let first = picture(9);
+    let other = picture(10);
+    let again = picture(9);
+    assert!(
+        first == again,
+        "seed 9 drew another picture the second time"
+    );
+    assert!(first != other, "seeds 9 and 10 drew the same picture");
+}
+
+#[test]
+fn url_parameters_set_the_simulation_and_the_address_bar_keeps_them() {
+    let address = serve(small(1), true, Speed::Real);
+    let mut page = Browser::open(
+        &format!("http://{address}/?robots=3&pucks=12&seed=77&field=letter:T"),
+        SIZE,
+    );
+    page.wait_for("document.documentElement.dataset.generation === '1'", 60);
+    let s = state(address);
+    assert_eq!(s["frame"]["robots"].as_array().unwrap().len(), 12);
+    assert_eq!(s["frame"]["pucks"].as_array().unwrap().len(), 24);
+    let search = page.eval("location.search").as_str().unwrap().to_string();
+    assert!(
+        search.contains("seed=77") && search.contains("robots=3") && search.contains("letter%3AT"),
+        "{search}"
+    );
+}
+
+#[test]
+fn a_bad_setting_or_policy_file_is_refused_with_a_message_and_nothing_else_changes() {
+    let address = serve(small(4), true, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+    let before = state(address);
+    page.eval("const f = document.getElementById('settings'); f.elements.robots.value = '0'; f.elements.seed.value = '5'; f.requestSubmit()");
+    page.wait_for("document.documentElement.dataset.error !== ''", 30);
+    let error = page.data("error");
+    assert!(
+        error.contains("robots = 0") && error.contains("outside"),
+        "{error}"
+    );
+    page.eval("const d = new DataTransfer(); d.items.add(new File([new Uint8Array([1, 2, 3, 4])], 'broken.policy')); const u = document.getElementById('upload'); u.files = d.files; u.dispatchEvent(new Event('change'))");
+    page.wait_for(
+        "document.documentElement.dataset.error.includes('broken.policy')",
+        30,
+    );
+    let after = state(address);
+    assert_eq!(after["hello"], before["hello"], "the settings changed");
+    assert_eq!(after["frame"]["step"], before["frame"]["step"]);
+    assert_eq!(after["frame"]["robots"], before["frame"]["robots"]);
+}
