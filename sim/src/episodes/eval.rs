@@ -160,7 +160,8 @@ impl EvalTracker {
             distances: vec![0; world.bodies().len()],
             total: 0,
             lookup,
-            changes: Vec::new(),
+            // at most one change per puck: an update never allocates
+            changes: Vec::with_capacity(world.pucks().len()),
         };
         tracker.rebuild(world, field, t);
         tracker
