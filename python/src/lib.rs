@@ -8,7 +8,8 @@
 //! in parallel, [`observation`] turns readings into arrays, and
 //! [`policy_codec`] encodes greedy tables with `shared`'s blob format. The
 //! Gymnasium and PettingZoo classes are Python (`zumo_swarm/`), over
-//! [`PyBatch`].
+//! [`PyBatch`]; their `render_mode="human"` hands world 0 to the `view`
+//! crate's `View::follow` after every step and reset.
 #![warn(missing_docs)]
 
 pub mod batch;
