@@ -4,7 +4,7 @@
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::process::{Child, Command, Stdio};
+use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant};
 
 const HOST: &str = env!("CARGO_BIN_EXE_host");
@@ -13,6 +13,9 @@ const HOST: &str = env!("CARGO_BIN_EXE_host");
 struct Served {
     child: Child,
     address: String,
+    /// Kept open: `host view` prints more after its first line, and a
+    /// pipe closed under it kills it with SIGPIPE.
+    _stdout: BufReader<ChildStdout>,
 }
 
 impl Drop for Served {
@@ -30,16 +33,19 @@ fn serve(args: &[&str]) -> Served {
         .spawn()
         .expect("cannot start host view");
     let mut first = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut first)
-        .unwrap();
+    let mut stdout = BufReader::new(child.stdout.take().unwrap());
+    stdout.read_line(&mut first).unwrap();
     let address = first
         .trim()
         .strip_prefix("view: serving http://")
         .unwrap_or_else(|| panic!("first line: {first:?}"))
         .trim_end_matches('/')
         .to_string();
-    Served { child, address }
+    Served {
+        child,
+        address,
+        _stdout: stdout,
+    }
 }
 
 fn request(address: &str, method: &str, path: &str) -> (u16, String) {

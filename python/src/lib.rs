@@ -8,7 +8,8 @@
 //! in parallel, [`observation`] turns readings into arrays, and
 //! [`policy_codec`] encodes greedy tables with `shared`'s blob format. The
 //! Gymnasium and PettingZoo classes are Python (`zumo_swarm/`), over
-//! [`PyBatch`].
+//! [`PyBatch`]; their `render_mode="human"` hands world 0 to the `view`
+//! crate's `View::follow` after every step and reset.
 #![warn(missing_docs)]
 
 pub mod batch;
@@ -46,6 +47,9 @@ fn step_error(e: StepError) -> PyErr {
 #[pyclass(module = "zumo_swarm._native", name = "Batch")]
 pub struct PyBatch {
     batch: Batch,
+    /// The live view of world 0 (`render_mode="human"`), fed after every
+    /// step and reset.
+    view: Option<view::Follower>,
 }
 
 fn observations_array<'py>(
@@ -66,6 +70,21 @@ impl PyBatch {
         match self.batch.settings().observation {
             ObservationKind::Reading => vec![worlds, robots, READING_LEN],
             ObservationKind::State(_) => vec![worlds, robots],
+        }
+    }
+
+    /// Gives the live view, if one is served, world 0 after a step or
+    /// (`restarted`) a reset.
+    fn feed_view(&self, restarted: bool) -> PyResult<()> {
+        let Some(view) = &self.view else {
+            return Ok(());
+        };
+        let sim = self.batch.worlds()[0].sim();
+        if restarted {
+            view.reset(sim).map_err(PyRuntimeError::new_err)
+        } else {
+            view.step(sim);
+            Ok(())
         }
     }
 
@@ -177,7 +196,7 @@ impl PyBatch {
                     .map_err(|e| e.to_string())
             })
             .map_err(PyValueError::new_err)?;
-        Ok(PyBatch { batch })
+        Ok(PyBatch { batch, view: None })
     }
 
     /// Number of worlds.
@@ -311,6 +330,7 @@ impl PyBatch {
         let obs = py
             .detach(|| batch.reset(seeds.as_deref()))
             .map_err(value_error)?;
+        self.feed_view(true)?;
         observations_array(py, obs, &self.observation_shape(n))
     }
 
@@ -348,6 +368,8 @@ impl PyBatch {
             ));
         }
         .map_err(step_error)?;
+        // world 0 started a new episode in this step (autoreset)
+        self.feed_view(out.steps[0].reset || out.final_mask.first() == Some(&true))?;
         let n = out.steps.len();
         let shape = self.observation_shape(n);
         let column = |f: &dyn Fn(&world_env::WorldStep) -> f64| {
@@ -409,6 +431,31 @@ impl PyBatch {
         Ok((obs, rewards, terminated, truncated, info, robot_rewards)
             .into_pyobject(py)?
             .into_any())
+    }
+
+    /// Serves the live view of world 0 (`docs/view.md`) on `bind` (by
+    /// default loopback, any free port) until [`PyBatch::close_view`] or
+    /// the batch is dropped; every step and reset is shown. Returns the
+    /// page's address.
+    #[pyo3(signature = (bind = "127.0.0.1:0"))]
+    fn serve_view(&mut self, bind: &str) -> PyResult<String> {
+        let address = bind.parse().map_err(|e| {
+            value_error(format!(
+                "bind = {bind:?}: expected an address and port such as 127.0.0.1:0 ({e})"
+            ))
+        })?;
+        // the old one stops first, so its port is free again
+        self.view = None;
+        let follower = view::View::follow(address, self.batch.worlds()[0].sim())
+            .map_err(PyRuntimeError::new_err)?;
+        let url = follower.url();
+        self.view = Some(follower);
+        Ok(url)
+    }
+
+    /// Stops the live view, if one is served.
+    fn close_view(&mut self) {
+        self.view = None;
     }
 
     /// World `world` drawn as `host render` draws it: an RGB array of

@@ -48,8 +48,11 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   largest of ``actions``);
 - ``actions=None``: the angular speeds, 2 to 4 (default 0.3, 0.15, -0.15,
   -0.3; positive turns right); ``forward_speed=2.0`` units per step;
-- ``render_mode=None`` or ``"rgb_array"`` (the picture ``host render``
-  draws), ``render_size=800`` pixels.
+- ``render_mode=None``, ``"rgb_array"`` (the picture ``host render``
+  draws) or, for one world, ``"human"`` (the live view of ``host view``,
+  served on loopback for the environment's own world, its address
+  printed and in ``env.view_url``; docs/python.md), ``render_size=800``
+  pixels.
 
 A bad argument raises ``ValueError`` or ``TypeError`` naming it; an
 unknown keyword is refused with the closest valid name and the list.

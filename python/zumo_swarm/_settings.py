@@ -25,6 +25,10 @@ from zumo_swarm._native import Batch
 #: Render modes of every environment: the picture ``host render`` draws.
 RENDER_MODES = ["rgb_array"]
 
+#: Render modes of the environments of one world: also ``"human"``, the
+#: live view in a browser (docs/view.md).
+ONE_WORLD_RENDER_MODES = ["rgb_array", "human"]
+
 #: The simulator settings every environment takes: the native batch's
 #: keyword arguments, less those the environments set themselves.
 SETTINGS = tuple(name for name in inspect.signature(Batch).parameters if name not in ("num_worlds", "autoreset", "threads"))
@@ -88,11 +92,12 @@ def make_batch(
     return Batch(num_worlds, autoreset=autoreset, threads=threads, **settings)
 
 
-def check_render(render_mode: str | None, render_size: int) -> tuple[str | None, int]:
-    """``render_mode`` ``None`` or ``"rgb_array"``, ``render_size`` 16 to 4096
+def check_render(render_mode: str | None, render_size: int, modes: list[str] = RENDER_MODES) -> tuple[str | None, int]:
+    """``render_mode`` ``None`` or one of ``modes``, ``render_size`` 16 to 4096
     pixels; anything else is refused by name."""
-    if render_mode is not None and render_mode not in RENDER_MODES:
-        raise ValueError(f"render_mode = {render_mode!r}: expected None or 'rgb_array'")
+    if render_mode is not None and render_mode not in modes:
+        expected = " or ".join(["None"] + [repr(m) for m in modes])
+        raise ValueError(f"render_mode = {render_mode!r}: expected {expected}")
     if not isinstance(render_size, (int, np.integer)) or not 16 <= render_size <= 4096:
         raise ValueError(f"render_size = {render_size!r}: must be a whole number of pixels from 16 to 4096")
     return render_mode, int(render_size)
@@ -146,14 +151,33 @@ def world_info(info: dict[str, np.ndarray], world: int) -> dict[str, Any]:
 
 
 class OneWorld:
-    """What the environments of one world share: drawing it and its bodies
-    (the class has ``_batch``, ``render_mode`` and ``render_size``)."""
+    """What the environments of one world share: drawing it, its live view
+    and its bodies (the class has ``_batch``, ``render_mode`` and
+    ``render_size``)."""
+
+    #: The live view's address with ``render_mode="human"``, else None.
+    view_url: str | None = None
+
+    def _start_view(self) -> None:
+        """With ``render_mode="human"``: serves the live view of this world
+        on loopback (any free port), every step and reset shown, and prints
+        its address once."""
+        if self.render_mode == "human":
+            self.view_url = self._batch.serve_view()
+            print(f"zumo_swarm: live view at {self.view_url}", flush=True)
 
     def render(self):
-        """The world as ``host render`` draws it (``render_mode="rgb_array"``)."""
-        if self.render_mode is None:
+        """The world as ``host render`` draws it (``render_mode="rgb_array"``);
+        None with ``"human"`` (the live view shows every step by itself) or
+        no render mode."""
+        if self.render_mode in (None, "human"):
             return None
         return self._batch.render(0, self.render_size)
+
+    def close(self) -> None:
+        """Stops the live view, if one is served."""
+        self._batch.close_view()
+        self.view_url = None
 
     def positions(self):
         """Bodies' positions (robots first, then pucks) and the robots' headings."""

@@ -9,6 +9,7 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from zumo_swarm._settings import (
+    ONE_WORLD_RENDER_MODES,
     OneWorld,
     check_render,
     flat_actions,
@@ -38,10 +39,10 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
     Keyword arguments: see :func:`zumo_swarm.parallel_env`.
     """
 
-    metadata = {"name": "zumo_swarm_v0", "render_modes": ["rgb_array"], "render_fps": 30, "is_parallelizable": True}
+    metadata = {"name": "zumo_swarm_v0", "render_modes": ONE_WORLD_RENDER_MODES, "render_fps": 30, "is_parallelizable": True}
 
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
-        self.render_mode, self.render_size = check_render(render_mode, render_size)
+        self.render_mode, self.render_size = check_render(render_mode, render_size, ONE_WORLD_RENDER_MODES)
         self.settings = dict(settings)
         self._batch = make_batch(1, "off", 1, settings, ("render_mode", "render_size"))
         self.possible_agents = [f"robot_{i}" for i in range(self._batch.robots)]
@@ -50,6 +51,7 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         self._action_space = robot_action_space(self._batch)
         #: The global state :meth:`state` returns.
         self.state_space = spaces.Box(-1.0, 1.0, shape=(self._batch.state_size,), dtype=np.float32)
+        self._start_view()
 
     def observation_space(self, agent: str):
         """Every agent's observation space (the same object for all)."""
@@ -103,5 +105,3 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         it."""
         return self._batch.state(0)
 
-    def close(self) -> None:
-        pass

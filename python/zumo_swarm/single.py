@@ -8,6 +8,7 @@ from typing import Any
 import gymnasium as gym
 
 from zumo_swarm._settings import (
+    ONE_WORLD_RENDER_MODES,
     OneWorld,
     check_render,
     flat_actions,
@@ -31,14 +32,15 @@ class SwarmEnv(OneWorld, gym.Env):
     first one is the constructor's ``seed``'s).
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    metadata = {"render_modes": ONE_WORLD_RENDER_MODES, "render_fps": 30}
 
     def __init__(self, *, render_mode: str | None = None, render_size: int = 800, **settings: Any) -> None:
-        self.render_mode, self.render_size = check_render(render_mode, render_size)
+        self.render_mode, self.render_size = check_render(render_mode, render_size, ONE_WORLD_RENDER_MODES)
         self.settings = dict(settings)
         self._batch = make_batch(1, "off", 1, settings, ("render_mode", "render_size"))
         self.observation_space = world_observation_space(self._batch)
         self.action_space = world_action_space(self._batch)
+        self._start_view()
 
     @property
     def batch(self):

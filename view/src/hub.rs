@@ -40,6 +40,11 @@ impl Hub {
         before - viewers.len()
     }
 
+    /// Drops every viewer (their queues end once read).
+    pub fn close(&self) {
+        self.lock().clear();
+    }
+
     /// Viewers connected.
     pub fn viewers(&self) -> usize {
         self.lock().len()

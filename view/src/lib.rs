@@ -16,5 +16,5 @@ pub mod server;
 pub mod session;
 pub mod settings;
 
-pub use server::{Speed, View, ViewOptions};
+pub use server::{Follower, Speed, View, ViewOptions};
 pub use settings::{Allowed, ViewController, ViewSettings};

@@ -12,16 +12,19 @@
 
 use crate::http::{self, Request};
 use crate::hub::Hub;
-use crate::session::{Frame, Hello, Policy, Session};
+use crate::session::{self, Frame, Hello, History, Policy, Session};
 use crate::settings::{self, valid_name, Allowed, ViewController, ViewSettings};
 use serde::Serialize;
 use sim::base::ranges;
 use sim::control::policy_file;
+use sim::scenario::sensor_setup::SelectedSensors;
+use sim::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::net::{SocketAddr, TcpListener, TcpStream};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 use tungstenite::protocol::Role;
 use tungstenite::{Message, Utf8Bytes, WebSocket};
@@ -117,10 +120,72 @@ struct Shared {
     connections: AtomicUsize,
     policies: Option<PathBuf>,
     allowed: Allowed,
+    /// Set when a [`Follower`] is dropped: the server ends.
+    stopped: AtomicBool,
+}
+
+/// Where the frames come from.
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one per view, replaced only at a reset: boxing would buy nothing"
+)]
+enum Source {
+    /// A simulation of the view's own, stepped by its thread.
+    Own(Session),
+    /// A world someone else steps ([`Follower`]): its last hello and frame,
+    /// and whether that frame is published yet.
+    Fed {
+        hello: Hello,
+        frame: Frame,
+        published: bool,
+    },
+}
+
+/// Refusal of the controls when the view follows a world stepped elsewhere.
+const FOLLOWING: &str =
+    "this view follows a world its owner steps (a Python environment): controls and settings are not available";
+
+impl Source {
+    fn own(&mut self) -> Result<&mut Session, String> {
+        match self {
+            Source::Own(session) => Ok(session),
+            Source::Fed { .. } => Err(FOLLOWING.into()),
+        }
+    }
+
+    fn hello(&self) -> Hello {
+        match self {
+            Source::Own(session) => session.hello(),
+            Source::Fed { hello, .. } => hello.clone(),
+        }
+    }
+
+    fn frame(&self) -> Frame {
+        match self {
+            Source::Own(session) => session.frame(),
+            Source::Fed { frame, .. } => frame.clone(),
+        }
+    }
+
+    /// One step of the view's own simulation.
+    fn step(&mut self) {
+        if let Source::Own(session) = self {
+            session.step();
+        }
+    }
+
+    fn steps(&self) -> u64 {
+        match self {
+            Source::Own(session) => session.simulation().totals().steps,
+            Source::Fed { frame, .. } => frame.step,
+        }
+    }
 }
 
 struct Control {
-    session: Session,
+    source: Source,
+    /// The Eval plot's points since the last reset.
+    history: History,
     /// Bumped at every reset: the field image's and hello's version.
     generation: u64,
     hello: Utf8Bytes,
@@ -168,26 +233,92 @@ impl View {
     /// Builds the first simulation and starts listening and stepping;
     /// errors name the setting or the address.
     pub fn start(options: ViewOptions) -> Result<View, String> {
-        let listener = TcpListener::bind(options.bind)
-            .map_err(|e| format!("cannot listen on {}: {e}", options.bind))?;
-        let address = listener
-            .local_addr()
-            .map_err(|e| format!("cannot read the address of {}: {e}", options.bind))?;
         let policy = policy_for(
             &options.settings,
             options.policies.as_deref(),
             &BTreeMap::new(),
         )?;
         let session = Session::build(options.settings, policy)?;
-        let field_png = Arc::new(session.field_png()?);
+        let field_png = session.field_png()?;
+        let view = View::listen(
+            options.bind,
+            Source::Own(session),
+            field_png,
+            options.policies,
+            options.allowed,
+            options.paused,
+            options.speed,
+        )?;
+        let stepper = view.shared.clone();
+        std::thread::Builder::new()
+            .name("view-sim".into())
+            .spawn(move || stepper.run())
+            .map_err(|e| format!("cannot start the simulation's thread: {e}"))?;
+        Ok(view)
+    }
+
+    /// Listens on `bind` (port 0: any free one) and serves frames of a world
+    /// the caller steps: `sim` as it is now, then whatever the returned
+    /// [`Follower`] is given after each step or reset. The page's controls
+    /// and settings are refused. Serves from background threads until the
+    /// follower is dropped.
+    pub fn follow(bind: SocketAddr, sim: &Simulation<SelectedSensors>) -> Result<Follower, String> {
+        let source = Source::Fed {
+            hello: Hello::of(sim, Vec::new()),
+            frame: Frame::of(sim),
+            published: false,
+        };
+        let view = View::listen(
+            bind,
+            source,
+            session::field_png(sim)?,
+            None,
+            Allowed::default(),
+            true,
+            Speed::Real,
+        )?;
+        let shared = view.shared.clone();
+        let address = view.address;
+        let publisher = shared.clone();
+        std::thread::Builder::new()
+            .name("view-publish".into())
+            .spawn(move || publisher.publish_fed())
+            .map_err(|e| format!("cannot start the publishing thread: {e}"))?;
+        let accept = std::thread::Builder::new()
+            .name("view-accept".into())
+            .spawn(move || view.serve())
+            .map_err(|e| format!("cannot start the server's thread: {e}"))?;
+        Ok(Follower {
+            shared,
+            address,
+            accept: Some(accept),
+        })
+    }
+
+    /// Listens on `bind` and sets up the state `source` starts with.
+    fn listen(
+        bind: SocketAddr,
+        source: Source,
+        field_png: Vec<u8>,
+        policies: Option<PathBuf>,
+        allowed: Allowed,
+        paused: bool,
+        speed: Speed,
+    ) -> Result<View, String> {
+        let listener =
+            TcpListener::bind(bind).map_err(|e| format!("cannot listen on {bind}: {e}"))?;
+        let address = listener
+            .local_addr()
+            .map_err(|e| format!("cannot read the address of {bind}: {e}"))?;
         let shared = Arc::new(Shared {
             control: Mutex::new(Control {
-                session,
+                source,
+                history: History::default(),
                 generation: 0,
                 hello: Utf8Bytes::from_static(""),
-                field_png,
-                paused: options.paused,
-                speed: options.speed,
+                field_png: Arc::new(field_png),
+                paused,
+                speed,
                 pending: 0,
                 anchor: (Instant::now(), 0),
                 last_publish: None,
@@ -198,18 +329,16 @@ impl View {
             wake: Condvar::new(),
             hub: Hub::default(),
             connections: AtomicUsize::new(0),
-            policies: options.policies,
-            allowed: options.allowed,
+            policies,
+            allowed,
+            stopped: AtomicBool::new(false),
         });
         {
             let mut c = shared.lock();
+            let frame = c.source.frame();
+            c.history.record(&frame);
             c.hello = shared.hello_message(&c);
         }
-        let stepper = shared.clone();
-        std::thread::Builder::new()
-            .name("view-sim".into())
-            .spawn(move || stepper.run())
-            .map_err(|e| format!("cannot start the simulation's thread: {e}"))?;
         Ok(View {
             address,
             listener,
@@ -230,6 +359,9 @@ impl View {
     /// Answers connections until the process ends, each in its own thread.
     pub fn serve(&self) {
         for stream in self.listener.incoming() {
+            if self.shared.stopped.load(Ordering::SeqCst) {
+                return;
+            }
             let Ok(stream) = stream else { continue };
             let shared = self.shared.clone();
             if shared.connections.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
@@ -339,8 +471,8 @@ impl Shared {
         json(&HelloMessage {
             t: "hello",
             generation: c.generation,
-            hello: &c.session.hello(),
-            history: c.session.history(),
+            hello: &c.source.hello(),
+            history: c.history.points(),
             policies: policy_names(self.policies.as_deref()),
             uploads: c.uploads.keys().cloned().collect(),
             arenas,
@@ -348,6 +480,10 @@ impl Shared {
     }
 
     fn frame_message(&self, c: &Control) -> Utf8Bytes {
+        self.frame_message_of(c, &c.source.frame())
+    }
+
+    fn frame_message_of(&self, c: &Control, frame: &Frame) -> Utf8Bytes {
         let rate = match (c.meter.first(), c.meter.last()) {
             (Some(a), Some(b)) if b.0 > a.0 => (b.1 - a.1) as f64 / (b.0 - a.0).as_secs_f64(),
             _ => 0.0,
@@ -359,29 +495,59 @@ impl Shared {
             speed: c.speed.name(),
             steps_per_second: (rate * 10.0).round() / 10.0,
             viewers: self.hub.viewers(),
-            frame: &c.session.frame(),
+            frame,
         })
     }
 
     fn publish(&self, c: &mut Control) {
-        c.session.record();
+        let frame = c.source.frame();
+        c.history.record(&frame);
         c.last_publish = Some(Instant::now());
-        let message = self.frame_message(c);
+        let message = self.frame_message_of(c, &frame);
         self.hub.publish(&message);
     }
 
     /// Replaces the simulation (a reset, new settings) and tells every viewer.
     fn replace(&self, c: &mut Control, session: Session) -> Result<(), String> {
         let png = session.field_png()?;
-        c.session = session;
+        c.source = Source::Own(session);
+        self.restart(c, png);
+        self.publish(c);
+        Ok(())
+    }
+
+    /// A new generation: its field image, an empty plot, a hello to every viewer.
+    fn restart(&self, c: &mut Control, png: Vec<u8>) {
         c.field_png = Arc::new(png);
+        c.history = History::default();
         c.generation += 1;
         c.anchor = (Instant::now(), 0);
         c.meter.clear();
         c.hello = self.hello_message(c);
         self.hub.publish(&c.hello);
-        self.publish(c);
-        Ok(())
+    }
+
+    /// The publishing thread of a [`Follower`]: the newest frame it was
+    /// given, at most [`FRAMES_PER_SECOND`] a second, and always the last.
+    fn publish_fed(&self) {
+        let frame_gap = Duration::from_secs_f64(1.0 / FRAMES_PER_SECOND);
+        let mut c = self.lock();
+        while !self.stopped.load(Ordering::SeqCst) {
+            if let Source::Fed { published, .. } = &mut c.source {
+                if !*published {
+                    *published = true;
+                    self.publish(&mut c);
+                    drop(c);
+                    std::thread::sleep(frame_gap);
+                    c = self.lock();
+                    continue;
+                }
+            }
+            c = self
+                .wake
+                .wait(c)
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+        }
     }
 
     /// The simulation's thread: steps at the chosen speed, publishes.
@@ -403,7 +569,7 @@ impl Shared {
                 // single steps run in chunks, so controls stay answered
                 let n = c.pending.min(10_000);
                 for _ in 0..n {
-                    c.session.step();
+                    c.source.step();
                 }
                 c.pending -= n;
                 stepped = true;
@@ -420,7 +586,7 @@ impl Shared {
                             c.anchor = (now, due.saturating_sub(1));
                         }
                         for _ in 0..n {
-                            c.session.step();
+                            c.source.step();
                         }
                         c.anchor.1 += n;
                         stepped = n > 0;
@@ -428,14 +594,14 @@ impl Shared {
                     None => {
                         let until = now + Duration::from_millis(8);
                         while Instant::now() < until {
-                            c.session.step();
+                            c.source.step();
                         }
                         stepped = true;
                     }
                 }
             }
             if stepped {
-                let steps = c.session.simulation().totals().steps;
+                let steps = c.source.steps();
                 c.meter.push((Instant::now(), steps));
                 let recent = Instant::now() - Duration::from_secs(1);
                 let old = c.meter.iter().take_while(|m| m.0 < recent).count();
@@ -544,6 +710,7 @@ impl Shared {
                 .map(|(_, v)| v.as_str())
         };
         let mut c = self.lock();
+        c.source.own()?;
         if let Some(speed) = get("speed") {
             c.speed = speed.parse()?;
             c.anchor = (Instant::now(), 0);
@@ -577,7 +744,7 @@ impl Shared {
                 c.pending += steps;
             }
             Some("reset") => {
-                let mut next = c.session.settings().clone();
+                let mut next = c.source.own()?.settings().clone();
                 if let Some(seed) = get("seed") {
                     next.seed = seed.parse().map_err(|_| {
                         format!("seed={seed}: not a whole number from 0 to 2^64 - 1")
@@ -600,10 +767,11 @@ impl Shared {
 
     fn settings(&self, query: &str) -> Result<(), String> {
         let mut c = self.lock();
-        let next = c
-            .session
-            .settings()
-            .with_query(query, &self.allowed, &["speed", "paused"])?;
+        let next =
+            c.source
+                .own()?
+                .settings()
+                .with_query(query, &self.allowed, &["speed", "paused"])?;
         let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
         let session = Session::build(next, policy)?;
         self.replace(&mut c, session)?;
@@ -612,6 +780,7 @@ impl Shared {
     }
 
     fn upload(&self, query: &str, body: &[u8]) -> Result<String, String> {
+        self.lock().source.own()?;
         let pairs = settings::query_pairs(query);
         let name = pairs
             .iter()
@@ -668,5 +837,72 @@ impl Shared {
         }
         let _ = socket.close(None);
         let _ = socket.flush();
+    }
+}
+
+/// The server of a world the caller steps ([`View::follow`]): give it the
+/// world after each step ([`Follower::step`]) and reset
+/// ([`Follower::reset`]); dropping it stops the server.
+pub struct Follower {
+    shared: Arc<Shared>,
+    address: SocketAddr,
+    accept: Option<JoinHandle<()>>,
+}
+
+impl Follower {
+    /// Where it listens.
+    pub fn address(&self) -> SocketAddr {
+        self.address
+    }
+
+    /// The page's address.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.address)
+    }
+
+    /// `sim` after a step: its frame, published by the server's thread (at
+    /// most [`FRAMES_PER_SECOND`] a second; the newest is always sent).
+    pub fn step(&self, sim: &Simulation<SelectedSensors>) {
+        let frame = Frame::of(sim);
+        let mut c = self.shared.lock();
+        if let Source::Fed {
+            frame: last,
+            published,
+            ..
+        } = &mut c.source
+        {
+            *last = frame;
+            *published = false;
+        }
+        self.shared.wake.notify_all();
+    }
+
+    /// `sim` after a reset (a new episode, a new seed): a new hello and
+    /// field image, then its frame.
+    pub fn reset(&self, sim: &Simulation<SelectedSensors>) -> Result<(), String> {
+        let png = session::field_png(sim)?;
+        let mut c = self.shared.lock();
+        c.source = Source::Fed {
+            hello: Hello::of(sim, Vec::new()),
+            frame: Frame::of(sim),
+            published: false,
+        };
+        self.shared.restart(&mut c, png);
+        self.shared.wake.notify_all();
+        Ok(())
+    }
+}
+
+impl Drop for Follower {
+    fn drop(&mut self) {
+        self.shared.stopped.store(true, Ordering::SeqCst);
+        self.shared.wake.notify_all();
+        // wake the accepting thread, which then sees `stopped` and ends,
+        // closing the listener; viewers' queues end with the hub's list
+        let _ = TcpStream::connect_timeout(&self.address, Duration::from_secs(1));
+        if let Some(accept) = self.accept.take() {
+            let _ = accept.join();
+        }
+        self.shared.hub.close();
     }
 }

@@ -28,7 +28,34 @@ pub struct Session {
     settings: ViewSettings,
     sim: Simulation<SelectedSensors>,
     controller: Box<dyn Controller + Send>,
-    history: Vec<[f64; 2]>,
+}
+
+/// The Eval plot's points (step, Eval), at most [`HISTORY_POINTS`].
+#[derive(Clone, Debug, Default)]
+pub struct History(Vec<[f64; 2]>);
+
+impl History {
+    /// Adds a frame's step and Eval (once a step); past
+    /// [`HISTORY_POINTS`], every other point is dropped.
+    pub fn record(&mut self, frame: &Frame) {
+        let point = [frame.step as f64, frame.eval];
+        if self.0.last().is_some_and(|p| p[0] == point[0]) {
+            return;
+        }
+        if self.0.len() >= HISTORY_POINTS {
+            let mut k = 0;
+            self.0.retain(|_| {
+                k += 1;
+                k % 2 == 1
+            });
+        }
+        self.0.push(point);
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[[f64; 2]] {
+        &self.0
+    }
 }
 
 /// A policy to drive the robots with, already read or decoded.
@@ -96,14 +123,11 @@ impl Session {
             None => scenario.build(),
         };
         let (sim, controller) = built.map_err(|e| e.to_string())?;
-        let mut session = Session {
+        Ok(Session {
             settings,
             sim,
             controller,
-            history: Vec::new(),
-        };
-        session.record();
-        Ok(session)
+        })
     }
 
     /// The settings.
@@ -121,60 +145,58 @@ impl Session {
         self.sim.step(self.controller.as_mut());
     }
 
-    /// Adds the current Eval to the plot's points.
-    pub fn record(&mut self) {
-        let point = [self.sim.totals().steps as f64, self.sim.eval()];
-        if self.history.last().is_some_and(|p| p[0] == point[0]) {
-            return;
-        }
-        if self.history.len() >= HISTORY_POINTS {
-            let mut k = 0;
-            self.history.retain(|_| {
-                k += 1;
-                k % 2 == 1
-            });
-        }
-        self.history.push(point);
-    }
-
-    /// The Eval plot's points: step, Eval.
-    pub fn history(&self) -> &[[f64; 2]] {
-        &self.history
-    }
-
     /// What stays until the next reset.
     pub fn hello(&self) -> Hello {
-        let world = self.sim.world().config();
+        Hello::of(&self.sim, self.settings.pairs())
+    }
+
+    /// The field as grey with the target band outlined, as a PNG
+    /// [`FIELD_IMAGE_WIDTH`] pixels wide.
+    pub fn field_png(&self) -> Result<Vec<u8>, String> {
+        field_png(&self.sim)
+    }
+
+    /// The current state.
+    pub fn frame(&self) -> Frame {
+        Frame::of(&self.sim)
+    }
+}
+
+impl Hello {
+    /// What stays of `sim` until its next reset; `settings` as URL parameters.
+    pub fn of(sim: &Simulation<SelectedSensors>, settings: Vec<(&'static str, String)>) -> Hello {
+        let world = sim.world().config();
         let arena = world.arena();
         Hello {
             arena: [arena.x, arena.y],
             robot_radius: world.robot_radius,
             puck_radius: world.puck_radius,
             outline: Outline::of(world.robot_shape, world.robot_radius).map(|o| boundary(&o)),
-            settings: self.settings.pairs(),
-            check_interval: self.sim.config().episode.check_interval,
+            settings,
+            check_interval: sim.config().episode.check_interval,
         }
     }
+}
 
-    /// The field as grey with the target band outlined, as a PNG
-    /// [`FIELD_IMAGE_WIDTH`] pixels wide.
-    pub fn field_png(&self) -> Result<Vec<u8>, String> {
-        let options = RenderOptions {
-            size: FIELD_IMAGE_WIDTH,
-            footprints: false,
-            band: true,
-        };
-        let image = render::draw_ground(&self.sim, options);
-        let mut png = Vec::new();
-        image::DynamicImage::ImageRgb8(image)
-            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-            .map_err(|e| format!("cannot encode the field image: {e}"))?;
-        Ok(png)
-    }
+/// `sim`'s field as grey with the target band outlined, as a PNG
+/// [`FIELD_IMAGE_WIDTH`] pixels wide.
+pub fn field_png(sim: &Simulation<SelectedSensors>) -> Result<Vec<u8>, String> {
+    let options = RenderOptions {
+        size: FIELD_IMAGE_WIDTH,
+        footprints: false,
+        band: true,
+    };
+    let image = render::draw_ground(sim, options);
+    let mut png = Vec::new();
+    image::DynamicImage::ImageRgb8(image)
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .map_err(|e| format!("cannot encode the field image: {e}"))?;
+    Ok(png)
+}
 
-    /// The current state.
-    pub fn frame(&self) -> Frame {
-        let sim = &self.sim;
+impl Frame {
+    /// `sim`'s current state.
+    pub fn of(sim: &Simulation<SelectedSensors>) -> Frame {
         let world = sim.world();
         let totals = sim.totals();
         let robots = world
@@ -280,11 +302,12 @@ mod tests {
             None,
         )
         .unwrap();
+        let mut history = History::default();
         for _ in 0..3 * HISTORY_POINTS {
             session.step();
-            session.record();
+            history.record(&session.frame());
         }
-        assert!(session.history().len() <= HISTORY_POINTS);
-        assert!(session.history().windows(2).all(|w| w[0][0] < w[1][0]));
+        assert!(history.points().len() <= HISTORY_POINTS);
+        assert!(history.points().windows(2).all(|w| w[0][0] < w[1][0]));
     }
 }
