@@ -10,12 +10,12 @@
 //! | clock               | Timer3 free-running at clk/64 (4 us ticks): control period and RC timing |
 //! | Pixy                | TWI master 100 kHz, address 0x54, one 2-byte read per word; a stuck bus is freed by clocking SCL by hand |
 //! | encoders            | left XOR PB4 (PCINT0 vector), B PE2; right XOR PE6 (INT6, any edge), B PF0; pulled-up inputs |
-//! | log                 | USART1 TX (PD3), 115200 8N1, U2X1            |
+//! | log                 | USART1 TX (PD3), 115200 8N1, U2X1, fed from `firmware::log_queue` |
 //! | buttons             | A PB3, B PD5 (shared with the green LED), both active low |
 //! | LEDs                | yellow PC7 (high = on), green PD5 and red PB0 (low = on) |
 //! | markers             | GPIOR0 (simulator cycle counting): 4 at a period's start, 1 before a decision, 2 after the motor writes, 3 after the log frame is sent |
 //! | identity            | `shared::FirmwareIdentity` record in flash: robot id and policy CRC |
-//! | USB serial port     | the USB controller, polled (`board::usb`): while waiting for the next period, once per TWI step and per USART byte (while the hardware moves the byte), while an EEPROM write completes |
+//! | USB serial port     | the USB controller, polled (`board::usb`): while waiting for the next period, once per TWI step, while an EEPROM write completes; each service first moves a queued log byte into USART1 |
 //!
 //! Interrupts: only the two encoder interrupts are enabled; the timed
 //! sequences (watchdog, EEPROM) and the reads of the counts run with
@@ -30,6 +30,7 @@ use core::cell::{Cell, RefCell};
 use firmware::camera::{BusError, WordSource};
 use firmware::config::{PERIOD_TICKS, RC_CHARGE_US, TICK_US, TWI_TIMEOUT_TICKS, USB_QUIET_TICKS};
 use firmware::embedded;
+use firmware::log_queue::LogQueue;
 use firmware::odometry::Quadrature;
 use firmware::pins;
 use firmware::rc::Discharge;
@@ -162,6 +163,14 @@ const WDP1_0: u8 = 0b11; // with WDP2 = 0: 125 ms, the touch's reset
 /// and writes it only for a 1200-baud touch.
 const BOOT_KEY_AT: *mut u16 = firmware::usb::BOOT_KEY_ADDR as *mut u16;
 
+/// The log queue. Only `Board::send` and `Board::feed_usart` call this,
+/// from the control loop (never from an interrupt), and neither keeps the
+/// reference past its own statement: no two references are ever live.
+fn log_queue() -> &'static mut LogQueue<LOG_QUEUE_LEN> {
+    // SAFETY: see above.
+    unsafe { &mut *core::ptr::addr_of_mut!(LOG_QUEUE) }
+}
+
 /// The peripherals, the control period's clock and the USB serial port.
 pub struct Board {
     dp: Peripherals,
@@ -176,6 +185,15 @@ pub struct Board {
 /// rather than on the stack, which must stay above the bootloader key at
 /// 0x0800 (`tests/tests/firmware_smoke.rs` checks).
 static mut FIELD_SCALES: FieldScales = FieldScales::UNSET;
+
+/// Room for two of the longest log frames: one going out while the next
+/// period queues its own.
+const LOG_QUEUE_LEN: usize = 2 * shared::LogFrame::MAX_ENCODED_LEN;
+
+/// The log frames waiting for USART1, in static RAM. Reached only through
+/// [`log_queue`] (not a field of `Board`: the board lives in the control
+/// loop's stack frame, which has no bytes to spare).
+static mut LOG_QUEUE: LogQueue<LOG_QUEUE_LEN> = LogQueue::new();
 
 impl Board {
     /// First thing at start-up: stop the watchdog a reset may have left
@@ -288,6 +306,7 @@ impl Board {
     /// watchdog is set to 125 ms and no longer fed; cancelled, the key is
     /// cleared and the control loop's watchdog (250 ms) is back.
     fn serve_usb(&self) {
+        self.feed_usart();
         let Ok(mut port) = self.usb.try_borrow_mut() else {
             return;
         };
@@ -515,14 +534,25 @@ impl Board {
         });
     }
 
-    /// Sends bytes on USART1 (blocking; serves USB once per byte, while
-    /// the byte goes out: 87 us).
-    pub fn send(&self, bytes: &[u8]) {
+    /// Queues a log frame for USART1 (`firmware::log_queue`: dropped
+    /// whole and counted if the queue is full); it goes out a byte at a
+    /// time while the loop waits.
+    pub fn send(&self, frame: &[u8]) {
+        log_queue().push_frame(frame);
+        self.feed_usart();
+    }
+
+    /// Moves the next queued log byte into USART1 if its data register is
+    /// empty. Out of line: inlined into `serve_usb` it deepened the stack
+    /// under USB's service, the firmware's deepest chain.
+    #[inline(never)]
+    fn feed_usart(&self) {
         let u = &self.dp.USART1;
-        for byte in bytes {
-            while u.ucsr1a().read().bits() & (1 << 5) == 0 {} // UDRE1
-            u.udr1().write(|w| unsafe { w.bits(*byte) });
-            self.serve_usb();
+        if u.ucsr1a().read().bits() & (1 << 5) == 0 {
+            return; // UDRE1: the last byte is still in the data register
+        }
+        if let Some(byte) = log_queue().pop() {
+            u.udr1().write(|w| unsafe { w.bits(byte) });
         }
     }
 

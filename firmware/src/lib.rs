@@ -14,6 +14,7 @@ pub mod config;
 pub mod decision;
 pub mod embedded;
 pub mod health;
+pub mod log_queue;
 pub mod odometry;
 pub mod pins;
 pub mod pixy;

@@ -3,7 +3,7 @@
 //!
 //! Each 20 ms period: encoder counts of the period before -> buttons -> field sensors (RC timing) -> Pixy blocks
 //! -> supervisor (mode, faults) -> decision -> motors -> EEPROM (after a
-//! calibration from the display's screens) -> LEDs -> log frame on USART1
+//! calibration from the display's screens) -> LEDs -> log frame queued for USART1
 //! and, when a host holds the USB serial port open, on USB. USB is served
 //! while the loop waits (`board::usb`); after a 1200-baud touch the loop
 //! only waits, motors stopped, for the watchdog to reset the chip into the

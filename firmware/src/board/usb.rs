@@ -4,8 +4,7 @@
 //!
 //! Polled, never in an interrupt: the control loop calls
 //! [`UsbPort::service`] while it waits (for the next period, once per TWI
-//! step and per USART byte while the hardware moves it, while an EEPROM
-//! write completes), so the RC timing of the field sensors and
+//! step, while an EEPROM write completes), so the RC timing of the field sensors and
 //! the encoder interrupts are never delayed by USB work, and no USB state
 //! is shared with an interrupt. One service call, in order:
 //!
