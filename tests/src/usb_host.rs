@@ -31,6 +31,8 @@ const NAK: i32 = -2;
 const STALL: i32 = -3;
 /// How long the host waits between a setup packet and its OUT data stage.
 const SETUP_TO_DATA_US: u64 = 5_000;
+/// How long the host waits after a bus reset before its first setup packet.
+const RESET_RECOVERY_US: u64 = 10_000;
 /// How long a transaction may be NAKed before the host gives up.
 const TIMEOUT_US: u64 = 50_000;
 
@@ -232,12 +234,16 @@ impl Zumo {
         (a & 0x80 != 0).then_some(a & 0x7F)
     }
 
-    /// A bus reset, then 1 ms for the firmware to take it.
+    /// A bus reset, then the reset recovery time USB 2.0 gives a device
+    /// before its first setup packet (10 ms, section 9.2.6.2). simavr's
+    /// reset disables endpoint 0 until the firmware configures it again,
+    /// which the firmware does when it next services the bus: within its
+    /// longest gap between two services, not within 1 ms.
     pub fn usb_reset(&mut self) {
         let mut none = [0u8; 0];
         let (r, _) = self.usb_ioctl(*b"usbR", 0, &mut none, 0);
         assert_eq!(r, 0, "bus reset refused");
-        self.run_us(1000);
+        self.run_us(RESET_RECOVERY_US);
     }
 
     /// One IN transaction on `ep`, retried while NAKed; an empty bulk

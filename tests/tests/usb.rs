@@ -80,6 +80,32 @@ fn the_robot_enumerates_as_a_cdc_acm_serial_port_named_by_its_robot_id() {
     assert_eq!(configuration, [1]);
 }
 
+/// A host resets the bus whenever it likes; the firmware spends most of a
+/// 20 ms period deciding and logging, so the reset lands at every point of
+/// its loop in turn (offsets 0 to 19 ms after a period starts, 1 ms apart).
+#[test]
+fn the_robot_enumerates_wherever_in_its_period_the_host_resets_the_bus() {
+    for offset_ms in 0..20 {
+        let mut z = plugged_zumo();
+        let periods = z.period_cycles().len();
+        while z.period_cycles().len() == periods {
+            z.run_us(100);
+        }
+        z.run_ms(offset_ms);
+        let (device, _) = z.usb_enumerate(9);
+        assert_eq!(
+            device.len(),
+            18,
+            "device descriptor after a reset {offset_ms} ms into a period"
+        );
+        assert_eq!(
+            z.usb_address(),
+            Some(9),
+            "address after a reset {offset_ms} ms into a period"
+        );
+    }
+}
+
 #[test]
 fn line_coding_and_control_line_state_are_answered() {
     let mut z = plugged_zumo();
