@@ -17,4 +17,5 @@ pub mod session;
 pub mod settings;
 
 pub use server::{Follower, Speed, View, ViewOptions};
+pub use session::{Companion, Learning};
 pub use settings::{Allowed, ViewController, ViewSettings};

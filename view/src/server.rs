@@ -12,7 +12,7 @@
 
 use crate::http::{self, Request};
 use crate::hub::Hub;
-use crate::session::{self, Frame, Hello, History, Policy, Session};
+use crate::session::{self, Companion, Frame, Hello, History, Learning, Policy, Session};
 use crate::settings::{self, valid_name, Allowed, ViewController, ViewSettings};
 use serde::Serialize;
 use sim::base::ranges;
@@ -210,7 +210,7 @@ struct HelloMessage<'a> {
     generation: u64,
     #[serde(flatten)]
     hello: &'a Hello,
-    history: &'a [[f64; 2]],
+    history: &'a [[f64; 3]],
     policies: Vec<String>,
     uploads: Vec<String>,
     arenas: Vec<String>,
@@ -263,8 +263,20 @@ impl View {
     /// and settings are refused. Serves from background threads until the
     /// follower is dropped.
     pub fn follow(bind: SocketAddr, sim: &Simulation<SelectedSensors>) -> Result<Follower, String> {
+        View::follow_beside(bind, sim, None)
+    }
+
+    /// [`View::follow`], the page showing `companion` beside the world.
+    pub fn follow_beside(
+        bind: SocketAddr,
+        sim: &Simulation<SelectedSensors>,
+        companion: Option<Companion>,
+    ) -> Result<Follower, String> {
         let source = Source::Fed {
-            hello: Hello::of(sim, Vec::new()),
+            hello: Hello {
+                companion: companion.clone(),
+                ..Hello::of(sim, Vec::new())
+            },
             frame: Frame::of(sim),
             published: false,
         };
@@ -292,6 +304,7 @@ impl View {
             shared,
             address,
             accept: Some(accept),
+            companion,
         })
     }
 
@@ -847,6 +860,7 @@ pub struct Follower {
     shared: Arc<Shared>,
     address: SocketAddr,
     accept: Option<JoinHandle<()>>,
+    companion: Option<Companion>,
 }
 
 impl Follower {
@@ -863,7 +877,24 @@ impl Follower {
     /// `sim` after a step: its frame, published by the server's thread (at
     /// most [`FRAMES_PER_SECOND`] a second; the newest is always sent).
     pub fn step(&self, sim: &Simulation<SelectedSensors>) {
-        let frame = Frame::of(sim);
+        self.show(Frame::of(sim));
+    }
+
+    /// [`Follower::step`] for a world a learner learns in: `learning` is
+    /// its progress, shown with the frame.
+    pub fn step_learning(&self, sim: &Simulation<SelectedSensors>, learning: Learning) {
+        self.show(Frame {
+            learning: Some(learning),
+            ..Frame::of(sim)
+        });
+    }
+
+    /// Viewers connected now.
+    pub fn viewers(&self) -> usize {
+        self.shared.hub.viewers()
+    }
+
+    fn show(&self, frame: Frame) {
         let mut c = self.shared.lock();
         if let Source::Fed {
             frame: last,
@@ -883,7 +914,10 @@ impl Follower {
         let png = session::field_png(sim)?;
         let mut c = self.shared.lock();
         c.source = Source::Fed {
-            hello: Hello::of(sim, Vec::new()),
+            hello: Hello {
+                companion: self.companion.clone(),
+                ..Hello::of(sim, Vec::new())
+            },
             frame: Frame::of(sim),
             published: false,
         };

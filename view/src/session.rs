@@ -30,15 +30,15 @@ pub struct Session {
     controller: Box<dyn Controller + Send>,
 }
 
-/// The Eval plot's points (step, Eval), at most [`HISTORY_POINTS`].
+/// The plot's points (step, Eval, formations), at most [`HISTORY_POINTS`].
 #[derive(Clone, Debug, Default)]
-pub struct History(Vec<[f64; 2]>);
+pub struct History(Vec<[f64; 3]>);
 
 impl History {
-    /// Adds a frame's step and Eval (once a step); past
+    /// Adds a frame's step, Eval and formations (once a step); past
     /// [`HISTORY_POINTS`], every other point is dropped.
     pub fn record(&mut self, frame: &Frame) {
-        let point = [frame.step as f64, frame.eval];
+        let point = [frame.step as f64, frame.eval, frame.formations as f64];
         if self.0.last().is_some_and(|p| p[0] == point[0]) {
             return;
         }
@@ -53,7 +53,7 @@ impl History {
     }
 
     /// The points.
-    pub fn points(&self) -> &[[f64; 2]] {
+    pub fn points(&self) -> &[[f64; 3]] {
         &self.0
     }
 }
@@ -82,6 +82,34 @@ pub struct Hello {
     pub settings: Vec<(&'static str, String)>,
     /// Steps between formation checks.
     pub check_interval: u64,
+    /// A second view to show beside this one (`host train --view`: the
+    /// world acting with the learner's greedy table).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub companion: Option<Companion>,
+}
+
+/// A second view a page shows beside its own, in a frame.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Companion {
+    /// Its heading.
+    pub label: String,
+    /// Its page's address.
+    pub url: String,
+}
+
+/// A learning run's progress, sent with the frames of the world it learns
+/// in (`host train --view`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Learning {
+    /// States the learner has visited.
+    pub states_visited: u64,
+    /// States its hasher has.
+    pub states_total: u64,
+    /// Exploration (epsilon) now.
+    pub exploration: f64,
+    /// The training step of the greedy table the companion acts with, if
+    /// it has one yet.
+    pub greedy_step: Option<u64>,
 }
 
 /// The state after a step.
@@ -107,6 +135,9 @@ pub struct Frame {
     pub pucks: Vec<f32>,
     /// Each puck: 1 in the target band, 0 outside.
     pub in_band: Vec<u8>,
+    /// With a learning run: its progress.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub learning: Option<Learning>,
 }
 
 impl Session {
@@ -174,6 +205,7 @@ impl Hello {
             outline: Outline::of(world.robot_shape, world.robot_radius).map(|o| boundary(&o)),
             settings,
             check_interval: sim.config().episode.check_interval,
+            companion: None,
         }
     }
 }
@@ -225,6 +257,7 @@ impl Frame {
             robots,
             pucks,
             in_band,
+            learning: None,
         }
     }
 }

@@ -144,3 +144,66 @@ fn a_bad_setting_or_policy_file_is_refused_with_a_message_and_nothing_else_chang
     assert_eq!(after["frame"]["step"], before["frame"]["step"]);
     assert_eq!(after["frame"]["robots"], before["frame"]["robots"]);
 }
+
+#[test]
+fn a_learning_world_shows_its_progress_and_its_companion_beside_it() {
+    let (mut sim, mut controller) = small(5).choices(None).scenario().unwrap().build().unwrap();
+    let companion_address = serve(small(6), false, Speed::Real);
+    let companion = view::Companion {
+        label: "The exported policy acting".into(),
+        url: format!("http://{companion_address}/"),
+    };
+    let follower =
+        view::View::follow_beside("127.0.0.1:0".parse().unwrap(), &sim, Some(companion)).unwrap();
+    let mut page = Browser::open(&follower.url(), (1600, 820));
+    for _ in 0..40 {
+        sim.step(controller.as_mut());
+    }
+    follower.step_learning(
+        &sim,
+        view::Learning {
+            states_visited: 17,
+            states_total: 256,
+            exploration: 0.05,
+            greedy_step: Some(20),
+        },
+    );
+    page.wait_for("document.documentElement.dataset.step === '40'", 60);
+    let stats = page.eval("document.getElementById('stats').textContent");
+    let stats = stats.as_str().unwrap();
+    for shown in [
+        "states visited17 of 256",
+        "exploration0.050",
+        "greedy table of step20",
+    ] {
+        assert!(stats.contains(shown), "{shown:?} not in {stats:?}");
+    }
+    // a followed world takes no controls: the page shows none
+    assert_eq!(
+        page.eval("[document.getElementById('play').offsetParent, document.getElementById('settings').offsetParent]"),
+        serde_json::json!([null, null])
+    );
+    assert_eq!(
+        page.eval("document.getElementById('beside').hidden"),
+        serde_json::json!(false)
+    );
+    assert_eq!(
+        page.eval("document.getElementById('besideLabel').textContent"),
+        serde_json::json!("The exported policy acting")
+    );
+    // the companion's own page (another origin) runs inside the frame,
+    // beside the world: its server counts it as a viewer
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while state(companion_address)["frame"]["viewers"] != 1 {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the frame never connected"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let boxes = page.eval("(() => { const w = document.getElementById('world').getBoundingClientRect(); const f = document.getElementById('companion').getBoundingClientRect(); return [w.right, f.left, f.width]; })()");
+    assert!(
+        boxes[1].as_f64() > boxes[0].as_f64() && boxes[2].as_f64().unwrap() > 400.0,
+        "{boxes}"
+    );
+}

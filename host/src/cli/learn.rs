@@ -1,5 +1,6 @@
 //! Learning: `host train` and `host experiment`.
 
+use super::screen::{parse_bind, Bind};
 use clap::{Args, Subcommand};
 use host::experiment::shard::Shard;
 use host::experiment::RunOptions;
@@ -27,6 +28,11 @@ pub struct TrainArgs {
     /// policy blob (its actions preferred); hasher and actions must match.
     #[arg(long)]
     pub init_from: Option<PathBuf>,
+    /// Show the run on the live view's page at this address, IP or IP:PORT
+    /// (port 0: any free one): the world it learns in and beside it the
+    /// exported policy acting (docs/view.md). The address is the first line printed.
+    #[arg(long, value_name = "ADDRESS", num_args = 0..=1, default_missing_value = "127.0.0.1:8077", value_parser = parse_bind)]
+    pub view: Option<Bind>,
 }
 
 impl TrainArgs {
@@ -38,6 +44,7 @@ impl TrainArgs {
             randomise: self.randomise,
             resume: self.resume,
             init_from: self.init_from,
+            view: self.view.map(|b| b.or_port(8077)),
         }
     }
 }

@@ -107,6 +107,16 @@ pub enum Bind {
     Socket(SocketAddr),
 }
 
+impl Bind {
+    /// The address, `port` when it names none.
+    pub fn or_port(self, port: u16) -> SocketAddr {
+        match self {
+            Bind::Socket(a) => a,
+            Bind::Ip(ip) => SocketAddr::new(ip, port),
+        }
+    }
+}
+
 pub(crate) fn parse_bind(s: &str) -> Result<Bind, String> {
     s.parse::<SocketAddr>()
         .map(Bind::Socket)
@@ -117,10 +127,7 @@ pub(crate) fn parse_bind(s: &str) -> Result<Bind, String> {
 impl DisplayArgs {
     /// The server's settings.
     pub fn settings(self) -> Result<DisplaySettings> {
-        let bind = match self.bind {
-            Bind::Socket(a) => a,
-            Bind::Ip(ip) => SocketAddr::new(ip, self.port),
-        };
+        let bind = self.bind.or_port(self.port);
         // checked in seconds, as given, before it becomes milliseconds
         ranges::HOLD_S.check(self.hold)?;
         let hold_ms = (self.hold * 1000.0).round() as u32;

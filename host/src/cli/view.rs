@@ -9,7 +9,6 @@ use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::ControllerChoice;
-use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use view::{Allowed, Speed, ViewController, ViewOptions, ViewSettings};
 
@@ -44,10 +43,7 @@ pub struct ViewArgs {
 impl ViewArgs {
     /// The server's options; errors name the flag.
     pub fn options(self) -> Result<ViewOptions> {
-        let bind = match self.bind {
-            Bind::Socket(a) => a,
-            Bind::Ip(ip) => SocketAddr::new(ip, self.port),
-        };
+        let bind = self.bind.or_port(self.port);
         let choices = self.scenario.choices();
         let mut policies = self.policies;
         let controller = match &choices.controller {

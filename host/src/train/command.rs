@@ -1,10 +1,11 @@
 //! `host train`: settings from a file and flags, a new or resumed run with
-//! a progress bar, periodic atomic checkpoints, the policy blob, and a
-//! summary.
+//! a progress bar (and with `--view` the live view's page, [`super::watch`]),
+//! periodic atomic checkpoints, the policy blob, and a summary.
 
 use super::checkpoint;
 use super::config::{TrainConfig, TrainFlags};
 use super::trainer::{Trainer, TrainingState};
+use super::watch::TrainingView;
 use crate::learn::{QTable, TableSummary};
 use anyhow::{bail, Context, Result};
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
@@ -12,7 +13,8 @@ use shared::PolicyBlob;
 use sim::base::ranges;
 use sim::scenario::sensor_setup::SelectedSensors;
 use std::fmt;
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
+use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -32,6 +34,8 @@ pub struct TrainRequest {
     pub resume: Option<PathBuf>,
     /// Start from the Q-table of a checkpoint, or from a policy blob.
     pub init_from: Option<PathBuf>,
+    /// Serve the run on the live view's page at this address ([`watch`]).
+    pub view: Option<SocketAddr>,
 }
 
 /// What a training session did.
@@ -125,7 +129,23 @@ pub fn train(args: &TrainRequest) -> Result<TrainReport> {
     trainer.config().validate()?;
     // a resumed run's output folder may be another than its checkpoint's
     crate::atomic::check_writable(&trainer.config().output.dir)?;
-    run(&mut trainer, steps)
+    let mut view = match args.view {
+        Some(bind) => {
+            let view = TrainingView::start(bind, &trainer)?;
+            // the first line, for whoever opens it (a script reads it)
+            println!(
+                "view: {} (the exported policy acting: {})",
+                view.url(),
+                view.greedy_url()
+            );
+            std::io::stdout()
+                .flush()
+                .context("cannot write the view's address")?;
+            Some(view)
+        }
+        None => None,
+    };
+    run(&mut trainer, steps, view.as_mut())
 }
 
 /// A new run from the config file, the flags and `--init-from`.
@@ -206,7 +226,11 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
 
 /// Runs `steps` steps with a progress bar, checkpointing on the way, then
 /// writes the policy and the final checkpoint.
-fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport> {
+fn run(
+    trainer: &mut Trainer<SelectedSensors>,
+    steps: u64,
+    mut view: Option<&mut TrainingView>,
+) -> Result<TrainReport> {
     let out = trainer.config().output.clone();
     let name = trainer.config().name();
     let policy_path = out.dir.join(format!("{name}.policy"));
@@ -227,6 +251,9 @@ fn run(trainer: &mut Trainer<SelectedSensors>, steps: u64) -> Result<TrainReport
             && done < steps
         {
             checkpoint::save(&checkpoint_path, &trainer.state())?;
+        }
+        if let Some(view) = view.as_deref_mut() {
+            view.update(trainer)?;
         }
         let t = trainer.totals();
         bar.set_position(done);

@@ -1,7 +1,7 @@
 //! Training: a run's settings ([`config`]), the learning loop over any
 //! sensor model ([`trainer`]), its checkpoint file ([`checkpoint`]; the
 //! layouts of formats 1 to 4: [`format1`], [`format2`], [`format3`], [`format4`]) and the `host train` command
-//! ([`command`]).
+//! ([`command`]), shown live with `--view` ([`watch`]).
 
 pub mod checkpoint;
 pub mod command;
@@ -13,6 +13,7 @@ pub mod format3;
 pub mod format4;
 pub mod selection;
 pub mod trainer;
+pub mod watch;
 
 pub use command::{train, TrainReport, TrainRequest};
 pub use config::{OutputConfig, TrainConfig, TrainFlags};
