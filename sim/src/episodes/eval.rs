@@ -13,6 +13,7 @@ use crate::config::Thresholds;
 use crate::fields::{FieldLayout, FieldSampling, ScalarField};
 use crate::world::World;
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// Whether a field value lies in the band `[T_o, T_i]` (where Eval wants
 /// every puck).
@@ -64,12 +65,13 @@ fn fixed_of_value(value: f32, t: &Thresholds) -> u64 {
 /// Each puck position's fixed-point distance, the way [`fixed_distance`]
 /// finds it: with nearest sampling from a table of every cell's distance
 /// (a cell index and a load instead of the conversion and rounding of each
-/// moved puck: Eval every step is a learner's reward), with bilinear
-/// sampling by the formula.
+/// moved puck: Eval every step is a learner's reward; one table per field
+/// and thresholds, shared by the worlds of a batch,
+/// [`ScalarField::derived_table`]), with bilinear sampling by the formula.
 #[derive(Clone, Debug, PartialEq)]
 enum Distances {
     /// Nearest sampling: each cell's distance, and that of the outside.
-    ByCell { cells: Vec<u64>, outside: u64 },
+    ByCell { cells: Arc<[u64]>, outside: u64 },
     /// Bilinear sampling.
     Interpolated,
 }
@@ -78,11 +80,9 @@ impl Distances {
     fn new(field: &ScalarField, layout: &FieldLayout, t: &Thresholds) -> Distances {
         match layout.sampling {
             FieldSampling::Nearest => Distances::ByCell {
-                cells: field
-                    .values()
-                    .iter()
-                    .map(|&v| fixed_of_value(v, t))
-                    .collect(),
+                cells: field.derived_table([t.outie.to_bits(), t.innie.to_bits()], |values| {
+                    values.iter().map(|&v| fixed_of_value(v, t)).collect()
+                }),
                 outside: fixed_of_value(0.0, t),
             },
             FieldSampling::Bilinear => Distances::Interpolated,

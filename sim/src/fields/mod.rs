@@ -23,6 +23,7 @@ use crate::base::rounding::floor;
 use crate::base::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::FieldValue;
+use std::sync::{Arc, Mutex};
 
 /// The rectangle of the arena a field's grid covers, units.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -77,6 +78,36 @@ pub struct ScalarField {
     height: usize,
     values: Vec<f32>,
     fixed: Vec<FieldValue>,
+    derived: DerivedTables,
+}
+
+/// Tables computed from a field's values, one per key (such as a set of
+/// thresholds), made once and then shared by every world that reads this
+/// field: a batch of hundreds of worlds keeps one copy, not one a world,
+/// in the caches they share. A clone starts without any; equality is the
+/// values'.
+#[derive(Default)]
+struct DerivedTables(Mutex<Vec<DerivedTable>>);
+
+/// A derived table and its key.
+type DerivedTable = ([u64; 2], Arc<[u64]>);
+
+impl Clone for DerivedTables {
+    fn clone(&self) -> DerivedTables {
+        DerivedTables::default()
+    }
+}
+
+impl PartialEq for DerivedTables {
+    fn eq(&self, _: &DerivedTables) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for DerivedTables {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("DerivedTables")
+    }
 }
 
 impl ScalarField {
@@ -96,6 +127,7 @@ impl ScalarField {
             height,
             values,
             fixed,
+            derived: DerivedTables::default(),
         })
     }
 
@@ -120,6 +152,27 @@ impl ScalarField {
             })
             .collect();
         ScalarField::new(width, height, values).expect("width x height values")
+    }
+
+    /// The table `make` computes from the values, for `key`: made on the
+    /// first call with that key, the same shared table afterwards.
+    pub fn derived_table(
+        &self,
+        key: [u64; 2],
+        make: impl FnOnce(&[f32]) -> Vec<u64>,
+    ) -> Arc<[u64]> {
+        // a panic while holding the lock left at most a table unmade
+        let mut tables = self
+            .derived
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((_, table)) = tables.iter().find(|(k, _)| *k == key) {
+            return table.clone();
+        }
+        let table: Arc<[u64]> = make(&self.values).into();
+        tables.push((key, table.clone()));
+        table
     }
 
     /// Grid width (columns).
@@ -258,6 +311,27 @@ fn nearest_index(t: f64, n: usize) -> Option<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_derived_table_is_made_once_per_key_and_shared() {
+        let f = ScalarField::annulus();
+        let made = std::cell::Cell::new(0);
+        let make = |values: &[f32]| {
+            made.set(made.get() + 1);
+            values.iter().map(|&v| u64::from(v > 0.5)).collect()
+        };
+        let a = f.derived_table([1, 2], make);
+        let b = f.derived_table([1, 2], make);
+        assert!(Arc::ptr_eq(&a, &b));
+        assert_eq!(a.len(), 64 * 64);
+        let c = f.derived_table([1, 3], make);
+        assert!(!Arc::ptr_eq(&a, &c));
+        assert_eq!(made.get(), 2);
+        // a clone is the same field and makes its own
+        let g = f.clone();
+        assert_eq!(g, f);
+        assert!(!Arc::ptr_eq(&g.derived_table([1, 2], make), &a));
+    }
 
     #[test]
     fn annulus_centre_is_exactly_one_and_far_corner_zero() {
