@@ -5,10 +5,14 @@
 //! the hold each, timed by the browser's virtual time (no wall-clock
 //! sleeps), and the grey patches show their levels.
 
+#[path = "../../view/tests/browser/mod.rs"]
+mod browser;
+
+use browser::chromium;
 use image::RgbImage;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -61,17 +65,6 @@ fn display(args: &[&str]) -> Display {
         child,
         _stdout: stdout,
     }
-}
-
-/// Headless Chromium, or a failure saying what to install.
-fn chromium() -> PathBuf {
-    let path = std::env::var_os("PATH").unwrap_or_default();
-    std::env::split_paths(&path)
-        .map(|dir| dir.join("chromium"))
-        .find(|p| p.is_file())
-        .expect(
-            "the display tests need headless Chromium: apt-get install chromium chromium-driver (scripts/setup installs them)",
-        )
 }
 
 /// What to take from the page once `budget_ms` of virtual time have passed.

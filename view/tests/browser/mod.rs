@@ -2,6 +2,7 @@
 //! driven over the DevTools protocol: a page that keeps running in real
 //! time (the display tests' `--dump-dom` with virtual time suits a still
 //! page, not a live stream), its state read with `Runtime.evaluate`.
+//! `host/tests/display_cli.rs` takes [`chromium`] from here too.
 
 #![allow(dead_code, reason = "each test binary uses part of the helper")]
 
@@ -19,7 +20,7 @@ pub fn chromium() -> PathBuf {
         .map(|dir| dir.join("chromium"))
         .find(|p| p.is_file())
         .expect(
-            "the view's page tests need headless Chromium: apt-get install chromium (scripts/setup installs it)",
+            "the browser tests need headless Chromium: apt-get install chromium (scripts/setup installs it)",
         )
 }
 
