@@ -111,6 +111,11 @@ fn the_page_shows_the_learning_world_with_its_progress_and_the_exported_policy_a
             "{l}"
         );
     }
+    // the training speed, measured from the frames the trainer gives
+    assert!(
+        later["steps_per_second"].as_f64().unwrap() > 1000.0,
+        "{later}"
+    );
     // the greedy world's policy is refreshed as training goes on
     let refreshed = |f: &serde_json::Value| f["learning"]["greedy_step"].as_u64().unwrap();
     assert!(refreshed(&later) > refreshed(&first), "{first} {later}");

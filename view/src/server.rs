@@ -203,6 +203,19 @@ struct Control {
     uploads_made: u64,
 }
 
+impl Control {
+    /// Adds the step count now to the steps-a-second meter, which keeps
+    /// the last second (and at least two readings).
+    fn measure(&mut self) {
+        let steps = self.source.steps();
+        self.meter.push((Instant::now(), steps));
+        let recent = Instant::now() - Duration::from_secs(1);
+        let old = self.meter.iter().take_while(|m| m.0 < recent).count();
+        let keep = self.meter.len().saturating_sub(2);
+        self.meter.drain(..old.min(keep));
+    }
+}
+
 /// A hello as browsers get it.
 #[derive(Serialize)]
 struct HelloMessage<'a> {
@@ -614,12 +627,7 @@ impl Shared {
                 }
             }
             if stepped {
-                let steps = c.source.steps();
-                c.meter.push((Instant::now(), steps));
-                let recent = Instant::now() - Duration::from_secs(1);
-                let old = c.meter.iter().take_while(|m| m.0 < recent).count();
-                let keep = c.meter.len().saturating_sub(2);
-                c.meter.drain(..old.min(keep));
+                c.measure();
             }
             let due = c.last_publish.is_none_or(|t| t.elapsed() >= frame_gap);
             if stepped && (due || single) {
@@ -905,6 +913,7 @@ impl Follower {
             *last = frame;
             *published = false;
         }
+        c.measure();
         self.shared.wake.notify_all();
     }
 
