@@ -14,7 +14,7 @@ set -uo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 work="$root/out/reproduction-pending"
-names=(transfer letters-generated)
+names=(letters-generated)
 mkdir -p "$work"
 
 collect() {
