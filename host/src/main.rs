@@ -195,14 +195,7 @@ fn inspect_policy(file: &Path, summary: bool) -> Result<()> {
 
 fn replay(args: ReplayArgs) -> Result<()> {
     use host::robot::replay::{odometry, replay_files};
-    ranges::UNIT_MM.check_as("--mm-per-unit", args.mm_per_unit)?;
-    ranges::COUNTS_PER_MM.check(args.counts_per_mm)?;
-    ranges::TRACK_MM.check(args.track_mm)?;
-    let settings = odometry::OdometrySettings {
-        mm_per_unit: args.mm_per_unit,
-        counts_per_mm: args.counts_per_mm,
-        track_mm: args.track_mm,
-    };
+    let settings = args.odometry.settings()?;
     let report = replay_files(&args.log, &args.policy, args.visits.as_deref(), settings)?;
     if let Some(path) = &args.fit_profile {
         let file = odometry::merge_into_file(path, &report.motion)?;
@@ -277,6 +270,9 @@ fn display(args: DisplayArgs) -> Result<()> {
 }
 
 fn view(args: ViewArgs) -> Result<()> {
+    if let (Some(log), Some(policy)) = (&args.log, &args.policy) {
+        return view_log(log, policy, &args);
+    }
     warn_policy_mismatch(&args.scenario)?;
     let view = view::View::start(args.options()?).map_err(anyhow::Error::msg)?;
     let url = view.url();
@@ -284,6 +280,32 @@ fn view(args: ViewArgs) -> Result<()> {
     println!("view: serving {url}");
     println!(
         "  keys: space play/pause, s step, 1 2 3 speed, r reset, n next seed, h help; Ctrl-C stops"
+    );
+    std::io::stdout()
+        .flush()
+        .context("cannot write to stdout")?;
+    view.serve();
+    Ok(())
+}
+
+fn view_log(log: &Path, policy: &Path, args: &ViewArgs) -> Result<()> {
+    let played = host::robot::log_view::log_view(
+        log,
+        policy,
+        &args.log_scenario()?,
+        args.odometry.settings()?,
+    )?;
+    let bind = args.bind.or_port(args.port);
+    let view = view::RecordingView::listen(bind, played.document, played.field_png)
+        .map_err(anyhow::Error::msg)?;
+    // The first line names the address (scripts and tests read it).
+    println!("view: serving {}", view.url());
+    println!(
+        "  {} frames of {}, {} diverging from {}; keys: space play/pause, left/right step, d next divergence, h help; Ctrl-C stops",
+        played.frames,
+        log.display(),
+        played.diverged,
+        policy.display()
     );
     std::io::stdout()
         .flush()

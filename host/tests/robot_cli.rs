@@ -1,10 +1,14 @@
 //! The robot commands of the `host` CLI: replay (text and JSON, damaged
-//! input), flash --dry-run, and their errors naming the bad input.
+//! input), a log on the view's page (`host view --log`), flash --dry-run,
+//! and their errors naming the bad input.
 
 use assert_cmd::Command;
 use host::robot::log_file::{encode_record, MAGIC, VERSION};
 use shared::{FieldCalibration, LogFrame, PolicyBlob, RunMode, SensorRange};
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
+
+mod served;
 
 const CAL: FieldCalibration = FieldCalibration {
     ranges: [SensorRange {
@@ -68,6 +72,19 @@ fn write_log(path: &Path) -> u64 {
     damaged_at
 }
 
+/// `host replay --json` of `log` against the policy.
+fn replay_json(log: &Path) -> serde_json::Value {
+    let out = host()
+        .args(["replay", "--json", "--log"])
+        .arg(log)
+        .arg("--policy")
+        .arg(policy_path())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
 #[test]
 fn replay_reports_in_text_and_json_and_names_damaged_records() {
     let dir = tempfile::tempdir().unwrap();
@@ -92,15 +109,7 @@ fn replay_reports_in_text_and_json_and_names_damaged_records() {
         "{text}"
     );
 
-    let out = host()
-        .args(["replay", "--json", "--log"])
-        .arg(&log)
-        .arg("--policy")
-        .arg(policy_path())
-        .output()
-        .unwrap();
-    assert!(out.status.success());
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = replay_json(&log);
     assert_eq!(
         (
             v["frames"].as_u64(),
@@ -204,6 +213,95 @@ fn replay_fits_each_robots_wheel_speed_and_turn_bias_into_one_file_for_the_swarm
         robots[0].as_object().unwrap().keys().collect::<Vec<_>>(),
         ["id", "turn_bias", "wheel_speed_factor"]
     );
+}
+
+/// `host view --log LOG --policy POLICY ARGS`.
+fn view_log(log: &Path, args: &[&str]) -> served::Served {
+    let mut all = vec![OsString::from("--log"), log.into(), "--policy".into()];
+    all.push(policy_path().into());
+    all.extend(args.iter().map(OsString::from));
+    served::serve(all)
+}
+
+fn get(address: &str, path: &str) -> (u16, Vec<u8>) {
+    served::request(address, "GET", path)
+}
+
+#[test]
+fn view_log_serves_every_frame_checked_as_replay_checks_it_and_the_dead_reckoned_track() {
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("run.log");
+    write_log(&log);
+    let served = view_log(&log, &[]);
+    let (status, body) = get(&served.address, "/recording.json");
+    assert_eq!(status, 200);
+    let doc: serde_json::Value = serde_json::from_slice(&body).unwrap();
+    let replayed = replay_json(&log);
+    let frames = doc["playback"]["frames"].as_array().unwrap();
+    assert_eq!(Some(frames.len() as u64), replayed["frames"].as_u64());
+    assert_eq!(doc["playback"]["damaged"], replayed["damaged"]);
+    assert_eq!(doc["playback"]["diverged"], replayed["diverged"]);
+    assert!(frames.iter().all(|f| f["stages"] == serde_json::json!([])));
+    // tv75 unless told: its arena, its robots' wedge
+    assert_eq!(doc["world"]["arena"][0].as_f64().unwrap().round(), 254.0);
+    assert!(doc["world"]["outline"].is_array());
+    assert_eq!(doc["log"], "run.log");
+    let (status, png) = get(&served.address, "/field.png");
+    assert_eq!((status, &png[1..4]), (200, &b"PNG"[..]));
+    let (status, page) = get(&served.address, "/");
+    assert!(status == 200 && String::from_utf8_lossy(&page).contains("recording.json"));
+    assert_eq!(get(&served.address, "/state.json").0, 404);
+
+    // a robot driving straight: 26 counts at 2 per mm and 6.5 mm per unit
+    // is 2 units a period, from the arena's centre
+    let capture = dir.path().join("drive.bin");
+    let straight = shared::MotorCommand {
+        left: 150,
+        right: 150,
+    };
+    std::fs::write(&capture, driving_capture(1, straight, [26, 26])).unwrap();
+    let served = view_log(&capture, &["--counts-per-mm", "2", "--arena", "thesis"]);
+    let doc: serde_json::Value =
+        serde_json::from_slice(&get(&served.address, "/recording.json").1).unwrap();
+    let frames = doc["playback"]["frames"].as_array().unwrap();
+    let pose = |k: usize| -> Vec<f64> {
+        frames[k]["pose"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect()
+    };
+    assert_eq!(frames.len(), 20);
+    assert_eq!(pose(0), [402.0, 400.0, 0.0]);
+    assert!(
+        (pose(19)[0] - 440.0).abs() < 1e-9 && pose(19)[1] == 400.0,
+        "{:?}",
+        pose(19)
+    );
+}
+
+#[test]
+fn view_log_errors_name_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let not_a_log = dir.path().join("notes.txt");
+    std::fs::write(&not_a_log, "hello").unwrap();
+    let out = host()
+        .args(["view", "--port", "0", "--log"])
+        .arg(&not_a_log)
+        .arg("--policy")
+        .arg(policy_path())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("notes.txt"), "{err}");
+    let out = host()
+        .args(["view", "--port", "0", "--log"])
+        .arg(&not_a_log)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--policy"), "{err}");
 }
 
 #[test]

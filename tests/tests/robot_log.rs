@@ -301,3 +301,102 @@ fn check_report(r: &ReplayReport, frames: &[LogFrame]) {
         .iter()
         .any(|e| e.fault == "no calibration" && e.first_tick == 1));
 }
+
+#[path = "../../view/tests/browser/mod.rs"]
+mod browser;
+
+/// Shows frame `k` as a user scrubbing the timeline would.
+fn scrub(b: &mut browser::Browser, k: usize) {
+    b.eval(&format!(
+        "(() => {{ const t = document.getElementById('timeline'); t.value = {k}; t.dispatchEvent(new Event('input')); }})()"
+    ));
+}
+
+#[test]
+fn the_log_plays_on_the_view_s_page_with_the_decisions_replay_reports() {
+    let stream = session();
+    let frames = frames_of(&stream);
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("capture.bin");
+    std::fs::write(&log, &stream).unwrap();
+    let policy = PolicyBlob::decode(embedded::POLICY_BLOB).unwrap();
+    let embedded_file = dir.path().join("embedded.policy");
+    std::fs::write(&embedded_file, embedded::POLICY_BLOB).unwrap();
+    // another policy, each action one on: every decision of the log differs
+    let mut table = PolicyTable::new(policy.hasher());
+    for (s, a) in policy.table().entries() {
+        table.set(s, ActionId((a.0 + 1) % policy.actions().len() as u8));
+    }
+    let other = PolicyBlob::new(*policy.actions(), table, policy.provenance().clone()).unwrap();
+    let other_file = dir.path().join("other.policy");
+    std::fs::write(&other_file, other.encode()).unwrap();
+    let scenario = sim::scenario::Scenario {
+        arena: sim::scenario::Arena::Screen(Box::new(sim::scenario::arena::ArenaSpec::tv75())),
+        ..Default::default()
+    };
+    let recording = log_file::parse(&stream).unwrap();
+    for (file, blob) in [(&embedded_file, &policy), (&other_file, &other)] {
+        let report = replay(&recording, blob, None, Default::default());
+        let played =
+            host::robot::log_view::log_view(&log, file, &scenario, Default::default()).unwrap();
+        assert_eq!(
+            (played.frames as u64, played.diverged),
+            (report.frames, report.diverged)
+        );
+        let address = view::RecordingView::listen(
+            "127.0.0.1:0".parse().unwrap(),
+            played.document,
+            played.field_png,
+        )
+        .unwrap()
+        .spawn()
+        .unwrap();
+        let mut b = browser::Browser::open(&format!("http://{address}/"), (1200, 800));
+        b.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+        assert_eq!(b.data("frames"), frames.len().to_string());
+        for (k, f) in frames.iter().enumerate() {
+            scrub(&mut b, k);
+            assert_eq!(
+                [
+                    b.data("index"),
+                    b.data("tick"),
+                    b.data("state"),
+                    b.data("action")
+                ],
+                [
+                    k,
+                    f.tick as usize,
+                    usize::from(f.state.0),
+                    usize::from(f.action.0)
+                ]
+                .map(|v| v.to_string()),
+                "frame {k}"
+            );
+            // what replay says of the frame: the embedded policy agrees
+            // everywhere, the other one differs at the policy stage alone
+            let (stages, expected) = if report.diverged == 0 {
+                ("", f.action.0)
+            } else {
+                ("policy", (f.action.0 + 1) % policy.actions().len() as u8)
+            };
+            assert_eq!(
+                (b.data("stages"), b.data("expectedAction")),
+                (stages.to_string(), expected.to_string()),
+                "frame {k}"
+            );
+        }
+        // the next-divergence key finds one exactly when replay does
+        scrub(&mut b, 0);
+        b.eval("document.dispatchEvent(new KeyboardEvent('keydown', { key: 'd' }))");
+        let expected = if report.diverged == 0 { "0" } else { "1" };
+        assert_eq!(b.data("index"), expected);
+        // played at 100x from the start, it runs through to the last frame
+        scrub(&mut b, 0);
+        b.eval("document.getElementById('speed').value = '100'; document.getElementById('play').click()");
+        let last = frames.len() - 1;
+        b.wait_for(
+            &format!("document.documentElement.dataset.index === '{last}'"),
+            60,
+        );
+    }
+}

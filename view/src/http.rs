@@ -4,7 +4,9 @@
 //! connection ends), and the WebSocket handshake.
 
 use std::io::{Read, Write};
-use std::net::TcpStream;
+use std::net::{TcpListener, TcpStream};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 /// Longest request head.
@@ -12,6 +14,44 @@ pub const HEAD_LIMIT: usize = 16 * 1024;
 
 /// How long a read or a write may wait.
 pub const TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Connections served at once; more are answered 503.
+pub const MAX_CONNECTIONS: usize = 512;
+
+/// Answers connections on `listener`, each in its own thread running
+/// `answer`, at most [`MAX_CONNECTIONS`] at once (`open` counts them; the
+/// rest get 503), until a connection arrives after `stopped` is set.
+pub fn serve_connections<F>(
+    listener: &TcpListener,
+    open: &Arc<AtomicUsize>,
+    stopped: &AtomicBool,
+    answer: F,
+) where
+    F: Fn(TcpStream) + Clone + Send + 'static,
+{
+    for stream in listener.incoming() {
+        if stopped.load(Ordering::SeqCst) {
+            return;
+        }
+        let Ok(mut stream) = stream else { continue };
+        if open.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
+            open.fetch_sub(1, Ordering::SeqCst);
+            let _ = stream.set_write_timeout(Some(Duration::from_secs(1)));
+            respond(&mut stream, 503, "text/plain", b"too many connections\n");
+            continue;
+        }
+        let (answer, counted) = (answer.clone(), open.clone());
+        let spawned = std::thread::Builder::new()
+            .name("view-conn".into())
+            .spawn(move || {
+                answer(stream);
+                counted.fetch_sub(1, Ordering::SeqCst);
+            });
+        if spawned.is_err() {
+            open.fetch_sub(1, Ordering::SeqCst);
+        }
+    }
+}
 
 /// A request.
 #[derive(Debug)]
@@ -131,6 +171,39 @@ pub fn read_request(stream: &mut TcpStream, body_limit: usize) -> Result<Request
     }
     request.body.truncate(length);
     Ok(request)
+}
+
+/// A connection's request, with [`TIMEOUT`] on its reads and writes; a
+/// request that cannot be read is answered (its status, the message as
+/// [`error_json`]) and gives `None`.
+pub fn accept_request(stream: &mut TcpStream, body_limit: usize) -> Option<Request> {
+    let _ = stream.set_read_timeout(Some(TIMEOUT));
+    let _ = stream.set_write_timeout(Some(TIMEOUT));
+    match read_request(stream, body_limit) {
+        Ok(r) => Some(r),
+        Err(e) => {
+            if let Some(status) = e.status {
+                respond(stream, status, "application/json", &error_json(&e.message));
+            }
+            None
+        }
+    }
+}
+
+/// `{"error": message}`, the view's error answers.
+pub fn error_json(message: &str) -> Vec<u8> {
+    serde_json::json!({ "error": message })
+        .to_string()
+        .into_bytes()
+}
+
+/// Runs `serve` on a thread of its own (a server's accepting loop).
+pub fn spawn_server(serve: impl FnOnce() + Send + 'static) -> Result<(), String> {
+    std::thread::Builder::new()
+        .name("view-accept".into())
+        .spawn(serve)
+        .map(drop)
+        .map_err(|e| format!("cannot start the server's thread: {e}"))
 }
 
 /// Answers and closes: `status`, `kind` (Content-Type) and `body`.

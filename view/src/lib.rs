@@ -8,14 +8,17 @@
 //! parameters and what a browser may name), [`session`] (a simulation as
 //! the page sees it: hello and frames), [`hub`] (viewers' bounded queues),
 //! [`http`] (the little HTTP the page needs), [`server`] (the stepping
-//! thread, requests, WebSockets).
+//! thread, requests, WebSockets), [`recording`] (a robot's recorded log,
+//! checked by the caller, on its own page).
 
 pub mod http;
 pub mod hub;
+pub mod recording;
 pub mod server;
 pub mod session;
 pub mod settings;
 
+pub use recording::RecordingView;
 pub use server::{Follower, Speed, View, ViewOptions};
 pub use session::{Companion, Learning};
 pub use settings::{Allowed, ViewController, ViewSettings};

@@ -10,7 +10,7 @@
 //! `POST /policy?name=NAME` (a policy blob as the body). Refused settings
 //! answer 400 with the reason and change nothing.
 
-use crate::http::{self, Request};
+use crate::http::{self, error_json, Request};
 use crate::hub::Hub;
 use crate::session::{self, Companion, Frame, Hello, History, Learning, Policy, Session};
 use crate::settings::{self, valid_name, Allowed, ViewController, ViewSettings};
@@ -31,9 +31,6 @@ use tungstenite::{Message, Utf8Bytes, WebSocket};
 
 /// The page, built in.
 const PAGE: &str = include_str!("page.html");
-
-/// Connections served at once; more are answered 503.
-pub const MAX_CONNECTIONS: usize = 512;
 
 /// Uploaded policies kept; the oldest goes first.
 pub const MAX_UPLOADS: usize = 16;
@@ -117,7 +114,7 @@ struct Shared {
     control: Mutex<Control>,
     wake: Condvar,
     hub: Hub,
-    connections: AtomicUsize,
+    connections: Arc<AtomicUsize>,
     policies: Option<PathBuf>,
     allowed: Allowed,
     /// Set when a [`Follower`] is dropped: the server ends.
@@ -354,7 +351,7 @@ impl View {
             }),
             wake: Condvar::new(),
             hub: Hub::default(),
-            connections: AtomicUsize::new(0),
+            connections: Arc::new(AtomicUsize::new(0)),
             policies,
             allowed,
             stopped: AtomicBool::new(false),
@@ -384,39 +381,20 @@ impl View {
 
     /// Answers connections until the process ends, each in its own thread.
     pub fn serve(&self) {
-        for stream in self.listener.incoming() {
-            if self.shared.stopped.load(Ordering::SeqCst) {
-                return;
-            }
-            let Ok(stream) = stream else { continue };
-            let shared = self.shared.clone();
-            if shared.connections.fetch_add(1, Ordering::SeqCst) >= MAX_CONNECTIONS {
-                shared.connections.fetch_sub(1, Ordering::SeqCst);
-                let mut stream = stream;
-                let _ = stream.set_write_timeout(Some(Duration::from_secs(1)));
-                http::respond(&mut stream, 503, "text/plain", b"too many connections\n");
-                continue;
-            }
-            let spawned = std::thread::Builder::new()
-                .name("view-conn".into())
-                .spawn(move || {
-                    shared.connection(stream);
-                    shared.connections.fetch_sub(1, Ordering::SeqCst);
-                });
-            if spawned.is_err() {
-                self.shared.connections.fetch_sub(1, Ordering::SeqCst);
-            }
-        }
+        let shared = self.shared.clone();
+        http::serve_connections(
+            &self.listener,
+            &self.shared.connections,
+            &self.shared.stopped,
+            move |stream| shared.connection(stream),
+        );
     }
 
     /// Serves from a background thread (the caller goes on: a Python
     /// environment, a test).
     pub fn spawn(self) -> Result<SocketAddr, String> {
         let address = self.address;
-        std::thread::Builder::new()
-            .name("view-accept".into())
-            .spawn(move || self.serve())
-            .map_err(|e| format!("cannot start the server's thread: {e}"))?;
+        http::spawn_server(move || self.serve())?;
         Ok(address)
     }
 }
@@ -464,12 +442,6 @@ fn json<T: Serialize>(value: &T) -> Utf8Bytes {
     serde_json::to_string(value)
         .unwrap_or_else(|e| format!("{{\"t\":\"error\",\"error\":\"{e}\"}}"))
         .into()
-}
-
-fn error_json(message: &str) -> Vec<u8> {
-    serde_json::json!({ "error": message })
-        .to_string()
-        .into_bytes()
 }
 
 impl Shared {
@@ -656,22 +628,9 @@ impl Shared {
 
     /// One connection: one request, or a WebSocket's life.
     fn connection(&self, mut stream: TcpStream) {
-        let _ = stream.set_read_timeout(Some(http::TIMEOUT));
-        let _ = stream.set_write_timeout(Some(http::TIMEOUT));
         let limit = ranges::POLICY_FILE.max as usize;
-        let request = match http::read_request(&mut stream, limit) {
-            Ok(r) => r,
-            Err(e) => {
-                if let Some(status) = e.status {
-                    http::respond(
-                        &mut stream,
-                        status,
-                        "application/json",
-                        &error_json(&e.message),
-                    );
-                }
-                return;
-            }
+        let Some(request) = http::accept_request(&mut stream, limit) else {
+            return;
         };
         if request.path == "/stream" && request.is_websocket() {
             return self.stream(stream, &request);

@@ -1,7 +1,9 @@
 //! Real robots: `host monitor`, `host replay` and `host flash`.
 
 use clap::Args;
+use host::robot::replay::odometry::OdometrySettings;
 use shared::StateHasher;
+use sim::base::ranges;
 use std::path::PathBuf;
 
 /// `host monitor`'s options (docs/robot-logs.md).
@@ -49,6 +51,15 @@ pub struct ReplayArgs {
     /// robots, so the logs of a swarm merge into one file.
     #[arg(long)]
     pub fit_profile: Option<PathBuf>,
+    /// How the wheel encoders' counts become motion.
+    #[command(flatten)]
+    pub odometry: OdometryArgs,
+}
+
+/// The geometry that turns wheel encoder counts into motion (`host replay`,
+/// `host view --log`).
+#[derive(Args)]
+pub struct OdometryArgs {
     /// Millimetres per simulator unit (a tenth of the robot radius; 6.5 for
     /// the Zumo in its 65 mm skirt on the TV arena).
     #[arg(long, default_value_t = 6.5, value_parser = super::parse_positive)]
@@ -59,6 +70,20 @@ pub struct ReplayArgs {
     /// Distance between the tracks' centre lines, mm.
     #[arg(long, default_value_t = 85.0, value_parser = super::parse_positive)]
     pub track_mm: f64,
+}
+
+impl OdometryArgs {
+    /// The settings; errors name the flag out of its range.
+    pub fn settings(&self) -> anyhow::Result<OdometrySettings> {
+        ranges::UNIT_MM.check_as("--mm-per-unit", self.mm_per_unit)?;
+        ranges::COUNTS_PER_MM.check(self.counts_per_mm)?;
+        ranges::TRACK_MM.check(self.track_mm)?;
+        Ok(OdometrySettings {
+            mm_per_unit: self.mm_per_unit,
+            counts_per_mm: self.counts_per_mm,
+            track_mm: self.track_mm,
+        })
+    }
 }
 
 /// `host flash`'s options (docs/robot-logs.md).

@@ -1,14 +1,16 @@
 //! `host view`: the live browser view's options (the world's flags are
 //! `host run`'s, [`ScenarioArgs`]).
 
+use super::robot::OdometryArgs;
 use super::scenario::ScenarioArgs;
 use super::screen::{parse_bind, Bind};
 use anyhow::{bail, Result};
 use clap::Args;
 use sim::fields::source::FieldSource;
+use sim::scenario::arena::ArenaSpec;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::sensor_choice::SensorChoice;
-use sim::scenario::ControllerChoice;
+use sim::scenario::{Arena, ControllerChoice, Scenario};
 use std::path::{Path, PathBuf};
 use view::{Allowed, Speed, ViewController, ViewOptions, ViewSettings};
 
@@ -38,9 +40,31 @@ pub struct ViewArgs {
     /// real (50 steps/s, the robot's 20 ms period), 10x or max.
     #[arg(long, default_value = "real")]
     pub speed: Speed,
+    /// Play a robot's recorded log (`host monitor`'s, or a raw capture)
+    /// instead of a simulation, each frame checked against --policy as
+    /// `host replay` checks it; --field and --arena say what the robot
+    /// drove on (default the annulus on tv75).
+    #[arg(long, requires = "policy")]
+    pub log: Option<PathBuf>,
+    /// The policy blob the robot of --log was flashed with.
+    #[arg(long, requires = "log")]
+    pub policy: Option<PathBuf>,
+    /// How --log's wheel encoder counts become the robot's track.
+    #[command(flatten)]
+    pub odometry: OdometryArgs,
 }
 
 impl ViewArgs {
+    /// The world a recorded log is drawn on: the flags' field and arena,
+    /// tv75 when no arena is given (the robots' screen).
+    pub fn log_scenario(&self) -> Result<Scenario> {
+        let mut scenario = self.scenario.clone().scenario()?;
+        if self.scenario.choices().arena.is_none() {
+            scenario.arena = Arena::Screen(Box::new(ArenaSpec::tv75()));
+        }
+        Ok(scenario)
+    }
+
     /// The server's options; errors name the flag.
     pub fn options(self) -> Result<ViewOptions> {
         let bind = self.bind.or_port(self.port);

@@ -1,7 +1,7 @@
 //! Stage by stage, what the firmware should have decided for a frame's
 //! logged inputs, and the frames whose logged decision differs.
 
-use super::report::{Divergence, Stage, StageCounts, LISTED};
+use super::report::{FrameCheck, Stage, StageCounts, LISTED};
 use shared::{
     ActionId, ActionMotors, ChoiceRng, FieldCalibration, FieldValue, LogFrame, MotorCommand,
     PolicyBlob, RobotProfile, Role, SensorReading, State,
@@ -38,8 +38,8 @@ pub struct DecisionCheck<'a> {
     pub diverged: u64,
     /// Diverged frames per stage.
     pub by_stage: StageCounts,
-    /// The first [`LISTED`] divergences.
-    pub first: Vec<Divergence>,
+    /// The first [`LISTED`] frames that diverged.
+    pub first: Vec<FrameCheck>,
 }
 
 impl<'a> DecisionCheck<'a> {
@@ -58,9 +58,11 @@ impl<'a> DecisionCheck<'a> {
         }
     }
 
-    /// Checks one frame (at byte `offset`); a calibration it carries
+    /// Checks one frame (at byte `offset`) and returns what it logged
+    /// beside what each stage should have produced (no divergent stage:
+    /// the robot decided as the policy does); a calibration it carries
     /// applies from this frame on.
-    pub fn frame(&mut self, offset: u64, f: &LogFrame) {
+    pub fn frame(&mut self, offset: u64, f: &LogFrame) -> FrameCheck {
         if let Some(c) = f.calibration {
             if self.calibrations.last() != Some(&c) {
                 self.calibrations.push(c);
@@ -88,10 +90,17 @@ impl<'a> DecisionCheck<'a> {
         if expected.values.is_some() {
             self.calibration_checked += 1;
         }
-        let stages = divergent_stages(f, &expected);
-        if !stages.is_empty() {
-            self.record(offset, f, &expected, stages);
+        let check = frame_check(offset, f, &expected);
+        if !check.stages.is_empty() {
+            self.diverged += 1;
+            for s in &check.stages {
+                self.by_stage.count(*s);
+            }
+            if self.first.len() < LISTED {
+                self.first.push(check.clone());
+            }
         }
+        check
     }
 
     /// Each stage's result from the frame's logged inputs to that stage.
@@ -127,36 +136,31 @@ impl<'a> DecisionCheck<'a> {
             choice_ok: !in_range || several == f.choice.is_some(),
         }
     }
+}
 
-    fn record(&mut self, offset: u64, f: &LogFrame, e: &Expected, stages: Vec<Stage>) {
-        self.diverged += 1;
-        for s in &stages {
-            self.by_stage.count(*s);
-        }
-        if self.first.len() < LISTED {
-            self.first.push(Divergence {
-                offset,
-                tick: f.tick,
-                stages,
-                mode: f.mode,
-                faults: f.faults.0,
-                raw_times: f.raw_times,
-                values: f.values.map(|v| v.raw()),
-                expected_values: e.values.map(|v| v.map(|x| x.raw())),
-                blobs: [
-                    f.blobs.puck_left,
-                    f.blobs.puck_right,
-                    f.blobs.obstacle_left,
-                    f.blobs.obstacle_right,
-                ],
-                state: f.state.0,
-                expected_state: e.state.0,
-                action: f.action.0,
-                expected_action: e.action.0,
-                motors: [f.motors.left, f.motors.right],
-                expected_motors: [e.motors.left, e.motors.right],
-            });
-        }
+/// A frame's logged results beside the expected ones.
+fn frame_check(offset: u64, f: &LogFrame, e: &Expected) -> FrameCheck {
+    FrameCheck {
+        offset,
+        tick: f.tick,
+        stages: divergent_stages(f, e),
+        mode: f.mode,
+        faults: f.faults.0,
+        raw_times: f.raw_times,
+        values: f.values.map(|v| v.raw()),
+        expected_values: e.values.map(|v| v.map(|x| x.raw())),
+        blobs: [
+            f.blobs.puck_left,
+            f.blobs.puck_right,
+            f.blobs.obstacle_left,
+            f.blobs.obstacle_right,
+        ],
+        state: f.state.0,
+        expected_state: e.state.0,
+        action: f.action.0,
+        expected_action: e.action.0,
+        motors: [f.motors.left, f.motors.right],
+        expected_motors: [e.motors.left, e.motors.right],
     }
 }
 

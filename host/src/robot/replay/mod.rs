@@ -26,11 +26,12 @@
 pub mod decisions;
 pub mod faults;
 pub mod odometry;
+pub mod playback;
 pub mod report;
 pub mod timeline;
 
 pub use report::{
-    Coverage, Damaged, Divergence, FaultCount, FaultEpisode, ModeCounts, ReplayReport, Stage,
+    Coverage, Damaged, FaultCount, FaultEpisode, FrameCheck, ModeCounts, ReplayReport, Stage,
     StageCounts, LISTED,
 };
 

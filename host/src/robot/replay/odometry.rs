@@ -43,6 +43,19 @@ pub struct OdometrySettings {
     pub track_mm: f64,
 }
 
+impl OdometrySettings {
+    /// What a period's encoder counts (left, right) say the robot did:
+    /// forward travel in simulator units and turning in radians, positive =
+    /// right.
+    pub fn travel(&self, counts: [i16; 2]) -> (f64, f64) {
+        let [left, right] = counts.map(|c| f64::from(c) / self.counts_per_mm);
+        (
+            (left + right) / 2.0 / self.mm_per_unit,
+            (left - right) / self.track_mm,
+        )
+    }
+}
+
 impl Default for OdometrySettings {
     fn default() -> OdometrySettings {
         OdometrySettings {
@@ -132,11 +145,11 @@ impl OdometryTracker {
     fn add(&mut self, p: &LogFrame, counts: [i16; 2]) {
         let s = self.settings;
         let (intended_forward, intended_turn) = RobotProfile::ZUMO.unicycle(p.motors);
-        let [left, right] = counts.map(|c| f64::from(c) / s.counts_per_mm);
+        let (forward, turn) = s.travel(counts);
         let sums = self.sums.entry((p.robot_id, p.action.0)).or_default();
         sums.periods += 1;
-        sums.forward += (left + right) / 2.0 / s.mm_per_unit;
-        sums.turn += (left - right) / s.track_mm;
+        sums.forward += forward;
+        sums.turn += turn;
         sums.intended_forward += f64::from(intended_forward);
         sums.intended_turn += f64::from(intended_turn);
     }

@@ -102,14 +102,15 @@ impl StageCounts {
     }
 }
 
-/// One frame whose logged decision differs from the recomputed one.
+/// A frame's logged results beside the recomputed ones, stage by stage.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Divergence {
+pub struct FrameCheck {
     /// Byte offset of the frame's record or chunk in the file.
     pub offset: u64,
     /// The frame's tick.
     pub tick: u32,
-    /// Every stage that diverged, pipeline order (the first is where it began).
+    /// Every stage that diverged, pipeline order (the first is where it
+    /// began); none when the frame agrees.
     pub stages: Vec<Stage>,
     /// Mode.
     pub mode: RunMode,
@@ -222,7 +223,7 @@ pub struct ReplayReport {
     /// Diverged frames per stage.
     pub diverged_by_stage: StageCounts,
     /// The first [`LISTED`] divergences.
-    pub first_divergences: Vec<Divergence>,
+    pub first_divergences: Vec<FrameCheck>,
     /// States met while the policy drove.
     pub coverage: Coverage,
     /// Frames per action while the policy drove.
