@@ -146,8 +146,10 @@ fn formed_ring(field: &ScalarField, config: &SimConfig) -> World {
     World::scene(config, &robots, &pucks, 1)
 }
 
-/// The world after 2,000 steps of orbital construction on the TV (the
-/// bodies start overlapping; physics has pushed them apart by then).
+/// The world of orbital construction on the TV after 2,000 steps, or
+/// after the first step from there at which no two pucks overlap: a new
+/// episode places its bodies overlapping and physics pushes them apart over
+/// some steps, and a photo shows two pucks in one place as one.
 fn mid_run() -> World {
     let scenario = Scenario {
         arena: Arena::Screen(Box::new(ArenaSpec::tv75())),
@@ -156,7 +158,18 @@ fn mid_run() -> World {
     };
     let (mut sim, mut controller) = scenario.build().unwrap();
     sim.run(&mut *controller, 2000);
-    sim.world().clone()
+    let apart = |w: &World| {
+        let p = w.pucks();
+        let reach = 2.0 * w.config().puck_radius - 0.5;
+        (0..p.len()).all(|i| (i + 1..p.len()).all(|j| (p[i].pos - p[j].pos).length() > reach))
+    };
+    for _ in 0..2000 {
+        if apart(sim.world()) {
+            return sim.world().clone();
+        }
+        sim.run(&mut *controller, 1);
+    }
+    panic!("the pucks kept overlapping for 2,000 steps");
 }
 
 /// Four pucks in a touching row, three touching in a triangle, five apart.

@@ -135,15 +135,17 @@ fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkp
 }
 
 #[test]
-fn a_noisy_run_of_the_robot_senses_on_the_tv_resumes_exactly_from_a_format_3_checkpoint() {
+fn a_noisy_run_of_the_robot_senses_on_the_tv_s_discs_resumes_exactly_from_a_format_3_checkpoint() {
+    let discs = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../experiments/arenas/tv75-disc.toml");
     let noisy = TrainConfig {
         sensors: SensorChoice::Robot(None),
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(discs)),
         noise: 1.0,
         stuck_limit: Some(900),
         seed: 12,
         ..TrainConfig::default()
     };
-    assert_eq!(noisy.arena_choice().to_string(), "tv75");
     // resumed mid-episode, with camera links, held blocks and a latency
     // frame in flight, after episode resets that drew new robot motions
     assert_eq!(resumes_exactly(noisy, 1700, 2600), 3);
@@ -250,21 +252,21 @@ fn the_rewards_for_deep_learners_resume_exactly_from_a_format_6_checkpoint_and_c
 
 #[test]
 fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5_checkpoint() {
-    let arena = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../experiments/arenas/tv75-wedge.toml");
     let wedge = TrainConfig {
         sensors: SensorChoice::Robot(None),
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(arena)),
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
+            "tv75".into(),
+        )),
         noise: 1.0,
         seed: 17,
         ..TrainConfig::default()
     };
     assert_eq!(resumes_exactly(wedge.clone(), 1100, 2500), 5);
-    // the same run on tv75's discs is another run, of an older format
+    // the same run on discs is another run, of an older format
+    let disc_arena = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../experiments/arenas/tv75-disc.toml");
     let disc = TrainConfig {
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
-            "tv75".into(),
-        )),
+        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(disc_arena)),
         ..wedge.clone()
     };
     assert!(resumes_exactly(disc.clone(), 1100, 2500) < 5);

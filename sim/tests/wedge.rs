@@ -337,26 +337,26 @@ fn deepest(world: &World) -> f64 {
     deepest
 }
 
-/// tv75 with the thesis' wedge (`experiments/arenas/tv75-wedge.toml`).
+/// tv75, whose robots wear the thesis' wedge.
 fn tv75_wedge() -> ArenaSpec {
-    ArenaSpec {
-        robot_shape: SkirtShape::thesis_wedge(),
-        ..ArenaSpec::tv75()
-    }
+    ArenaSpec::tv75()
 }
 
 #[test]
-fn the_wedge_arena_file_is_tv75_in_the_thesis_skirt() {
+fn tv75_is_in_the_thesis_skirt_and_its_disc_file_differs_only_in_the_outline() {
+    assert_eq!(ArenaSpec::tv75().robot_shape, SkirtShape::thesis_wedge());
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../experiments/arenas/tv75-wedge.toml");
-    let spec = sim::scenario::arena_choice::read_arena(&path).unwrap();
+        .join("../experiments/arenas/tv75-disc.toml");
+    let disc = sim::scenario::arena_choice::read_arena(&path).unwrap();
     assert_eq!(
-        spec,
+        disc,
         ArenaSpec {
-            name: "tv75-wedge".into(),
-            ..tv75_wedge()
+            name: "tv75-disc".into(),
+            robot_shape: SkirtShape::Disc,
+            ..ArenaSpec::tv75()
         }
     );
+    let spec = tv75_wedge();
     // 85 mm over 6.5 mm per unit; the faces meet at 2 asin(65 / 85).
     assert_eq!(
         spec.robot_shape_units(),

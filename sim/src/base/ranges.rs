@@ -318,7 +318,7 @@ pub const TIP_RADII: Range = Range::closed(
     1.0,
     3.0,
     "robot radii",
-    "the tip lies beyond the round back; the thesis' wedge on the TV (tv75-wedge.toml) is 1.31 radii, and a longer needle is no skirt",
+    "the tip lies beyond the round back; the thesis' wedge on the TV (tv75's) is 1.31 radii, and a longer needle is no skirt",
 )
 .above_min();
 

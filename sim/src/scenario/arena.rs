@@ -75,7 +75,7 @@ pub const SKIRT_HEIGHT_MM: f64 = 10.0;
 
 impl SkirtShape {
     /// The thesis' skirt on `tv75`'s robots: the wedge with its tip
-    /// [`TV75_TIP_MM`] ahead (`experiments/arenas/tv75-wedge.toml`).
+    /// [`TV75_TIP_MM`] ahead ([`ArenaSpec::tv75`]'s).
     pub fn thesis_wedge() -> SkirtShape {
         SkirtShape::Wedge {
             tip_mm: TV75_TIP_MM,
@@ -130,10 +130,11 @@ impl ArenaSpec {
 
     /// The thesis' hardware (section 1.4): a 75" LG TV (75UK6190PUB) lying
     /// flat, 1,650 x 928 mm visible, 3840 x 2160 pixels; a Zumo 32U4
-    /// (98 x 86 mm) in a round skirt of 65 mm radius, the least circle
-    /// around the chassis (the thesis' wedge-fronted skirt is
-    /// `experiments/arenas/tv75-wedge.toml`, with its tip [`TV75_TIP_MM`]
-    /// ahead of the centre); 5 robots and 12 pucks as large and heavy as a
+    /// (98 x 86 mm) in the thesis' wedge-fronted skirt: a round back of
+    /// 65 mm radius, the least circle around the chassis, and a pointed
+    /// wedge whose tip is [`TV75_TIP_MM`] ahead of the centre (the round
+    /// skirt alone, which tv75 had until 2026-12-04, is
+    /// `experiments/arenas/tv75-disc.toml`); 5 robots and 12 pucks as large and heavy as a
     /// robot (as in the thesis, radius and mass equal); the thesis' forward speed of
     /// 2 units (0.2 radii) per step; trials of 15,000 steps (5 minutes);
     /// images kept in their aspect; display gamma 2.2 (a TV's nominal). The
@@ -148,7 +149,7 @@ impl ArenaSpec {
             fit: FieldFit::Contain,
             display_gamma: 2.2,
             robot_radius_mm: 65.0,
-            robot_shape: SkirtShape::Disc,
+            robot_shape: SkirtShape::thesis_wedge(),
             puck_radius_mm: 65.0,
             puck_mass_ratio: 1.0,
             robots: 5,
