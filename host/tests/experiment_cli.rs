@@ -509,3 +509,91 @@ fn trials_another_run_made_with_the_same_settings_are_copied_not_run() {
     );
     assert!(other.contains("reuse: 0 trials copied"), "{other}");
 }
+
+/// `host experiment --view`: the trials run one at a time on the live
+/// view's page, each under a caption naming it, a learning arm with its
+/// learner's progress; and they give what a run without the view gives.
+#[test]
+fn with_the_view_each_trial_is_shown_in_turn_and_its_results_do_not_change() {
+    use std::io::{BufRead, Read, Write};
+    let dir = tempfile::tempdir().unwrap();
+    let spec = dir.path().join("watched.toml");
+    std::fs::write(
+        &spec,
+        r#"
+title = "watched"
+seed = 3
+[table]
+row_header = "Controller"
+metrics = ["formations"]
+[defaults]
+robots = 3
+pucks = 12
+steps = 100_000
+# long enough to be running when the test asks what the page shows
+[[arms]]
+name = "learner"
+controller = "learn"
+steps = 2_000_000
+[[arms]]
+name = "orbital"
+controller = "oc"
+"#,
+    )
+    .unwrap();
+    let watched = dir.path().join("watched");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_host"))
+        .arg("experiment")
+        .arg(&spec)
+        .args(["--trials", "1", "--view", "127.0.0.1:0", "--out"])
+        .arg(&watched)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    let address = loop {
+        let line = lines.next().expect("a line naming the view").unwrap();
+        if let Some(url) = line.strip_prefix("view: serving http://") {
+            break url.trim_end_matches('/').to_string();
+        }
+    };
+    let mut stream = std::net::TcpStream::connect(&address).unwrap();
+    write!(
+        stream,
+        "GET /state.json HTTP/1.1\r\nHost: {address}\r\n\r\n"
+    )
+    .unwrap();
+    let mut reply = String::new();
+    stream.read_to_string(&mut reply).unwrap();
+    let state: serde_json::Value =
+        serde_json::from_str(reply.split_once("\r\n\r\n").unwrap().1).unwrap();
+    assert_eq!(
+        state["hello"]["caption"], "watched: arm learner, trial 0 (1 of 2 to run)",
+        "{state}"
+    );
+    let rest: Vec<String> = lines.map(|l| l.unwrap()).collect();
+    assert!(child.wait().unwrap().success());
+    assert!(
+        rest.iter().any(|l| l.starts_with("[2/2] orbital trial 0")),
+        "{rest:?}"
+    );
+
+    let plain = dir.path().join("plain");
+    assert!(host()
+        .arg("experiment")
+        .arg(&spec)
+        .args(["--trials", "1", "--out"])
+        .arg(&plain)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    for arm in ["learner", "orbital"] {
+        let trial = Path::new("trials").join(arm).join("trial-00.json");
+        assert_eq!(
+            untimed(&watched.join(&trial)),
+            untimed(&plain.join(&trial)),
+            "{arm}"
+        );
+    }
+}

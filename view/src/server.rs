@@ -315,6 +315,7 @@ impl View {
             address,
             accept: Some(accept),
             companion,
+            caption: None,
         })
     }
 
@@ -828,6 +829,7 @@ pub struct Follower {
     address: SocketAddr,
     accept: Option<JoinHandle<()>>,
     companion: Option<Companion>,
+    caption: Option<String>,
 }
 
 impl Follower {
@@ -854,6 +856,18 @@ impl Follower {
             learning: Some(learning),
             ..Frame::of(sim)
         });
+    }
+
+    /// `sim`, a world other than the one followed so far (another trial),
+    /// under `caption`: [`Follower::reset`] with the caption shown over the
+    /// page's panel from now on.
+    pub fn switch(
+        &mut self,
+        sim: &Simulation<SelectedSensors>,
+        caption: String,
+    ) -> Result<(), String> {
+        self.caption = Some(caption);
+        self.reset(sim)
     }
 
     /// Viewers connected now.
@@ -884,6 +898,7 @@ impl Follower {
         c.source = Source::Fed {
             hello: Hello {
                 companion: self.companion.clone(),
+                caption: self.caption.clone(),
                 ..Hello::of(sim, Vec::new())
             },
             frame: Frame::of(sim),

@@ -86,6 +86,10 @@ pub struct Hello {
     /// world acting with the learner's greedy table).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub companion: Option<Companion>,
+    /// What the world is, over the panel (`host experiment --view`: the
+    /// experiment, arm and trial).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub caption: Option<String>,
 }
 
 /// A second view a page shows beside its own, in a frame.
@@ -206,6 +210,7 @@ impl Hello {
             settings,
             check_interval: sim.config().episode.check_interval,
             companion: None,
+            caption: None,
         }
     }
 }

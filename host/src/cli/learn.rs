@@ -187,6 +187,11 @@ pub struct ExperimentRunArgs {
     /// settings (config hash) are copied instead of run.
     #[arg(long, value_name = "DIR")]
     pub reuse: Vec<PathBuf>,
+    /// Run the trials one at a time, each shown on the live view's page at
+    /// this address, IP or IP:PORT (port 0: any free one; docs/view.md);
+    /// the line "view: serving URL" names it.
+    #[arg(long, value_name = "ADDRESS", num_args = 0..=1, default_missing_value = "127.0.0.1:8077", value_parser = parse_bind)]
+    pub view: Option<Bind>,
 }
 
 impl ExperimentRunArgs {
@@ -200,6 +205,7 @@ impl ExperimentRunArgs {
             threads: self.threads,
             shard: self.shard,
             reuse: self.reuse.clone(),
+            view: self.view.map(|b| b.or_port(8077)),
         }
     }
 }

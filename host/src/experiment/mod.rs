@@ -1,6 +1,6 @@
 //! `host experiment`: the thesis' experiments from TOML files ([`spec`]),
 //! planned into seeded trials ([`plan`]), run in parallel and resumable
-//! ([`runner`], [`trial`]), reusing other runs' identical trials ([`reuse`]), in shards over machines ([`shard`], [`merge`]),
+//! ([`runner`], [`trial`]) or one at a time on the live view ([`watch`]), reusing other runs' identical trials ([`reuse`]), in shards over machines ([`shard`], [`merge`]),
 //! and reported ([`metric`], [`figures`], [`outputs`], [`pictures`]); the
 //! published trials ([`published`]) render `docs/reproduction.md`
 //! ([`report`], [`template`]).
@@ -19,6 +19,7 @@ pub mod shard;
 pub mod spec;
 pub mod template;
 pub mod trial;
+pub mod watch;
 
 pub use runner::{run, RunOptions, RunReport};
 pub use spec::ExperimentSpec;

@@ -18,11 +18,13 @@ use super::reuse::ReusableTrials;
 use super::shard::{Shard, ShardManifest};
 use super::spec::ExperimentSpec;
 use super::trial::{self, TrialResult};
+use super::watch::TrialView;
 use crate::train::checkpoint;
 use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use sim::base::ranges;
 use std::collections::BTreeMap;
+use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -45,6 +47,9 @@ pub struct RunOptions {
     /// Other runs' output directories whose trials of the same settings
     /// are copied instead of run.
     pub reuse: Vec<PathBuf>,
+    /// Run the trials one at a time, each on the live view's page at this
+    /// address ([`TrialView`]); `None` for no view.
+    pub view: Option<SocketAddr>,
 }
 
 impl Default for RunOptions {
@@ -59,6 +64,7 @@ impl Default for RunOptions {
             threads: None,
             shard: None,
             reuse: Vec::new(),
+            view: None,
         }
     }
 }
@@ -142,7 +148,10 @@ pub fn run(spec: &ExperimentSpec, options: &RunOptions, log: Log<'_>) -> Result<
     let trials_reused = copy_reused(&plans, &mut finished, &options.reuse, &dir, log)?;
     let (pretrained_run, pretrained_skipped) =
         run_pretrainings(&plans, &finished, &dir, &workers, log)?;
-    let (results, trials_run) = run_trials(&plans, finished, &dir, &workers, log)?;
+    let (results, trials_run) = match options.view {
+        None => run_trials(&plans, finished, &dir, &workers, log)?,
+        Some(bind) => run_trials_watched(&plans, finished, &dir, TrialView::new(bind), log)?,
+    };
     let outputs = match manifest {
         Some(path) => vec![path],
         None => outputs::write(spec, &dir, &results, options.scale, seed)?,
@@ -317,29 +326,15 @@ fn run_trials(
     log: Log<'_>,
 ) -> Result<(Vec<TrialResult>, usize)> {
     let mut results = finished;
-    let todo: Vec<usize> = (0..plans.len()).filter(|&i| results[i].is_none()).collect();
-    log(&format!(
-        "trials: {}, {} already done (skipped)",
-        plans.len(),
-        plans.len() - todo.len()
-    ));
+    let todo = unfinished(&results, log, "");
     let count = AtomicUsize::new(0);
     let fresh = std::sync::Mutex::new(Vec::new());
     workers.run(&|| {
         todo.par_iter().try_for_each(|&i| {
             let plan = &plans[i];
-            let result = run_trial(plan, dir)?;
+            let result = run_trial(plan, dir, &mut |_, _| Ok(()))?;
             let k = count.fetch_add(1, Ordering::Relaxed) + 1;
-            log(&format!(
-                "[{k}/{}] {} trial {}: {} formations, {} stuck, {} steps at {:.0} steps/s",
-                todo.len(),
-                plan.arm,
-                plan.trial,
-                result.formations,
-                result.stuck,
-                result.steps,
-                result.steps_per_second
-            ));
+            log(&trial_line(k, todo.len(), plan, &result));
             if let Ok(mut f) = fresh.lock() {
                 f.push((i, result));
             }
@@ -352,14 +347,80 @@ fn run_trials(
     Ok((results.into_iter().flatten().collect(), todo.len()))
 }
 
-/// Runs one trial (from its stored pre-trained table, if it has one) and
-/// writes its result.
-fn run_trial(plan: &TrialPlan, dir: &Path) -> Result<TrialResult> {
+/// The trials still to run, by plan index, said in the log (with `how`).
+fn unfinished(results: &[Option<TrialResult>], log: Log<'_>, how: &str) -> Vec<usize> {
+    let todo: Vec<usize> = (0..results.len())
+        .filter(|&i| results[i].is_none())
+        .collect();
+    log(&format!(
+        "trials: {}, {} already done (skipped){how}",
+        results.len(),
+        results.len() - todo.len()
+    ));
+    todo
+}
+
+/// The log line of the `k`-th of `n` trials run.
+fn trial_line(k: usize, n: usize, plan: &TrialPlan, result: &TrialResult) -> String {
+    format!(
+        "[{k}/{n}] {} trial {}: {} formations, {} stuck, {} steps at {:.0} steps/s",
+        plan.arm,
+        plan.trial,
+        result.formations,
+        result.stuck,
+        result.steps,
+        result.steps_per_second
+    )
+}
+
+/// [`run_trials`] one trial at a time, each shown on `view`.
+fn run_trials_watched(
+    plans: &[TrialPlan],
+    finished: Vec<Option<TrialResult>>,
+    dir: &Path,
+    mut view: TrialView,
+    log: Log<'_>,
+) -> Result<(Vec<TrialResult>, usize)> {
+    let mut results = finished;
+    let todo = unfinished(&results, log, "; one at a time, on the view");
+    for (k, &i) in todo.iter().enumerate() {
+        let plan = &plans[i];
+        let caption = format!(
+            "{}: arm {}, trial {} ({} of {} to run)",
+            plan.experiment,
+            plan.arm,
+            plan.trial,
+            k + 1,
+            todo.len()
+        );
+        let result = run_trial(plan, dir, &mut |running, step| {
+            if step == 0 {
+                if let Some(url) = view.start(running, caption.clone())? {
+                    log(&format!("view: serving {url}"));
+                }
+            } else {
+                view.show(running);
+            }
+            Ok(())
+        })?;
+        log(&trial_line(k + 1, todo.len(), plan, &result));
+        results[i] = Some(result);
+    }
+    Ok((results.into_iter().flatten().collect(), todo.len()))
+}
+
+/// Runs one trial (from its stored pre-trained table, if it has one),
+/// shown to `watch` ([`trial::run_watched`]), and writes its result.
+fn run_trial(
+    plan: &TrialPlan,
+    dir: &Path,
+    watch: &mut dyn FnMut(&trial::Running, u64) -> Result<()>,
+) -> Result<TrialResult> {
     let seed_table = match &plan.pretrain {
         Some(p) => Some(pretrained_table(dir, p)?),
         None => None,
     };
-    let result = trial::run(plan, seed_table)
+    let result = trial::run_watched(plan, seed_table, watch)
         .with_context(|| format!("arm {} trial {}", plan.arm, plan.trial))?;
     write_result(&trial_path(dir, plan), &result)?;
     Ok(result)

@@ -199,14 +199,31 @@ impl Running {
     }
 }
 
+/// Steps between the frames a watched trial shows (`host experiment --view`).
+pub const WATCH_STEPS: u64 = 20_000;
+
 /// Runs a trial; `seed_table` is the pre-trained table of a pre-trained arm.
 pub fn run(plan: &TrialPlan, seed_table: Option<QTable>) -> Result<TrialResult> {
+    run_watched(plan, seed_table, &mut |_, _| Ok(()))
+}
+
+/// [`run`], `watch` shown the run and its steps so far at its start and
+/// every [`WATCH_STEPS`] steps (it only looks: the trial is the same).
+pub fn run_watched(
+    plan: &TrialPlan,
+    seed_table: Option<QTable>,
+    watch: &mut dyn FnMut(&Running, u64) -> Result<()>,
+) -> Result<TrialResult> {
     let mut running = Running::start(plan, seed_table)?;
     let mut recorder = Recorder::default();
     let start = Instant::now();
-    for _ in 0..plan.config.steps {
+    watch(&running, 0)?;
+    for step in 1..=plan.config.steps {
         let end = running.step();
         recorder.after_step(end, running.simulation().totals());
+        if step % WATCH_STEPS == 0 {
+            watch(&running, step)?;
+        }
     }
     let (totals, states) = (running.simulation().totals().clone(), running.states());
     let c = &plan.config;
