@@ -14,6 +14,7 @@ use sim::episodes::eval::pucks_in_band;
 use sim::physics::outline::Outline;
 use sim::render::{self, RenderOptions};
 use sim::scenario::sensor_setup::SelectedSensors;
+use sim::sensors::{FootprintKind, SensorModel};
 use sim::simulation::Simulation;
 use std::path::PathBuf;
 
@@ -78,6 +79,11 @@ pub struct Hello {
     /// A wedge robot's outline, points (forward, right) in units around
     /// its centre; `None` for discs.
     pub outline: Option<Vec<[f64; 2]>>,
+    /// Where a robot's sensors look, around its centre as the outline.
+    pub sensors: Vec<SensorMark>,
+    /// The floor a robot's camera sees, a polygon around its centre as the
+    /// outline; empty without a camera.
+    pub camera_view: Vec<[f64; 2]>,
     /// The settings, as URL parameters.
     pub settings: Vec<(&'static str, String)>,
     /// Steps between formation checks.
@@ -90,6 +96,17 @@ pub struct Hello {
     /// experiment, arm and trial).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub caption: Option<String>,
+}
+
+/// A sensor's footprint in a robot's frame, for drawing.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SensorMark {
+    /// `field` (a point read), `puck` or `obstacle` (a disc searched).
+    pub kind: &'static str,
+    /// Its centre, (forward, right) in units from the robot's centre.
+    pub at: [f64; 2],
+    /// Its radius, units (0 for a field point).
+    pub radius: f64,
 }
 
 /// A second view a page shows beside its own, in a frame.
@@ -207,6 +224,13 @@ impl Hello {
             robot_radius: world.robot_radius,
             puck_radius: world.puck_radius,
             outline: Outline::of(world.robot_shape, world.robot_radius).map(|o| boundary(&o)),
+            sensors: sensor_marks(sim),
+            camera_view: sim
+                .sensors()
+                .camera_view()
+                .iter()
+                .map(|p| [p.x, p.y])
+                .collect(),
             settings,
             check_interval: sim.config().episode.check_interval,
             companion: None,
@@ -265,6 +289,33 @@ impl Frame {
             learning: None,
         }
     }
+}
+
+/// Robot 0's sensor footprints in its own frame (every robot's are the
+/// same there); none in a world without robots.
+fn sensor_marks(sim: &Simulation<SelectedSensors>) -> Vec<SensorMark> {
+    let world = sim.world();
+    let (Some(body), Some(robot)) = (world.bodies().first(), world.robots().first()) else {
+        return Vec::new();
+    };
+    let mut footprints = Vec::new();
+    sim.sensors().footprints(world, 0, &mut footprints);
+    let back = Vec2::new(robot.direction.x, -robot.direction.y);
+    footprints
+        .iter()
+        .map(|f| {
+            let at = (f.centre - body.pos).rotated(back);
+            SensorMark {
+                kind: match f.kind {
+                    FootprintKind::Field => "field",
+                    FootprintKind::Puck => "puck",
+                    FootprintKind::Obstacle => "obstacle",
+                },
+                at: [at.x, at.y],
+                radius: f.radius,
+            }
+        })
+        .collect()
 }
 
 /// Points around a wedge robot's outline, (forward, right) in units: where
@@ -327,6 +378,43 @@ mod tests {
         let points = boundary(&o);
         assert!((points[0][0] - o.tip()).abs() < 1e-6, "{:?}", points[0]);
         assert!((points[32][0] + 10.0).abs() < 1e-6, "{:?}", points[32]);
+    }
+
+    #[test]
+    fn the_hello_places_each_sensor_in_the_robots_frame_whatever_its_heading() {
+        // the disc model: three field points, four puck and two obstacle discs
+        let session = Session::build(ViewSettings::default(), None).unwrap();
+        let hello = session.hello();
+        let kinds: Vec<&str> = hello.sensors.iter().map(|m| m.kind).collect();
+        assert_eq!(
+            kinds,
+            ["field", "field", "field", "puck", "puck", "puck", "puck", "obstacle", "obstacle"]
+        );
+        // the left and right ones mirror each other across the heading
+        let [l, _, r] = [0, 1, 2].map(|k| hello.sensors[k].at);
+        assert!(
+            (l[0] - r[0]).abs() < 1e-9 && (l[1] + r[1]).abs() < 1e-9,
+            "{l:?} {r:?}"
+        );
+        assert!(l[1] < 0.0, "left is negative right: {l:?}");
+        assert!(hello.camera_view.is_empty());
+        // the robot's senses: the photo-transistors and the camera's floor
+        let robot = Session::build(
+            ViewSettings {
+                sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
+                ..ViewSettings::default()
+            },
+            None,
+        )
+        .unwrap();
+        let hello = robot.hello();
+        assert_eq!(hello.sensors.len(), 3);
+        assert!(hello.sensors.iter().all(|m| m.kind == "field"));
+        assert_eq!(
+            hello.camera_view.len(),
+            4 * sim::sensors::pixy_camera::VIEW_EDGE_POINTS
+        );
+        assert!(hello.camera_view.iter().all(|p| p[0] > 0.0));
     }
 
     #[test]

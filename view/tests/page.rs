@@ -104,6 +104,34 @@ fn reset_with_a_seed_reproduces_the_same_frames() {
 }
 
 #[test]
+fn the_sensors_and_the_camera_view_are_drawn_on_request_and_kept_in_the_address() {
+    let settings = view::ViewSettings {
+        sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
+        ..view::ViewSettings::default()
+    };
+    let address = serve(settings, true, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+    assert_eq!(page.data("footprints"), "0");
+    let yellow = pixels_like(&mut page, [255, 255, 0]);
+    // on: per robot (tv75's 5) three photo-transistors and the camera's floor
+    page.eval("document.dispatchEvent(new KeyboardEvent('keydown', { key: 'f', bubbles: true }))");
+    page.wait_for("document.documentElement.dataset.footprints === '20'", 30);
+    assert!(pixels_like(&mut page, [255, 255, 0]) > yellow + 15);
+    assert!(page
+        .eval("location.search")
+        .as_str()
+        .unwrap()
+        .contains("footprints=true"));
+    // a page opened at that address draws them from the start
+    let search = page.eval("location.search").as_str().unwrap().to_string();
+    let mut shared = Browser::open(&format!("http://{address}/{search}"), SIZE);
+    shared.wait_for("document.documentElement.dataset.footprints === '20'", 60);
+    page.eval("document.getElementById('footprints').click()");
+    page.wait_for("document.documentElement.dataset.footprints === '0'", 30);
+}
+
+#[test]
 fn url_parameters_set_the_simulation_and_the_address_bar_keeps_them() {
     let address = serve(small(1), true, Speed::Real);
     let mut page = Browser::open(

@@ -11,6 +11,7 @@
 //! - a mix, for ablations: the field values, the puck bits and the
 //!   obstacle bits each from its own model ([`crate::sensors::mixed`]).
 
+use crate::base::vec2::Vec2;
 use crate::config::disc_sensors::DiscSensorConfig;
 use crate::config::validate::ConfigError;
 use crate::config::SimConfig;
@@ -144,6 +145,14 @@ impl SensorModel for SelectedSensors {
             SelectedSensors::Disc(s) => s.footprints(world, robot, out),
             SelectedSensors::Robot(s) => s.footprints(world, robot, out),
             SelectedSensors::Mixed(s) => s.footprints(world, robot, out),
+        }
+    }
+
+    fn camera_view(&self) -> Vec<Vec2> {
+        match self {
+            SelectedSensors::Disc(s) => s.camera_view(),
+            SelectedSensors::Robot(s) => s.camera_view(),
+            SelectedSensors::Mixed(s) => s.camera_view(),
         }
     }
 

@@ -3,6 +3,7 @@
 //! a third, for example the robot's photo-transistors with the thesis'
 //! puck and obstacle discs.
 
+use crate::base::vec2::Vec2;
 use crate::fields::ScalarField;
 use crate::sensors::{Footprint, SensorMemory, SensorModel};
 use crate::world::World;
@@ -50,6 +51,16 @@ impl<M: SensorModel> SensorModel for MixedSensors<M> {
         self.field.footprints(world, robot, out);
         self.pucks.footprints(world, robot, out);
         self.obstacles.footprints(world, robot, out);
+    }
+
+    /// The puck part's camera's, else the obstacle part's.
+    fn camera_view(&self) -> Vec<Vec2> {
+        let pucks = self.pucks.camera_view();
+        if pucks.is_empty() {
+            self.obstacles.camera_view()
+        } else {
+            pucks
+        }
     }
 
     /// The three parts' camera models, in order.

@@ -40,6 +40,13 @@ pub trait SensorModel {
     /// draws nothing.
     fn footprints(&self, _world: &World, _robot: usize, _out: &mut Vec<Footprint>) {}
 
+    /// The floor a robot's camera sees, for drawing: a polygon in the
+    /// robot's frame (x ahead, y to its right, units). The default, for a
+    /// model without a camera: none.
+    fn camera_view(&self) -> Vec<Vec2> {
+        Vec::new()
+    }
+
     /// What the model remembers, for a checkpoint. The default: nothing.
     fn memory(&self) -> SensorMemory {
         SensorMemory::default()

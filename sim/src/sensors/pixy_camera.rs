@@ -362,6 +362,10 @@ pub(crate) struct PixyCamera {
     avx2: bool,
 }
 
+/// Points along each edge of the image whose rays outline
+/// [`PixyCamera::floor_view`].
+pub const VIEW_EDGE_POINTS: usize = 8;
+
 impl PixyCamera {
     /// The camera of `config` in a world of `unit_mm` millimetres per unit.
     pub fn new(config: &PixyCameraConfig, unit_mm: f64) -> PixyCamera {
@@ -401,6 +405,40 @@ impl PixyCamera {
             merged: Vec::new(),
             avx2: has_avx2(),
         }
+    }
+
+    /// The floor the image covers, within the camera's range: where the
+    /// rays through [`VIEW_EDGE_POINTS`] points along each edge of the
+    /// image meet the floor (or, for rays that do not meet it within the
+    /// range, the range along their bearing), as a polygon in the robot's
+    /// frame (x ahead, y to its right, units), clockwise from the image's
+    /// top left.
+    pub fn floor_view(&self) -> Vec<Vec2> {
+        let tan_half_v = f64::from(IMAGE_HEIGHT) / 2.0 / self.fy;
+        let n = VIEW_EDGE_POINTS;
+        let along = |k: usize| -1.0 + 2.0 * k as f64 / n as f64;
+        // image coordinates (u to the right, v up), each in [-1, 1]
+        let border = (0..n)
+            .map(|k| (along(k), 1.0))
+            .chain((0..n).map(|k| (1.0, -along(k))))
+            .chain((0..n).map(|k| (-along(k), -1.0)))
+            .chain((0..n).map(|k| (-1.0, along(k))));
+        border
+            .map(|(u, v)| {
+                let (a, b) = (u * self.tan_half_h, v * tan_half_v);
+                // the ray: the optical axis pitched down by the tilt
+                let ahead = self.cos_tilt + b * self.sin_tilt;
+                let down = self.sin_tilt - b * self.cos_tilt;
+                let bearing = Vec2::new(ahead, a);
+                let flat = bearing.length();
+                let reach = if down > 0.0 {
+                    (self.height / down * flat).min(self.max_range)
+                } else {
+                    self.max_range
+                };
+                Vec2::new(self.forward, 0.0) + bearing * (reach / flat)
+            })
+            .collect()
     }
 
     /// The classification the firmware applies to the blocks.
@@ -957,6 +995,32 @@ mod tests {
     use std::sync::Arc;
 
     const R: f64 = 10.0;
+
+    #[test]
+    fn the_floor_view_starts_where_the_lowest_ray_meets_the_floor_and_ends_at_the_range() {
+        let camera = PixyCamera::new(&PixyCameraConfig::default(), 6.5);
+        let view = camera.floor_view();
+        assert_eq!(view.len(), 4 * VIEW_EDGE_POINTS);
+        // the image's bottom centre: 20 + 23.5 degrees down from 80 mm up,
+        // 15 mm ahead of the centre
+        let near = view[2 * VIEW_EDGE_POINTS + VIEW_EDGE_POINTS / 2];
+        let expected = (15.0 + 80.0 / 43.5_f64.to_radians().tan()) / 6.5;
+        assert!(
+            (near.x - expected).abs() < 1e-9 && near.y.abs() < 1e-9,
+            "{near:?}"
+        );
+        // the top edge looks 3.5 degrees above the horizon: out to the range
+        let top_centre = view[VIEW_EDGE_POINTS / 2];
+        assert!(
+            (top_centre.x - 15.0 / 6.5 - 1250.0 / 6.5).abs() < 1e-9,
+            "{top_centre:?}"
+        );
+        // left of the heading on the left half of the image, and symmetric
+        assert!(view[0].y < 0.0 && view[VIEW_EDGE_POINTS].y > 0.0);
+        let right = view[VIEW_EDGE_POINTS + 3];
+        let left = view[4 * VIEW_EDGE_POINTS - 3];
+        assert!((right.x - left.x).abs() < 1e-9 && (right.y + left.y).abs() < 1e-9);
+    }
 
     /// Robot 0 at (400, 400) facing +x (its right is +y), plus other robots
     /// and pucks at offsets (ahead, right) in robot radii.

@@ -25,6 +25,7 @@
 //! [`RobotSensorConfig`] (JSON, every field optional; `docs/robot-sensors.md`).
 
 use crate::base::noise::{self, Purpose};
+use crate::base::vec2::Vec2;
 use crate::config::validate::ConfigError;
 use crate::config::WorldConfig;
 use crate::fields::ScalarField;
@@ -228,7 +229,8 @@ impl SensorModel for RobotSensors {
         }
     }
 
-    /// The three field sensor points (the camera's view is not drawn).
+    /// The three field sensor points (the camera's view is
+    /// [`SensorModel::camera_view`]).
     fn footprints(&self, world: &World, robot: usize, out: &mut Vec<Footprint>) {
         let (pos, dir) = (world.bodies()[robot].pos, world.robots()[robot].direction);
         out.extend(self.photo.points().iter().map(|p| Footprint {
@@ -236,6 +238,10 @@ impl SensorModel for RobotSensors {
             radius: 0.0,
             kind: FootprintKind::Field,
         }));
+    }
+
+    fn camera_view(&self) -> Vec<Vec2> {
+        self.camera.floor_view()
     }
 
     /// One camera model: its robots' links.
