@@ -66,7 +66,7 @@ pub const TEN_BIT: Variant = Variant {
             FIRMWARE_OUT=target/avr-none/robot-annulus-10bit scripts/build-firmware",
 };
 
-/// A policy with ties (56 states with 2 best actions, 35 with 3, 42 with
+/// A policy with ties (60 states with 2 best actions, 29 with 3, 28 with
 /// 4): the firmware draws; built as robot 3, so that the generator is the
 /// robot id's, not robot 0's.
 pub const TIED: Variant = Variant {

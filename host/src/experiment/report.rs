@@ -51,6 +51,7 @@ pub const DOCUMENTS: [Document; 2] = [
             "robot-senses-ablation",
             "robot-senses-sweep",
             "robustness",
+            "robustness-thesis",
             "robot-senses-letter",
             "wedge",
             "wedge-sweep",

@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 14] = [
+pub const BUILT_IN: [(&str, &str); 15] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
@@ -54,6 +54,10 @@ pub const BUILT_IN: [(&str, &str); 14] = [
     (
         "robustness",
         include_str!("../../../experiments/robustness.toml"),
+    ),
+    (
+        "robustness-thesis",
+        include_str!("../../../experiments/robustness-thesis.toml"),
     ),
     (
         "robot-senses-letter",
