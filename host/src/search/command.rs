@@ -122,19 +122,29 @@ impl std::fmt::Display for SearchReport {
     }
 }
 
-/// The world's settings: the file, then the flags; on a screen the shape's
-/// puck count ([`tv_pucks`]) unless `--pucks` is given.
-fn world(request: &SearchRequest) -> Result<TrainConfig> {
-    let mut config = match &request.config {
+/// The worlds' settings: the file, then the flags, on the run's field and
+/// then on each `--also-field`; on a screen each shape's puck count
+/// ([`tv_pucks`]) unless `--pucks` is given.
+fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
+    let mut base = match &request.config {
         Some(path) => TrainConfig::from_file(path)?,
         None => TrainConfig::default(),
     };
-    request.flags.apply(&mut config)?;
-    if config.pucks.is_none() && config.arena_choice().screen().is_ok() {
-        config.pucks = tv_pucks(&config.field);
-    }
-    config.validate()?;
-    Ok(config)
+    request.flags.apply(&mut base)?;
+    let fields = std::iter::once(base.field.clone()).chain(request.search.also_field.clone());
+    fields
+        .map(|field| {
+            let mut config = TrainConfig {
+                field,
+                ..base.clone()
+            };
+            if base.pucks.is_none() && config.arena_choice().screen().is_ok() {
+                config.pucks = tv_pucks(&config.field);
+            }
+            config.validate()?;
+            Ok(config)
+        })
+        .collect()
 }
 
 /// The start table and the steps distilled for it.
@@ -155,13 +165,17 @@ fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, u64)
 
 /// Runs `host search`.
 pub fn search(request: &SearchRequest) -> Result<SearchReport> {
-    let config = world(request)?;
+    let configs = worlds(request)?;
+    let config = configs[0].clone();
     let settings = &request.search;
     let actions_count = config.learn.actions.len();
     settings.validate(actions_count)?;
     crate::atomic::check_writable(&config.output.dir)?;
-    let prepared = config.prepare()?;
-    let forward = prepared.config().world.forward_speed as f32;
+    let prepared = configs
+        .iter()
+        .map(TrainConfig::prepare)
+        .collect::<Result<Vec<_>>>()?;
+    let forward = prepared[0].config().world.forward_speed as f32;
     let actions = ActionTable::new(&config.learn.actions, forward)
         .context("the run's actions are not a valid action table")?;
     let scorer = Scorer::new(prepared, actions, settings.threads)?;
@@ -260,9 +274,15 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sim::fields::source::FieldSource;
 
     /// A small search on the TV with the robot's senses and noise.
     fn small(threads: usize, start: Start) -> SearchLog {
+        small_over(threads, start, Vec::new())
+    }
+
+    /// [`small`], also scored on `also_field`.
+    fn small_over(threads: usize, start: Start, also_field: Vec<FieldSource>) -> SearchLog {
         let flags = TrainFlags::parse([
             "--sensors",
             "robot",
@@ -290,12 +310,14 @@ mod tests {
                 rate: 0.5,
                 floor: 0.01,
                 threads,
+                also_field,
             },
         };
-        let config = world(&request).unwrap();
+        let configs = worlds(&request).unwrap();
+        let config = configs[0].clone();
         assert_eq!(config.pucks, Some(12), "the annulus' count on the TV");
-        let prepared = config.prepare().unwrap();
-        let forward = prepared.config().world.forward_speed as f32;
+        let prepared: Vec<_> = configs.iter().map(|c| c.prepare().unwrap()).collect();
+        let forward = prepared[0].config().world.forward_speed as f32;
         let actions = ActionTable::new(&config.learn.actions, forward).unwrap();
         let scorer = Scorer::new(prepared, actions, threads).unwrap();
         let (table, distilled) = start_table(&config, &request.search.start).unwrap();
@@ -314,6 +336,33 @@ mod tests {
             .generations
             .iter()
             .any(|g| g.fitness.iter().any(|f| f.formations > 0)));
+    }
+
+    #[test]
+    fn a_general_search_scores_every_field_with_its_pucks_the_same_on_any_thread_count() {
+        let letter: FieldSource = "letter:I".parse().unwrap();
+        let one = small_over(1, Start::Orbital, vec![letter.clone()]);
+        let mut two = small_over(2, Start::Orbital, vec![letter.clone()]);
+        two.search.threads = 1;
+        assert_eq!(one, two);
+        // the annulus alone scores differently: the I's worlds count too
+        let alone = small(1, Start::Orbital);
+        assert_ne!(one.start_validation, alone.start_validation);
+        assert!(one.start_validation.formations >= alone.start_validation.formations);
+        let request = SearchRequest {
+            config: None,
+            flags: TrainFlags::parse(["--sensors", "robot"]).unwrap(),
+            search: SearchConfig {
+                also_field: vec![letter],
+                ..one.search.clone()
+            },
+        };
+        let configs = worlds(&request).unwrap();
+        assert_eq!(
+            configs.iter().map(|c| c.pucks).collect::<Vec<_>>(),
+            [Some(12), Some(11)],
+            "each shape's own count on the TV"
+        );
     }
 
     #[test]

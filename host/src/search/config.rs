@@ -4,6 +4,7 @@
 
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
+use sim::fields::source::FieldSource;
 use std::path::PathBuf;
 
 /// Where the search starts.
@@ -94,6 +95,13 @@ pub struct SearchConfig {
     /// for any number.
     #[arg(long, default_value_t = 0)]
     pub threads: usize,
+    /// Another field every candidate is also scored on (repeatable), with
+    /// its shape's puck count on a screen unless --pucks is given: one
+    /// general table for several shapes, ranked by the sum over the fields
+    /// of ln(1 + formations).
+    #[arg(long = "also-field", value_name = "FIELD")]
+    #[serde(default)]
+    pub also_field: Vec<FieldSource>,
 }
 
 impl SearchConfig {

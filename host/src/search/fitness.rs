@@ -2,9 +2,15 @@
 //! of a run's settings, and their mean Eval at the formation checks (which
 //! orders tables that form equally many, as on a letter where few form
 //! any), one world per seed, every candidate on the same
-//! seeds (common random numbers), the (table, seed) pairs spread over a
-//! thread pool and gathered in order, so that the scores do not depend on
-//! the number of threads.
+//! seeds (common random numbers), the (table, world, seed) triples spread
+//! over a thread pool and gathered in order, so that the scores do not
+//! depend on the number of threads.
+//!
+//! Several worlds (one per field: a general policy's shapes) are balanced:
+//! a table ranks by the sum over the fields of ln(1 + its formations on
+//! that field), so that doubling a weak shape's count weighs what doubling
+//! a strong one's does. With one field that order is the formations'
+//! own.
 
 use crate::experiment::plan::mix;
 use anyhow::{Context, Result};
@@ -35,41 +41,57 @@ pub fn validation_seeds(seed: u64, count: usize) -> Vec<u64> {
         .collect()
 }
 
-/// A table's score on a set of worlds: more formations is better, and of
-/// equal formations a higher mean Eval.
+/// A table's score on a set of worlds: a higher balance is better (more
+/// formations, with one field), and of equal balance a higher mean Eval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Score {
-    /// Formations, summed over the worlds.
+    /// Formations, summed over the worlds of every field.
     pub formations: u64,
     /// Mean Eval at the formation checks, averaged over the worlds.
     pub eval: f64,
+    /// The sum over the fields of ln(1 + the field's formations).
+    pub balance: f64,
 }
 
 impl Score {
     /// Whether this score is better than `other`.
     pub fn beats(&self, other: &Score) -> bool {
-        (self.formations, self.eval) > (other.formations, other.eval)
+        Score::best_first(self, other) == std::cmp::Ordering::Less
     }
 
-    /// Best first: by formations, then mean Eval.
+    /// Best first: by balance, then mean Eval.
     pub fn best_first(a: &Score, b: &Score) -> std::cmp::Ordering {
-        (b.formations, b.eval)
-            .partial_cmp(&(a.formations, a.eval))
+        (b.balance, b.eval)
+            .partial_cmp(&(a.balance, a.eval))
             .unwrap_or(std::cmp::Ordering::Equal)
+    }
+
+    /// The score of per-field scores (formations and mean Eval of each).
+    fn of_fields(fields: &[(u64, f64)]) -> Score {
+        Score {
+            formations: fields.iter().map(|f| f.0).sum(),
+            eval: fields.iter().map(|f| f.1).sum::<f64>() / fields.len().max(1) as f64,
+            balance: fields.iter().map(|f| (f.0 as f64).ln_1p()).sum(),
+        }
     }
 }
 
-/// Builds worlds of one run's settings and drives them with tables.
+/// Builds worlds of one run's settings (one per field) and drives them
+/// with tables.
 pub struct Scorer {
-    prepared: PreparedScenario,
+    prepared: Vec<PreparedScenario>,
     actions: ActionTable,
     pool: rayon::ThreadPool,
 }
 
 impl Scorer {
-    /// A scorer of `prepared`'s worlds with `actions`, on `threads` threads
-    /// (0: one per core).
-    pub fn new(prepared: PreparedScenario, actions: ActionTable, threads: usize) -> Result<Scorer> {
+    /// A scorer of the worlds of each of `prepared` (one per field) with
+    /// `actions`, on `threads` threads (0: one per core).
+    pub fn new(
+        prepared: Vec<PreparedScenario>,
+        actions: ActionTable,
+        threads: usize,
+    ) -> Result<Scorer> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
@@ -81,45 +103,67 @@ impl Scorer {
         })
     }
 
-    /// Each table's score over `seeds`, `steps` steps per world; in the
-    /// order of `tables`.
+    /// Each table's score over `seeds` on every field, `steps` steps per
+    /// world; in the order of `tables`.
     pub fn score(&self, tables: &[PolicyTable], seeds: &[u64], steps: u64) -> Result<Vec<Score>> {
-        let jobs: Vec<(usize, u64)> = (0..tables.len())
-            .flat_map(|t| seeds.iter().map(move |&s| (t, s)))
+        let fields = self.prepared.len();
+        let jobs: Vec<(usize, usize, u64)> = (0..tables.len())
+            .flat_map(|t| (0..fields).flat_map(move |f| seeds.iter().map(move |&s| (t, f, s))))
             .collect();
-        let worlds: Vec<Score> = self.pool.install(|| {
+        let worlds: Vec<(u64, f64)> = self.pool.install(|| {
             jobs.par_iter()
-                .map(|&(t, seed)| self.world(&tables[t], seed, steps))
-                .collect::<Result<Vec<Score>>>()
+                .map(|&(t, f, seed)| self.world(&tables[t], f, seed, steps))
+                .collect::<Result<Vec<_>>>()
         })?;
-        Ok(worlds
+        let per_field: Vec<(u64, f64)> = worlds
             .chunks(seeds.len().max(1))
-            .map(|c| Score {
-                formations: c.iter().map(|s| s.formations).sum(),
-                eval: c.iter().map(|s| s.eval).sum::<f64>() / c.len() as f64,
+            .map(|c| {
+                (
+                    c.iter().map(|w| w.0).sum(),
+                    c.iter().map(|w| w.1).sum::<f64>() / c.len() as f64,
+                )
             })
+            .collect();
+        Ok(per_field
+            .chunks(fields.max(1))
+            .map(Score::of_fields)
             .collect())
     }
 
-    /// The score of `table` in the world of `seed` after `steps` steps.
-    fn world(&self, table: &PolicyTable, seed: u64, steps: u64) -> Result<Score> {
+    /// The formations and mean Eval of `table` in field `field`'s world of
+    /// `seed` after `steps` steps.
+    fn world(
+        &self,
+        table: &PolicyTable,
+        field: usize,
+        seed: u64,
+        steps: u64,
+    ) -> Result<(u64, f64)> {
         let provenance = Provenance::new("search", "candidate", 0, seed)?;
         let blob = PolicyBlob::new(self.actions, table.clone(), provenance)?;
-        let mut sim = self
-            .prepared
+        let mut sim = self.prepared[field]
             .simulation(seed)
             .context("cannot build a search world")?;
         sim.run(&mut GreedyPolicy::new(blob), steps);
-        Ok(Score {
-            formations: sim.totals().formations,
-            eval: sim.totals().mean_eval(),
-        })
+        Ok((sim.totals().formations, sim.totals().mean_eval()))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_field_ranks_by_formations_and_several_balance_them() {
+        let one = |f: u64, e: f64| Score::of_fields(&[(f, e)]);
+        assert!(one(5, 0.1).beats(&one(4, 0.9)));
+        assert!(one(4, 0.9).beats(&one(4, 0.8)));
+        // doubling a weak shape's count outweighs adding as many to a strong one's
+        let weak_doubled = Score::of_fields(&[(1000, 0.5), (20, 0.5)]);
+        let strong_plus = Score::of_fields(&[(1010, 0.5), (10, 0.5)]);
+        assert!(weak_doubled.beats(&strong_plus));
+        assert_eq!(weak_doubled.formations, 1020);
+    }
 
     #[test]
     fn fitness_and_validation_seeds_never_meet() {
