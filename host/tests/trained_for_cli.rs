@@ -134,10 +134,14 @@ fn run_and_render_warn_when_the_policy_was_trained_for_other_senses_or_another_a
     assert!(ok, "{err}");
     assert!(!err.contains("warning"), "{err}");
     // a version 1 blob does not say: no word
-    let v1 = format!(
-        "policy:{}",
-        repo().join("policies/robot-annulus-8bit.policy").display()
+    let v1_path = repo().join("policies/oc-heuristic.policy");
+    let v1_blob = PolicyBlob::decode(&std::fs::read(&v1_path).unwrap()).unwrap();
+    assert_eq!(
+        v1_blob.version(),
+        1,
+        "the shipped hand-written policy is a version 1 blob"
     );
+    let v1 = format!("policy:{}", v1_path.display());
     let (ok, _, err) = output(host().args(["run", "--steps", "200", "--controller", &v1]));
     assert!(ok, "{err}");
     assert!(!err.contains("warning"), "{err}");

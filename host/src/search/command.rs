@@ -207,8 +207,10 @@ pub fn run(
 ) -> Result<SearchLog> {
     let actions = config.learn.actions.len();
     let validation = validation_seeds(config.seed, settings.validation_seeds);
-    let validation_cost = settings.validation_steps * validation.len() as u64;
-    let fitness_cost = settings.fitness_steps * settings.fitness_seeds as u64;
+    // every world is run once per field
+    let fields = scorer.fields() as u64;
+    let validation_cost = settings.validation_steps * validation.len() as u64 * fields;
+    let fitness_cost = settings.fitness_steps * settings.fitness_seeds as u64 * fields;
     let start_validation = scorer.score(
         std::slice::from_ref(&start),
         &validation,
@@ -347,6 +349,7 @@ mod tests {
         assert_eq!(one, two);
         // the annulus alone scores differently: the I's worlds count too
         let alone = small(1, Start::Orbital);
+        assert_eq!(one.steps, 2 * alone.steps, "two fields' worlds simulated");
         assert_ne!(one.start_validation, alone.start_validation);
         assert!(one.start_validation.formations >= alone.start_validation.formations);
         let request = SearchRequest {

@@ -103,6 +103,11 @@ impl Scorer {
         })
     }
 
+    /// Fields each table is scored on.
+    pub fn fields(&self) -> usize {
+        self.prepared.len()
+    }
+
     /// Each table's score over `seeds` on every field, `steps` steps per
     /// world; in the order of `tables`.
     pub fn score(&self, tables: &[PolicyTable], seeds: &[u64], steps: u64) -> Result<Vec<Score>> {
