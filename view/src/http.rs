@@ -1,7 +1,9 @@
-//! Just enough HTTP/1.1 for the view: one request a connection (the answer
-//! closes it), headers at most [`HEAD_LIMIT`] bytes, a body of at most the
-//! caller's limit, every read and write with a timeout (so a half-open
-//! connection ends), and the WebSocket handshake.
+//! Just enough HTTP/1.1 for the view's servers: connections accepted each
+//! on its own thread, at most [`MAX_CONNECTIONS`] at once; one request a
+//! connection (the answer closes it), headers at most [`HEAD_LIMIT`] bytes,
+//! a body of at most the caller's limit, every read and write with a
+//! timeout (so a half-open connection ends), errors answered as JSON; and
+//! the WebSocket handshake.
 
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
