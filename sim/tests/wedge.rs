@@ -535,7 +535,7 @@ fn a_wedge_run_is_the_same_for_the_same_seed_and_resumes_exactly_from_a_snapshot
 }
 
 /// `docs/robot-sensors/skirt.svg`: the thesis' skirt on the TV's robots
-/// (`experiments/arenas/tv75-wedge.toml`) drawn to scale, 2 pixels per
+/// (tv75's) drawn to scale, 2 pixels per
 /// mm, heading up: the outline, the Zumo's 98 x 86 mm chassis, the three
 /// photo-transistors where the sensor model puts them, the Pixy's lens,
 /// and the disc of tv75's radius for comparison. Every figure is the
