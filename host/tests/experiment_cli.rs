@@ -4,6 +4,8 @@
 use assert_cmd::Command;
 use std::path::{Path, PathBuf};
 
+mod served;
+
 fn host() -> Command {
     Command::cargo_bin("host").unwrap()
 }
@@ -515,7 +517,7 @@ fn trials_another_run_made_with_the_same_settings_are_copied_not_run() {
 /// learner's progress; and they give what a run without the view gives.
 #[test]
 fn with_the_view_each_trial_is_shown_in_turn_and_its_results_do_not_change() {
-    use std::io::{BufRead, Read, Write};
+    use std::io::BufRead;
     let dir = tempfile::tempdir().unwrap();
     let spec = dir.path().join("watched.toml");
     std::fs::write(
@@ -557,16 +559,8 @@ controller = "oc"
             break url.trim_end_matches('/').to_string();
         }
     };
-    let mut stream = std::net::TcpStream::connect(&address).unwrap();
-    write!(
-        stream,
-        "GET /state.json HTTP/1.1\r\nHost: {address}\r\n\r\n"
-    )
-    .unwrap();
-    let mut reply = String::new();
-    stream.read_to_string(&mut reply).unwrap();
-    let state: serde_json::Value =
-        serde_json::from_str(reply.split_once("\r\n\r\n").unwrap().1).unwrap();
+    let (_, body) = served::request(&address, "GET", "/state.json");
+    let state: serde_json::Value = serde_json::from_slice(&body).unwrap();
     assert_eq!(
         state["hello"]["caption"], "watched: arm learner, trial 0 (1 of 2 to run)",
         "{state}"

@@ -1,5 +1,6 @@
-//! A `host view` process for the CLI tests: started on a free port, its
-//! address read from its first line, stopped when dropped.
+//! A `host view` process for the CLI tests (started on a free port, its
+//! address read from its first line, stopped when dropped), and one request
+//! to it or to any page `host` serves.
 
 #![allow(dead_code, reason = "each test binary uses part of the helper")]
 
