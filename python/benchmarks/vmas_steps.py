@@ -66,7 +66,7 @@ def main():
     def actions():
         return [torch.rand((args.envs, 2), generator=gen) * 2 - 1 for _ in env.agents]
 
-    for _ in range(2):  # warm-up
+    for _ in range(10):  # warm-up: the first calls pay for allocation and caching
         env.step(actions())
     start, cpu = time.perf_counter(), time.process_time()
     for _ in range(args.steps):
