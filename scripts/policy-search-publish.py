@@ -17,6 +17,8 @@ BEGIN, END = "<!-- results:begin -->", "<!-- results:end -->"
 NAMES = {
     "oc": "orbital construction",
     "-oc.policy": "search from distilled OC",
+    "-more.policy": "search from distilled OC, continued",
+    "-again.policy": "search from distilled OC, continued twice",
     "annulus-random.policy": "search from random",
     "annulus-from-q.policy": "search from Q-learning's table",
     "annulus-q.policy": "Q-learning (distilled start, selection)",
@@ -29,7 +31,8 @@ def name_of(controller):
     if controller == "oc":
         return NAMES["oc"]
     base = os.path.basename(controller)
-    return NAMES.get(base) or NAMES["-oc.policy"]
+    ending = next((e for e in ("-again.policy", "-more.policy") if base.endswith(e)), "-oc.policy")
+    return NAMES.get(base) or NAMES[ending]
 
 
 def publish(out, results_path):
@@ -88,9 +91,11 @@ def tables(results):
         if field == "annulus":
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
-        found = shape.get(NAMES["-oc.policy"], {}).get("per_million")
-        if found is None:
+        # a letter's search: the last continuation evaluated
+        searched = [shape[n] for n in (NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
+        if not searched:
             continue
+        found = searched[0]["per_million"]
         need = 50.0
         if oc >= 20:
             need = max(need, oc)

@@ -111,14 +111,22 @@ def run(args) -> dict:
                 agent, env, log = marl_ppo.train(a)
                 return agent.table(), log["formations"], env
             learned("shared-policy PPO (marl_ppo.py)", reward, marl)
-        import ppo_sb3
-
+        if args.sb3_rewards:  # stable-baselines3 only where its rows are asked for
+            import ppo_sb3
         for reward in args.sb3_rewards:
             def sb3(reward=reward):
                 model, env = ppo_sb3.train(steps=args.steps, seed=1, reward=reward)
                 formations = env.venv.formations  # counted before distil steps the worlds on
                 return ppo_sb3.distil(model, env), formations, env.venv.venv
             learned("SB3 PPO (ppo_sb3.py)", reward, sb3)
+        import marl_q
+
+        for reward in args.marl_q_rewards:
+            def shared_q(reward=reward):
+                a = marl_q.parse(["--steps", str(args.steps), "--reward", reward, "--seed", "1"])
+                q, env, log = marl_q.train(a)
+                return q.table(), log["formations"], env
+            learned("shared Q-network (marl_q.py)", reward, shared_q)
     return {
         "date": datetime.date.today().isoformat(),
         "machine": f"{platform.machine()}, {os.cpu_count()} cores",
@@ -158,6 +166,7 @@ def main() -> None:
     p.add_argument("--tabular-rewards", nargs="*", default=["reference", "thesis", "success-shaped"])
     p.add_argument("--marl-rewards", nargs="*", default=["reference", "per-robot", "success-shaped"])
     p.add_argument("--sb3-rewards", nargs="*", default=["success-shaped"])
+    p.add_argument("--marl-q-rewards", nargs="*", default=["reference"])
     p.add_argument("--no-neural", dest="neural", action="store_false")
     p.add_argument("--out", default="docs/python-learning.json")
     args = p.parse_args()

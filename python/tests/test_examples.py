@@ -41,6 +41,25 @@ def test_the_shared_policy_ppo_example_trains_logs_and_exports_its_table(tmp_pat
     assert np.array_equal(policy.act(states), greedy), "the blob acts as the network does greedily"
 
 
+def test_the_shared_q_network_example_trains_logs_and_exports_its_table(tmp_path):
+    torch = pytest.importorskip("torch")
+    import marl_q
+
+    args = marl_q.parse(["--steps", "2048", "--worlds", "4", "--max-steps", "100"])
+    q, env, log = marl_q.train(args)
+    assert len(log["episodes"]) >= 4, "ended episodes' returns are logged"
+    assert all(0.0 < e <= 1.0 for _, e in log["episodes"])
+    weights = q.linear.weight.detach()
+    assert (weights != args.initial_q).any(), "the steps moved some Q-values"
+    table = q.table()
+    path = zumo_swarm.export_policy(tmp_path / "marl-q.policy", table, env=env, trainer_steps=2048)
+    policy = zumo_swarm.load_policy(path)
+    states = np.arange(256).reshape(32, 8)
+    with torch.no_grad():
+        greedy = q(torch.as_tensor(states)).argmax(-1).numpy()
+    assert np.array_equal(policy.act(states), greedy), "the blob acts as the network does greedily"
+
+
 def test_the_sb3_ppo_example_logs_returns_and_eval_and_distils_into_a_blob(tmp_path):
     pytest.importorskip("stable_baselines3")
     import ppo_sb3

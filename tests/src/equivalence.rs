@@ -89,6 +89,27 @@ pub const ROLE: Variant = Variant {
             FIRMWARE_OUT=target/avr-none/robot-annulus-role scripts/build-firmware",
 };
 
+/// The policy search's annulus table (issue 31) in an innie's firmware.
+pub const SEARCH_ANNULUS: Variant = Variant {
+    policy: "robot-search-annulus.policy",
+    elf_dir: "robot-search-annulus",
+    hasher: StateHasher::OriginalRole,
+    robot_id: 1,
+    build: "FIRMWARE_POLICY=policies/robot-search-annulus.policy FIRMWARE_HASHER=original-role FIRMWARE_ROBOT_ID=1 \
+            FIRMWARE_OUT=target/avr-none/robot-search-annulus scripts/build-firmware",
+};
+
+/// The general policy (one table for every shape, issue 31).
+pub const GENERAL: Variant = Variant {
+    policy: "robot-general.policy",
+    elf_dir: "robot-general",
+    hasher: StateHasher::Original,
+    robot_id: 0,
+    build:
+        "FIRMWARE_POLICY=policies/robot-general.policy FIRMWARE_OUT=target/avr-none/robot-general \
+            scripts/build-firmware",
+};
+
 /// One robot's state in a simulated episode, with its raw stimulus.
 #[derive(Clone, Debug)]
 pub struct Sample {

@@ -33,8 +33,8 @@ use std::collections::HashMap;
 use std::time::Instant;
 use tests::equivalence::{
     check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, follow_log, mirrored, nudge,
-    read_policy, sample_states, Decided, Expectation, Expected, Sample, Variant, EIGHT_BIT, ROLE,
-    TEN_BIT, TIED,
+    read_policy, sample_states, Decided, Expectation, Expected, Sample, Variant, EIGHT_BIT,
+    GENERAL, ROLE, SEARCH_ANNULUS, TEN_BIT, TIED,
 };
 use tests::figures::{compiler_of, thousands, Figures, Outcome};
 use tests::playback::{driving_zumo, frames_since_boot, play, Observed, Stimulus};
@@ -469,4 +469,14 @@ fn the_firmware_of_a_tied_policy_draws_as_the_simulators_robot_of_its_id() {
 #[test]
 fn the_role_firmware_of_an_innie_decides_as_the_simulator() {
     equivalence(&ROLE);
+}
+
+#[test]
+fn the_firmware_of_the_searched_annulus_policy_decides_as_the_simulator() {
+    equivalence(&SEARCH_ANNULUS);
+}
+
+#[test]
+fn the_firmware_of_the_general_policy_decides_as_the_simulator() {
+    equivalence(&GENERAL);
 }

@@ -1,0 +1,111 @@
+"""Shared-network Q-learning in the style of CleanRL (one file, PyTorch):
+one Q-network for every robot of every world, over the vector env.
+
+The thesis' learner as a PyTorch module trained by gradient steps: each
+robot's hashed state (observation="state") goes in one-hot, every robot
+acts greedily on the shared Q-values (ties broken at random), and after
+each step one SGD step moves Q(s, a) of every robot's transition towards
+r + gamma max Q(s', .); the transitions of all robots of all worlds are
+the batch (no replay buffer, no target network). The loss is summed over
+the batch, so each transition moves its own Q-value by --lr of its error,
+as the thesis' alpha does. The network is linear in the one-hot state
+with every weight at --initial-q, above what the reference reward pays: an
+action not yet tried looks better than one that failed, the optimism the
+thesis' learner explores by. (A hidden layer shares what one state learns
+with every other state, which undoes that optimism: with 64 hidden units
+the greedy policy collapsed to one action everywhere, docs/python.md.)
+The greedy action per state is the table it exports: exactly the policy a
+robot runs.
+"""
+import argparse
+
+import numpy as np
+import torch
+from torch import nn
+
+import zumo_swarm
+
+
+def parse(argv=None):
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("--steps", type=int, default=1_000_000, help="world-steps, all worlds together")
+    p.add_argument("--worlds", type=int, default=4)
+    p.add_argument("--reward", default="reference")
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--lr", type=float, default=0.2, help="SGD step size: the thesis' alpha")
+    p.add_argument("--gamma", type=float, default=0.9)
+    p.add_argument("--initial-q", type=float, default=1.0)
+    p.add_argument("--max-steps", type=int, help="episode truncation (default none: an episode ends when it forms or is stuck)")
+    p.add_argument("--out", default="out/marl-q-annulus.policy")
+    return p.parse_args(argv)
+
+
+class QNetwork(nn.Module):
+    """Q-values of every action for one robot's hashed state."""
+
+    def __init__(self, states, actions, initial_q):
+        super().__init__()
+        self.states = states
+        self.linear = nn.Linear(states, actions, bias=False)
+        with torch.no_grad():
+            self.linear.weight.fill_(initial_q)
+
+    def forward(self, s):
+        return self.linear(nn.functional.one_hot(s, self.states).float())
+
+    def table(self):
+        """The greedy action of every state: the policy as the robot looks it up."""
+        with torch.no_grad():
+            return self(torch.arange(self.states)).argmax(-1).numpy()
+
+
+def greedy(q, generator):
+    """The best action of each row, ties broken uniformly at random."""
+    best = q == q.max(-1, keepdim=True).values
+    return torch.where(best, torch.rand(q.shape, generator=generator), -1.0).argmax(-1)
+
+
+def train(args):
+    torch.manual_seed(args.seed)
+    torch.set_num_threads(1)  # small network: more threads only contend with the simulator's
+    generator = torch.Generator().manual_seed(args.seed)
+    env = zumo_swarm.RecordRobotEpisodeStatistics(zumo_swarm.vector_env(
+        args.worlds, observation="state", reward=args.reward, gamma=args.gamma,
+        max_steps=args.max_steps, autoreset_mode="same-step", seed=args.seed,
+    ))
+    batch = env.unwrapped.batch
+    q = QNetwork(batch.num_states, len(batch.angular_speeds), args.initial_q)
+    optimiser = torch.optim.SGD(q.parameters(), lr=args.lr)
+    obs = torch.as_tensor(env.reset(seed=args.seed)[0])
+    log = {"formations": 0, "episodes": []}
+    calls = max(1, args.steps // args.worlds)
+    for call in range(calls):
+        with torch.no_grad():
+            action = greedy(q(obs), generator)
+        next_obs, reward, terminated, truncated, info = env.step(action.numpy())
+        # a world that ended restarted in this step: bootstrap from its final state
+        after = next_obs
+        if "final_obs" in info:
+            after = np.where(info["_final_obs"][:, None], info["final_obs"], next_obs)
+        with torch.no_grad():
+            target = torch.as_tensor(reward, dtype=torch.float) + args.gamma * q(torch.as_tensor(after)).max(-1).values
+        chosen = q(obs).gather(-1, action[..., None]).squeeze(-1)
+        loss = 0.5 * ((chosen - target) ** 2).sum()
+        optimiser.zero_grad()
+        loss.backward()
+        optimiser.step()
+        obs = torch.as_tensor(next_obs)
+        if "episode" in info:
+            ended = info["_episode"]
+            log["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
+        if call % 25_000 == 0 or call == calls - 1:
+            log["formations"] = int(info["formations"].sum())
+            print(f"step {(call + 1) * args.worlds}: {log['formations']} formed, Eval {info['eval'].mean():.4f}")
+    return q, env, log
+
+
+if __name__ == "__main__":
+    args = parse()
+    q, env, log = train(args)
+    print(f"{log['formations']} annuli formed in {args.steps} world-steps")
+    zumo_swarm.export_policy(args.out, q.table(), env=env, trainer_steps=args.steps, seed=args.seed)
