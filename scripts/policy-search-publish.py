@@ -56,7 +56,8 @@ def publish(out, results_path):
 
         searches.append({
             "name": os.path.basename(path)[: -len(".search.json")],
-            "field": log["world"]["field"],
+            # a general search's fields, the first the worlds' own
+            "field": " + ".join([log["world"]["field"], *log["search"].get("also_field", [])]),
             "hasher": log["world"]["learn"]["hasher"],
             "start": log["search"]["start"],
             "generations": len(log["generations"]),

@@ -11,11 +11,10 @@ the batch, so each transition moves its own Q-value by --lr of its error,
 as the thesis' alpha does. The network is linear in the one-hot state
 with every weight at --initial-q, above what the reference reward pays: an
 action not yet tried looks better than one that failed, the optimism the
-thesis' learner explores by. (A hidden layer shares what one state learns
-with every other state, which undoes that optimism: with 64 hidden units
-the greedy policy collapsed to one action everywhere, docs/python.md.)
-The greedy action per state is the table it exports: exactly the policy a
-robot runs.
+thesis' learner explores by. (Through a hidden layer what one state
+learns would move every other state's values too and undo that optimism.)
+Its Q-table is what it exports: each state's best actions, among which the
+robot picks as the learner did.
 """
 import argparse
 
@@ -53,10 +52,12 @@ class QNetwork(nn.Module):
     def forward(self, s):
         return self.linear(nn.functional.one_hot(s, self.states).float())
 
-    def table(self):
-        """The greedy action of every state: the policy as the robot looks it up."""
+    def values(self):
+        """The Q-table, states x actions: what `export_policy` turns into the
+        robot's policy (every best action of a state kept, as the learner
+        broke ties among them)."""
         with torch.no_grad():
-            return self(torch.arange(self.states)).argmax(-1).numpy()
+            return self(torch.arange(self.states)).numpy()
 
 
 def greedy(q, generator):
@@ -108,4 +109,4 @@ if __name__ == "__main__":
     args = parse()
     q, env, log = train(args)
     print(f"{log['formations']} annuli formed in {args.steps} world-steps")
-    zumo_swarm.export_policy(args.out, q.table(), env=env, trainer_steps=args.steps, seed=args.seed)
+    zumo_swarm.export_policy(args.out, q.values(), env=env, trainer_steps=args.steps, seed=args.seed)

@@ -55,6 +55,7 @@ pub const DOCUMENTS: [Document; 2] = [
             "robot-senses-letter",
             "wedge",
             "wedge-sweep",
+            "every-shape",
         ],
     },
 ];

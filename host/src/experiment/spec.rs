@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 15] = [
+pub const BUILT_IN: [(&str, &str); 16] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
@@ -67,6 +67,10 @@ pub const BUILT_IN: [(&str, &str); 15] = [
     (
         "wedge-sweep",
         include_str!("../../../experiments/wedge-sweep.toml"),
+    ),
+    (
+        "every-shape",
+        include_str!("../../../experiments/every-shape.toml"),
     ),
 ];
 
