@@ -61,3 +61,20 @@ def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it
     sb3 = by[("SB3 PPO", "success-shaped")]
     assert sb3["final_eval"] > still["final_eval"] > random["final_eval"]
     assert all(abs(r["final_eval"] - still["final_eval"]) < 0.001 for (learner, _), r in by.items() if learner == "shared-policy PPO")
+
+
+def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
+    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
+    learning = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(learning)
+    results = json.loads((repo / "docs" / "python-learning-q.json").read_text())
+    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
+    still, random = by[("robots standing still", None)], by[("random actions", None)]
+    tabular, shared = by[("tabular Q", "reference")], by[("shared Q-network", "reference")]
+    assert shared["trained_formations"] >= tabular["trained_formations"] / 4 > 0
+    assert shared["final_eval"] == max(r["final_eval"] for r in results["rows"])
+    assert shared["final_eval"] > max(still["final_eval"], random["final_eval"])
+    assert shared["formations"] < tabular["formations"] / 4
+    assert shared["exported_formations"] < 0.9 * shared["trained_formations"]
+    assert tabular["exported_formations"] >= 0.9 * tabular["trained_formations"]
