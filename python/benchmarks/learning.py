@@ -125,7 +125,7 @@ def run(args) -> dict:
             def shared_q(reward=reward):
                 a = marl_q.parse(["--steps", str(args.steps), "--reward", reward, "--seed", "1"])
                 q, env, log = marl_q.train(a)
-                return q.values(), log["formations"], env
+                return log["selected"], log["formations"], env
             learned("shared Q-network (marl_q.py)", reward, shared_q)
     return {
         "date": datetime.date.today().isoformat(),

@@ -13,8 +13,13 @@ with every weight at --initial-q, above what the reference reward pays: an
 action not yet tried looks better than one that failed, the optimism the
 thesis' learner explores by. (Through a hidden layer what one state
 learns would move every other state's values too and undo that optimism.)
-Its Q-table is what it exports: each state's best actions, among which the
-robot picks as the learner did.
+Every --select-every world-steps the table is frozen and run greedily on
+one evaluation world (the same world each time) for --select-steps steps;
+the table that forms most there (the earliest of equals) is the one it
+exports, as `host train --select-every` keeps its best policy: the table
+of the last step need not be the best the learner passed through. It
+exports the Q-table: each state's best actions, among which the robot
+picks as the learner did.
 """
 import argparse
 
@@ -34,6 +39,8 @@ def parse(argv=None):
     p.add_argument("--lr", type=float, default=0.2, help="SGD step size: the thesis' alpha")
     p.add_argument("--gamma", type=float, default=0.9)
     p.add_argument("--initial-q", type=float, default=1.0)
+    p.add_argument("--select-every", type=int, default=100_000, help="world-steps between evaluations of the greedy table")
+    p.add_argument("--select-steps", type=int, default=50_000, help="steps of each evaluation")
     p.add_argument("--max-steps", type=int, help="episode truncation (default none: an episode ends when it forms or is stuck)")
     p.add_argument("--out", default="out/marl-q-annulus.policy")
     return p.parse_args(argv)
@@ -66,6 +73,17 @@ def greedy(q, generator):
     return torch.where(best, torch.rand(q.shape, generator=generator), -1.0).argmax(-1)
 
 
+def evaluation(values, seed, steps):
+    """Formations of a frozen table acting greedily (the lowest of equal
+    actions) in a new world of `seed`, over `steps` steps."""
+    table = values.argmax(-1)
+    env = zumo_swarm.vector_env(1, observation="state", seed=seed)
+    obs, _ = env.reset(seed=seed)
+    for _ in range(steps):
+        obs, _, _, _, info = env.step(table[obs])
+    return int(info["formations"][0])
+
+
 def train(args):
     torch.manual_seed(args.seed)
     torch.set_num_threads(1)  # small network: more threads only contend with the simulator's
@@ -78,8 +96,10 @@ def train(args):
     q = QNetwork(batch.num_states, len(batch.angular_speeds), args.initial_q)
     optimiser = torch.optim.SGD(q.parameters(), lr=args.lr)
     obs = torch.as_tensor(env.reset(seed=args.seed)[0])
-    log = {"formations": 0, "episodes": []}
+    judge_seed = args.seed + 1_000_000  # the evaluation world's: no training world's
+    log = {"formations": 0, "episodes": [], "selected": q.values(), "selected_step": 0, "selected_formations": -1}
     calls = max(1, args.steps // args.worlds)
+    every = max(1, args.select_every // args.worlds)
     for call in range(calls):
         with torch.no_grad():
             action = greedy(q(obs), generator)
@@ -99,6 +119,11 @@ def train(args):
         if "episode" in info:
             ended = info["_episode"]
             log["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
+        if (call + 1) % every == 0 or call == calls - 1:
+            values = q.values()
+            formed = evaluation(values, judge_seed, args.select_steps)
+            if formed > log["selected_formations"]:
+                log.update(selected=values, selected_step=(call + 1) * args.worlds, selected_formations=formed)
         if call % 25_000 == 0 or call == calls - 1:
             log["formations"] = int(info["formations"].sum())
             print(f"step {(call + 1) * args.worlds}: {log['formations']} formed, Eval {info['eval'].mean():.4f}")
@@ -108,5 +133,6 @@ def train(args):
 if __name__ == "__main__":
     args = parse()
     q, env, log = train(args)
-    print(f"{log['formations']} annuli formed in {args.steps} world-steps")
-    zumo_swarm.export_policy(args.out, q.values(), env=env, trainer_steps=args.steps, seed=args.seed)
+    print(f"{log['formations']} annuli formed in {args.steps} world-steps; the table of step {log['selected_step']} "
+          f"formed {log['selected_formations']} on the evaluation world")
+    zumo_swarm.export_policy(args.out, log["selected"], env=env, trainer_steps=args.steps, seed=args.seed)

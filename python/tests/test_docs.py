@@ -72,9 +72,7 @@ def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
     still, random = by[("robots standing still", None)], by[("random actions", None)]
     tabular, shared = by[("tabular Q", "reference")], by[("shared Q-network", "reference")]
-    assert shared["trained_formations"] >= tabular["trained_formations"] / 4 > 0
-    assert shared["final_eval"] == max(r["final_eval"] for r in results["rows"])
+    assert tabular["trained_formations"] > shared["trained_formations"] >= tabular["trained_formations"] / 4 > 0
+    assert shared["formations"] >= tabular["formations"] / 4 > 0
     assert shared["final_eval"] > max(still["final_eval"], random["final_eval"])
-    assert shared["formations"] < tabular["formations"] / 4
-    assert shared["exported_formations"] < 0.9 * shared["trained_formations"]
-    assert tabular["exported_formations"] >= 0.9 * tabular["trained_formations"]
+    assert shared["exported_formations"] >= 0.9 * shared["trained_formations"]

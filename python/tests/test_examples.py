@@ -45,13 +45,16 @@ def test_the_shared_q_network_example_trains_logs_and_exports_its_table(tmp_path
     pytest.importorskip("torch")
     import marl_q
 
-    args = marl_q.parse(["--steps", "2048", "--worlds", "4", "--max-steps", "100"])
+    args = marl_q.parse(["--steps", "2048", "--worlds", "4", "--max-steps", "100", "--select-every", "1024", "--select-steps", "200"])
     q, env, log = marl_q.train(args)
+    assert log["selected_step"] in (1024, 2048) and log["selected_formations"] >= 0, "two evaluations, the best kept"
+    if log["selected_step"] == 2048:
+        assert np.array_equal(log["selected"], q.values())
     assert len(log["episodes"]) >= 4, "ended episodes' returns are logged"
     assert all(0.0 < e <= 1.0 for _, e in log["episodes"])
     weights = q.linear.weight.detach()
     assert (weights != args.initial_q).any(), "the steps moved some Q-values"
-    values = q.values()
+    values = log["selected"]
     assert values.shape == (256, 4)
     path = zumo_swarm.export_policy(tmp_path / "marl-q.policy", values, env=env, trainer_steps=2048)
     policy = zumo_swarm.load_policy(path)
