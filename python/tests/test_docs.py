@@ -6,6 +6,14 @@ import importlib.util
 import json
 
 
+def benchmark(repo, name):
+    """The module of python/benchmarks/NAME.py (not a package: loaded from its file)."""
+    spec = importlib.util.spec_from_file_location(name, repo / "python" / "benchmarks" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def test_the_examples_in_the_docs_are_the_example_files(repo):
     doc = (repo / "docs" / "python.md").read_text()
     for name in ["tabular_q.py", "ppo_sb3.py"]:
@@ -14,18 +22,14 @@ def test_the_examples_in_the_docs_are_the_example_files(repo):
 
 
 def test_the_throughput_tables_are_rendered_from_the_measured_results(repo):
-    spec = importlib.util.spec_from_file_location("throughput", repo / "python" / "benchmarks" / "throughput.py")
-    throughput = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(throughput)
+    throughput = benchmark(repo, "throughput")
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
     for doc in ["python.md", "performance.md"]:
         assert table in (repo / "docs" / doc).read_text(), f"docs/{doc} does not hold the rendered table"
 
 
 def test_the_learning_table_is_rendered_from_the_measured_results(repo):
-    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
-    learning = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(learning)
+    learning = benchmark(repo, "learning")
     table = learning.render(json.loads((repo / "docs" / "python-learning.json").read_text()))
     assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered learning table"
 
@@ -47,9 +51,7 @@ def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results
 
 
 def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
-    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
-    learning = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(learning)
+    learning = benchmark(repo, "learning")
     results = json.loads((repo / "docs" / "python-learning-1m.json").read_text())
     assert learning.render(results) in (repo / "docs" / "python.md").read_text()
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
@@ -64,9 +66,7 @@ def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it
 
 
 def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
-    spec = importlib.util.spec_from_file_location("learning", repo / "python" / "benchmarks" / "learning.py")
-    learning = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(learning)
+    learning = benchmark(repo, "learning")
     results = json.loads((repo / "docs" / "python-learning-q.json").read_text())
     assert learning.render(results) in (repo / "docs" / "python.md").read_text()
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
