@@ -186,12 +186,11 @@ def render(results: dict) -> str:
             f"| {cpu / random_cpu:.3g} |"
         )
     lines.append("")
-    if "bytes_per_world" in results:
-        world = results["bytes_per_world"]
-        lines.append(
-            f"A world holds about {world / 1024:,.0f} KB (peak resident memory of 4,096 worlds less that of 64, "
-            f"per world): {512 * world / 2**20:,.0f} MB for 512 worlds, {4096 * world / 2**20:,.0f} MB for 4,096.")
-        lines.append("")
+    world = results["bytes_per_world"]
+    lines.append(
+        f"A world holds about {world / 1024:,.0f} KB (peak resident memory of 4,096 worlds less that of 64, "
+        f"per world): {512 * world / 2**20:,.0f} MB for 512 worlds, {4096 * world / 2**20:,.0f} MB for 4,096.")
+    lines.append("")
     lines.extend(verdicts(rows, base_cpu, random_cpu))
     return "\n".join(lines) + "\n"
 
