@@ -251,6 +251,49 @@ fn the_rewards_for_deep_learners_resume_exactly_from_a_format_6_checkpoint_and_c
 }
 
 #[test]
+fn n_step_returns_are_the_same_per_seed_resume_exactly_with_steps_waiting_and_change_the_run() {
+    let n_step = |n: Option<u32>, updates: host::learn::Updates| TrainConfig {
+        n_step: n,
+        rules: host::learn::LearnerRules {
+            updates,
+            ..Default::default()
+        },
+        ..small(29)
+    };
+    let run = |config: TrainConfig| {
+        let mut t = trainer(config);
+        t.run(3000);
+        let pending = !t.learner().pending().is_empty();
+        (t.learner().table().clone(), pending)
+    };
+    for updates in [
+        host::learn::Updates::Sequential,
+        host::learn::Updates::Batched,
+    ] {
+        let four = n_step(Some(4), updates);
+        // 1,301 steps in: every robot has steps waiting, which the
+        // checkpoint keeps; the resumed run makes the straight run's updates
+        assert_eq!(resumes_exactly(four.clone(), 1301, 2600), 7);
+        let (table, pending) = run(four.clone());
+        assert!(pending, "steps wait between updates");
+        assert_eq!(run(four).0, table, "same seed, same table");
+        let (one_step, none_waiting) = run(n_step(None, updates));
+        assert!(!none_waiting);
+        assert_ne!(one_step, table, "n-step returns change the run");
+        assert_eq!(
+            run(n_step(Some(1), updates)).0,
+            one_step,
+            "n_step 1 is one-step Q-learning"
+        );
+    }
+    let mut bad = n_step(Some(65), host::learn::Updates::Sequential);
+    let e = Trainer::start(bad.clone(), None).err().unwrap().to_string();
+    assert!(e.contains("n_step = 65") && e.contains("1 to 64"), "{e}");
+    bad.n_step = Some(0);
+    assert!(Trainer::start(bad, None).is_err());
+}
+
+#[test]
 fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5_checkpoint() {
     let wedge = TrainConfig {
         sensors: SensorChoice::Robot(None),

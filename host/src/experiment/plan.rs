@@ -12,6 +12,7 @@ use crate::train::format1::TrainConfigV1;
 use crate::train::format2::TrainConfigV2;
 use crate::train::format3::TrainConfigV3;
 use crate::train::format4::TrainConfigV4;
+use crate::train::format6::TrainConfigV6;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
@@ -90,8 +91,8 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to the field's
 /// default counts as unset (the same run either way), and settings that use
-/// nothing newer than format 1, 2, 3 or 4 are hashed in its layout
-/// ([`TrainConfigV1`] to [`TrainConfigV4`]), so that trials
+/// nothing newer than format 1, 2, 3, 4 or 6 are hashed in its layout
+/// ([`TrainConfigV1`] to [`TrainConfigV6`]), so that trials
 /// run before the newer settings existed keep their hashes. (Those formats'
 /// runs had wall segments: a run in the thesis' square that clamps at its
 /// border, the default since, is of the newest layout and hashes anew.) Settings with the robot's
@@ -105,6 +106,7 @@ enum Hashed {
     V2(TrainConfigV2),
     V3(TrainConfigV3),
     V4(TrainConfigV4),
+    V6(TrainConfigV6),
     Current(TrainConfig),
     /// Settings with the robot's senses, and the version of their model.
     RobotSenses {
@@ -125,7 +127,9 @@ fn hashed(config: &TrainConfig) -> Hashed {
         c.innies = None;
     }
     let robot_senses = c.sensors.is_robot();
-    let settings = if let Some(v1) = TrainConfigV1::of(&c) {
+    let settings = if TrainConfigV6::of(&c).is_none() {
+        Hashed::Current(c)
+    } else if let Some(v1) = TrainConfigV1::of(&c) {
         Hashed::V1(v1)
     } else if let Some(v2) = TrainConfigV2::of(&c) {
         Hashed::V2(v2)
@@ -133,6 +137,8 @@ fn hashed(config: &TrainConfig) -> Hashed {
         Hashed::V3(v3)
     } else if let Some(v4) = TrainConfigV4::of(&c) {
         Hashed::V4(v4)
+    } else if let Some(v6) = TrainConfigV6::of(&c) {
+        Hashed::V6(v6)
     } else {
         Hashed::Current(c)
     };

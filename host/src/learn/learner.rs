@@ -1,6 +1,7 @@
 //! The Q-learning controller: one table, every robot's experience.
 
 use super::qtable::{QParams, QTable};
+use super::returns::{PendingSteps, WaitingStep};
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use shared::{ActionId, ActionTable, State, StateHasher};
@@ -222,6 +223,20 @@ pub struct QLearner {
     /// checkpoint.
     #[serde(skip)]
     exploration: Option<f64>,
+    /// Rewards per update target: 0 or 1 for one-step Q-learning (the
+    /// thesis'), more for n-step returns ([`super::returns`]). A run's
+    /// setting, given again on every start and resume
+    /// ([`QLearner::with_n_step`]), so not part of the learner's layout.
+    #[serde(skip)]
+    n_step: usize,
+    /// Each robot's steps waiting for their n-step update: a checkpoint
+    /// holds them beside the learner ([`QLearner::pending`]), so that the
+    /// formats of one-step runs keep their layout.
+    #[serde(skip)]
+    pending: PendingSteps,
+    /// Batched n-step updates of the step in flight.
+    #[serde(skip)]
+    due: Vec<(WaitingStep, f64)>,
 }
 
 impl QLearner {
@@ -239,6 +254,9 @@ impl QLearner {
             rewards: Vec::new(),
             touching: Vec::new(),
             exploration: None,
+            n_step: 1,
+            pending: PendingSteps::default(),
+            due: Vec::new(),
         })
     }
 
@@ -264,6 +282,21 @@ impl QLearner {
     pub fn with_rules(mut self, rules: LearnerRules) -> QLearner {
         self.rules = rules;
         self
+    }
+
+    /// This learner with n-step returns of `n` rewards (1: one-step
+    /// Q-learning) and the steps a checkpoint left waiting (none for a new
+    /// run).
+    pub fn with_n_step(mut self, n: usize, pending: PendingSteps) -> QLearner {
+        self.n_step = n;
+        self.pending = pending;
+        self
+    }
+
+    /// Each robot's steps waiting for their n-step update (none with
+    /// one-step returns).
+    pub fn pending(&self) -> &PendingSteps {
+        &self.pending
     }
 
     /// Explores with probability `epsilon` instead of the config's (a
@@ -359,6 +392,11 @@ impl Controller for QLearner {
             .iter()
             .zip(robots)
             .map(|(reading, robot)| hasher.hash_as(reading, robot.kind.role()));
+        if self.n_step > 1 {
+            self.update_n_step(next, outcome.end.is_some(), params);
+            self.last_signal = signal;
+            return;
+        }
         match self.rules.updates {
             Updates::Sequential => {
                 for ((&(s, a), s2), &r) in self.chosen.iter().zip(next).zip(&self.rewards) {
@@ -376,6 +414,44 @@ impl Controller for QLearner {
             }
         }
         self.last_signal = signal;
+    }
+}
+
+impl QLearner {
+    /// The n-step updates a step makes due ([`super::returns`]): each
+    /// robot's step waits; the oldest is updated once `n_step` wait, all
+    /// of them when the episode `ended`. In robot order, each update
+    /// seeing the ones before, or with batched rules all from the table
+    /// before the step.
+    fn update_n_step(&mut self, next: impl Iterator<Item = State>, ended: bool, params: QParams) {
+        let batched = self.rules.updates == Updates::Batched;
+        self.due.clear();
+        for (robot, ((&(state, action), next), &reward)) in
+            self.chosen.iter().zip(next).zip(&self.rewards).enumerate()
+        {
+            let step = WaitingStep {
+                state,
+                action,
+                reward,
+            };
+            self.pending.record(robot, step);
+            for _ in 0..self.pending.due(robot, self.n_step, ended) {
+                let Some((step, error)) =
+                    self.pending
+                        .complete_oldest(robot, next, params.gamma, &self.q)
+                else {
+                    break;
+                };
+                if batched {
+                    self.due.push((step, error));
+                } else {
+                    self.q.apply(step.state, step.action, error, params);
+                }
+            }
+        }
+        for &(step, error) in &self.due {
+            self.q.apply(step.state, step.action, error, params);
+        }
     }
 }
 

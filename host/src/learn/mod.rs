@@ -1,11 +1,14 @@
 //! Tabular Q-learning with one policy shared by all robots: the table
 //! ([`qtable`]), the learning controller ([`learner`]), rewarded by
-//! `sim::episodes::reward`, and a learned table frozen ([`frozen`]).
+//! `sim::episodes::reward`, its n-step returns' waiting steps
+//! ([`returns`]), and a learned table frozen ([`frozen`]).
 
 pub mod frozen;
 pub mod learner;
 pub mod qtable;
+pub mod returns;
 
 pub use frozen::FrozenLearner;
 pub use learner::{LearnConfig, LearnerRules, QLearner, StateHasherName, Updates};
 pub use qtable::{QParams, QTable, TableSummary};
+pub use returns::{PendingSteps, MAX_N_STEP};

@@ -230,12 +230,17 @@ impl QTable {
         next: State,
         params: QParams,
     ) -> f64 {
-        let next_best = self
-            .row(next)
+        reward + params.gamma * self.best_value(next)
+            - self.values[s.index() * self.actions + a.index()]
+    }
+
+    /// max_a Q(s, a): the value Q-learning bootstraps from.
+    #[inline]
+    pub fn best_value(&self, state: State) -> f64 {
+        self.row(state)
             .iter()
             .copied()
-            .fold(f64::NEG_INFINITY, f64::max);
-        reward + params.gamma * next_best - self.values[s.index() * self.actions + a.index()]
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// Q(s,a) += alpha `error`, a TD error computed earlier ([`QTable::td_error`]).

@@ -6,17 +6,17 @@
 //! | offset | size | content                                              |
 //! |--------|------|------------------------------------------------------|
 //! | 0      | 8    | magic `ZSWMCKPT`                                     |
-//! | 8      | 2    | format version (1 to 6), u16                         |
+//! | 8      | 2    | format version (1 to 7), u16                         |
 //! | 10     | 8    | body length `n`, u64                                 |
 //! | 18     | n    | body: the [`TrainingState`], postcard-encoded        |
 //! | 18 + n | 4    | CRC-32 (ISO-HDLC, as zlib) of bytes `0 .. 18 + n`    |
 //!
-//! Formats 5 and 6 have the [`TrainingState`] as body (6 for the rewards
-//! added since, which earlier builds cannot decode); formats 1 to 4 are the
+//! Format 7 has the [`TrainingState`] as body; formats 1 to 6 are the
 //! state without the settings added since ([`super::format1`],
-//! [`super::format2`], [`super::format3`], [`super::format4`]). A state is
-//! written in the oldest format that holds it, byte for byte what earlier
-//! builds wrote; all six are read.
+//! [`super::format2`], [`super::format3`], [`super::format4`], and
+//! [`super::format6`] for 5 and 6, 6 for the rewards format 5's readers
+//! cannot decode). A state is written in the oldest format that holds it,
+//! byte for byte what earlier builds wrote; all seven are read.
 //!
 //! postcard stores every `f64` as its 8 IEEE bytes, so values round-trip
 //! bit-exactly. Files are written atomically (temporary file, then rename):
@@ -26,6 +26,7 @@ use super::format1::StateV1;
 use super::format2::StateV2;
 use super::format3::StateV3;
 use super::format4::StateV4;
+use super::format6::StateV6;
 use super::trainer::TrainingState;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
@@ -47,8 +48,9 @@ pub const MAGIC: [u8; 8] = *b"ZSWMCKPT";
 /// decaying exploration (`epsilon_decay`); disc states of constant
 /// exploration keep format 4 or older. 6: the rewards `per-robot`,
 /// `success` and `success-shaped` (the same layout as 5, with reward
-/// variants format 5's readers do not know).
-pub const VERSION: u16 = 6;
+/// variants format 5's readers do not know). 7: n-step returns (`n_step`,
+/// and each robot's steps waiting for their update).
+pub const VERSION: u16 = 7;
 const HEADER_LEN: usize = 18;
 const CRC_LEN: usize = 4;
 const CRC32: Crc<u32> = Crc::<u32>::new(&CRC_32_ISO_HDLC);
@@ -124,19 +126,23 @@ impl std::error::Error for CheckpointError {}
 
 /// Encodes a training state into `w`.
 pub fn write_to(w: &mut dyn Write, state: &TrainingState) -> std::io::Result<()> {
-    // Format 6 added the rewards beyond the thesis' four.
-    let (version, body) = if !state.config.learn.reward.from_thesis() {
-        (VERSION, postcard::to_stdvec(state))
-    } else if let Some(v1) = StateV1::of(state) {
-        (1u16, postcard::to_stdvec(&v1))
-    } else if let Some(v2) = StateV2::of(state) {
-        (2, postcard::to_stdvec(&v2))
-    } else if let Some(v3) = StateV3::of(state) {
-        (3, postcard::to_stdvec(&v3))
-    } else if let Some(v4) = StateV4::of(state) {
-        (4, postcard::to_stdvec(&v4))
-    } else {
-        (5, postcard::to_stdvec(state))
+    let (version, body) = match StateV6::of(state) {
+        None => (VERSION, postcard::to_stdvec(state)),
+        // format 6 added the rewards beyond the thesis' four
+        Some(v6) if !state.config.learn.reward.from_thesis() => (6, postcard::to_stdvec(&v6)),
+        Some(v6) => {
+            if let Some(v1) = StateV1::of(state) {
+                (1, postcard::to_stdvec(&v1))
+            } else if let Some(v2) = StateV2::of(state) {
+                (2, postcard::to_stdvec(&v2))
+            } else if let Some(v3) = StateV3::of(state) {
+                (3, postcard::to_stdvec(&v3))
+            } else if let Some(v4) = StateV4::of(state) {
+                (4, postcard::to_stdvec(&v4))
+            } else {
+                (5, postcard::to_stdvec(&v6))
+            }
+        }
     };
     let body = body.map_err(std::io::Error::other)?;
     let mut head = Vec::with_capacity(HEADER_LEN);
@@ -212,6 +218,9 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
             .map_err(malformed),
         4 => postcard::from_bytes::<StateV4>(body)
             .map(StateV4::into_state)
+            .map_err(malformed),
+        5 | 6 => postcard::from_bytes::<StateV6>(body)
+            .map(StateV6::into_state)
             .map_err(malformed),
         _ => postcard::from_bytes(body).map_err(malformed),
     }

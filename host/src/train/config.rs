@@ -4,7 +4,7 @@
 //! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::learn::{LearnConfig, LearnerRules};
+use crate::learn::{LearnConfig, LearnerRules, MAX_N_STEP};
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
@@ -125,6 +125,11 @@ pub struct TrainConfig {
     /// 1,000) and stays 0 [default: none, --epsilon throughout].
     #[arg(long)]
     pub epsilon_decay: Option<u64>,
+    /// n-step returns: each update's target sums the robot's next N
+    /// rewards, discounted, before bootstrapping from the table (1 to 64)
+    /// [default: 1, the thesis' one-step Q-learning].
+    #[arg(long)]
+    pub n_step: Option<u32>,
 }
 
 /// When an episode's formation is checked (`[formation_check]`).
@@ -220,6 +225,7 @@ impl Default for TrainConfig {
             walls: None,
             rules: LearnerRules::default(),
             epsilon_decay: None,
+            n_step: None,
         }
     }
 }
@@ -334,6 +340,11 @@ impl TrainConfig {
         }
     }
 
+    /// Rewards per update target: [`TrainConfig::n_step`], 1 when unset.
+    pub fn rewards_per_update(&self) -> usize {
+        self.n_step.unwrap_or(1) as usize
+    }
+
     /// The run's name: [`OutputConfig::name`] or `<field>-<hasher>`.
     pub fn name(&self) -> String {
         match &self.output.name {
@@ -381,6 +392,9 @@ impl TrainConfig {
         }
         if let Some(steps) = self.epsilon_decay {
             ranges::STEPS.check_count("epsilon_decay", steps)?;
+        }
+        if let Some(n) = self.n_step.filter(|n| !(1..=MAX_N_STEP).contains(n)) {
+            bail!("n_step = {n}: must be 1 to {MAX_N_STEP} rewards per update");
         }
         ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {

@@ -15,7 +15,7 @@
 use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
 use super::format3::PhysicsConfigV3;
 use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, QLearner};
+use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
@@ -113,6 +113,7 @@ impl From<TrainConfigV2> for TrainConfig {
             walls: None,
             rules: LearnerRules::default(),
             epsilon_decay: None,
+            n_step: None,
         };
         // format 2's runs had wall segments
         if config.walls_in_effect() != Walls::Segments {
@@ -295,6 +296,7 @@ impl StateV2 {
             },
             learner: self.learner,
             selected: None,
+            pending: PendingSteps::default(),
         }
     }
 }

@@ -15,7 +15,7 @@ use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
 use super::format4::WorldConfigV4;
 use super::selection::{SelectConfig, Selected};
 use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, QLearner};
+use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::base::rng::SimRng;
@@ -115,6 +115,7 @@ impl From<TrainConfigV3> for TrainConfig {
             walls: None,
             rules: LearnerRules::default(),
             epsilon_decay: None,
+            n_step: None,
         };
         if config.walls_in_effect() != Walls::Segments {
             config.walls = Some(Walls::Segments);
@@ -266,6 +267,7 @@ impl StateV3 {
             },
             learner: self.learner,
             selected: self.selected,
+            pending: PendingSteps::default(),
         }
     }
 }

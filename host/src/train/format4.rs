@@ -13,7 +13,7 @@
 use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
 use super::selection::{SelectConfig, Selected};
 use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, QLearner};
+use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
@@ -117,6 +117,7 @@ impl From<TrainConfigV4> for TrainConfig {
             walls: c.walls,
             rules: c.rules,
             epsilon_decay: None,
+            n_step: None,
         }
     }
 }
@@ -293,6 +294,7 @@ impl StateV4 {
             },
             learner: self.learner,
             selected: self.selected,
+            pending: PendingSteps::default(),
         }
     }
 }

@@ -4,7 +4,7 @@
 use super::config::{field_label, TrainConfig, DECAY_PERIOD};
 use super::distil::distil_orbital;
 use super::selection::{Evaluation, Selected};
-use crate::learn::{QLearner, QTable};
+use crate::learn::{PendingSteps, QLearner, QTable};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use serde::{Deserialize, Serialize};
@@ -33,6 +33,9 @@ pub struct TrainingState {
     pub learner: QLearner,
     /// With policy selection: the best policy evaluated so far.
     pub selected: Option<Selected>,
+    /// With n-step returns: each robot's steps waiting for their update
+    /// (none with one-step returns).
+    pub pending: PendingSteps,
 }
 
 /// Q-learning on a simulation with sensor model `S`.
@@ -93,7 +96,8 @@ impl<S: SensorModel> Trainer<S> {
             Some(q) => QLearner::with_table(config.learn.clone(), q)?,
             None => QLearner::new(config.learn.clone())?,
         }
-        .with_rules(config.rules);
+        .with_rules(config.rules)
+        .with_n_step(config.rewards_per_update(), PendingSteps::default());
         let field_crc = field_fingerprint(sim.field());
         let evaluation = evaluation_of(&config)?;
         let mut trainer = Trainer {
@@ -124,7 +128,10 @@ impl<S: SensorModel> Trainer<S> {
         }
         let sim = Simulation::resume(state.sim, field, sensors);
         let evaluation = evaluation_of(&state.config)?;
-        let learner = state.learner.with_rules(state.config.rules);
+        let learner = state
+            .learner
+            .with_rules(state.config.rules)
+            .with_n_step(state.config.rewards_per_update(), state.pending);
         let (config, field_crc, selected) = (state.config, state.field_crc, state.selected);
         let trainer = Trainer {
             config,
@@ -212,6 +219,7 @@ impl<S: SensorModel> Trainer<S> {
             sim: self.sim.snapshot(),
             learner: self.learner.clone(),
             selected: self.selected.clone(),
+            pending: self.learner.pending().clone(),
         }
     }
 
