@@ -19,6 +19,7 @@ NAMES = {
     "-oc.policy": "search from distilled OC",
     "-more.policy": "search from distilled OC, continued",
     "-again.policy": "search from distilled OC, continued twice",
+    "-robust.policy": "search from distilled OC, continued at twice the noise",
     "annulus-random.policy": "search from random",
     "annulus-from-q.policy": "search from Q-learning's table",
     "annulus-q.policy": "Q-learning (distilled start, selection)",
@@ -34,7 +35,7 @@ def name_of(controller):
     if controller == "oc":
         return NAMES["oc"]
     base = os.path.basename(controller)
-    ending = next((e for e in ("-again.policy", "-more.policy", "-q-nstep.policy") if base.endswith(e)), "-oc.policy")
+    ending = next((e for e in ("-again.policy", "-more.policy", "-robust.policy", "-q-nstep.policy") if base.endswith(e)), "-oc.policy")
     return NAMES.get(base) or NAMES[ending]
 
 
@@ -96,7 +97,7 @@ def tables(results):
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
         # a letter's search: the last continuation evaluated
-        searched = [shape[n] for n in (NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
+        searched = [shape[n] for n in (NAMES["-robust.policy"], NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
         if not searched:
             continue
         # and n-step Q-learning's table, where there is one
