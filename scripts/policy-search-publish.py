@@ -20,6 +20,7 @@ NAMES = {
     "-more.policy": "search from distilled OC, continued",
     "-again.policy": "search from distilled OC, continued twice",
     "-robust.policy": "search from distilled OC, continued at twice the noise",
+    "letter-I-robust.policy": "search from Q-learning's table, at twice the noise",
     "annulus-random.policy": "search from random",
     "annulus-from-q.policy": "search from Q-learning's table",
     "annulus-q.policy": "Q-learning (distilled start, selection)",
@@ -97,7 +98,7 @@ def tables(results):
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
         # a letter's search: the last continuation evaluated
-        searched = [shape[n] for n in (NAMES["-robust.policy"], NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
+        searched = [shape[n] for n in (NAMES["letter-I-robust.policy"], NAMES["-robust.policy"], NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
         if not searched:
             continue
         # and n-step Q-learning's table, where there is one
