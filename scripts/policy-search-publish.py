@@ -29,6 +29,12 @@ NAMES = {
     "annulus-q-nstep.policy": "Q-learning, 4-step returns (distilled start, selection)",
     "annulus-q-nstep-optimistic.policy": "Q-learning, 4-step returns, optimistic start (Q 5)",
     "-q-nstep.policy": "Q-learning, 4-step returns (distilled start, selection)",
+    "thesis-T-bits9.policy": "search from distilled OC, 9-bit state",
+    "thesis-T-bits9-more.policy": "search from distilled OC, 9-bit state, continued",
+    "thesis-T-bits9-again.policy": "search from distilled OC, 9-bit state, continued twice",
+    "thesis-T-bits9-third.policy": "search from distilled OC, 9-bit state, continued three times",
+    "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
+    "thesis-T-obstacle-more.policy": "search from distilled OC, 10-bit state (robots seen), continued",
 }
 
 
@@ -63,6 +69,7 @@ def publish(out, results_path):
             "name": os.path.basename(path)[: -len(".search.json")],
             # a general search's fields, the first the worlds' own
             "field": " + ".join([log["world"]["field"], *log["search"].get("also_field", [])]),
+            "sensors": log["world"]["sensors"],
             "hasher": log["world"]["learn"]["hasher"],
             "start": log["search"]["start"],
             "generations": len(log["generations"]),
@@ -97,24 +104,24 @@ def tables(results):
         if field == "annulus":
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
-        # a letter's search: the last continuation evaluated
-        searched = [shape[n] for n in (NAMES["letter-I-robust.policy"], NAMES["-robust.policy"], NAMES["-again.policy"], NAMES["-more.policy"], NAMES["-oc.policy"]) if n in shape]
-        if not searched:
+        # every table learned for the letter (each search, whatever its
+        # state, and n-step Q-learning's)
+        learned = [c["per_million"] for n, c in shape.items() if n != NAMES["oc"]]
+        if not learned:
             continue
-        # and n-step Q-learning's table, where there is one
-        found = max(c["per_million"] for c in searched[:1] + [shape[n] for n in (NAMES["-q-nstep.policy"],) if n in shape])
+        found = max(learned)
         need = 50.0
         if oc >= 20:
             need = max(need, oc)
         if field == "thesis:L":
             need = max(need, 1.5 * oc)
         lines.append(f"| {field}: >= {need:,.1f} per million | best learned / million steps | {found:,.1f} | {'yes' if found >= need else 'no'} |")
-    lines += ["", "| search | field | hasher | start | generations | steps | validation: start | validation: result | result / start |",
-              "|---|---|---|---|---:|---:|---:|---:|---:|"]
+    lines += ["", "| search | field | senses | hasher | start | generations | steps | validation: start | validation: result | result / start |",
+              "|---|---|---|---|---|---:|---:|---:|---:|---:|"]
     for s in results["searches"]:
         ratio = f"{s['result_validation'] / s['start_validation']:.2f}" if s["start_validation"] else "-"
         lines.append(
-            f"| {s['name']} | {s['field']} | {s['hasher']} | {s['start']} | {s['generations']} | {s['steps']:,} "
+            f"| {s['name']} | {s['field']} | {s['sensors']} | {s['hasher']} | {s['start']} | {s['generations']} | {s['steps']:,} "
             f"| {s['start_validation']} | {s['result_validation']} | {ratio} |")
     return "\n".join(lines)
 

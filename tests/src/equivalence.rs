@@ -110,6 +110,16 @@ pub const GENERAL: Variant = Variant {
             scripts/build-firmware",
 };
 
+/// The policy search's T table (issue 31), the 9-bit state's.
+pub const SEARCH_T: Variant = Variant {
+    policy: "robot-search-T.policy",
+    elf_dir: "robot-search-T",
+    hasher: StateHasher::Bits9,
+    robot_id: 0,
+    build: "FIRMWARE_POLICY=policies/robot-search-T.policy FIRMWARE_HASHER=bits9 \
+            FIRMWARE_OUT=target/avr-none/robot-search-T scripts/build-firmware",
+};
+
 /// One robot's state in a simulated episode, with its raw stimulus.
 #[derive(Clone, Debug)]
 pub struct Sample {

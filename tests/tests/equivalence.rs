@@ -1,9 +1,11 @@
 //! Sim-vs-firmware decision equivalence on the real release firmware in
 //! simavr (`docs/equivalence.md`).
 //!
-//! For each hasher (8-bit and 10-bit), robot states are sampled from
-//! simulated episodes with the robot sensor model on the annulus and two
-//! letters, driven by the policy under test (`policies/robot-annulus-*`).
+//! For each policy under test (the `policies/robot-annulus-*` tables of
+//! the 8-bit, 10-bit and role hashers, and the searched annulus, general
+//! and 9-bit T tables), robot states are sampled from simulated episodes
+//! with the robot sensor model on the annulus and two letters, driven by
+//! that policy.
 //! Each state's stimulus goes on the emulated robot's pins (RC discharge
 //! delays on the three sensor pins) and bus (the camera frame served on
 //! I2C), one control period per state; the firmware's logged state and
@@ -34,7 +36,7 @@ use std::time::Instant;
 use tests::equivalence::{
     check_elf_embeds, cycles_of_ticks, cycles_of_us, explain, follow_log, mirrored, nudge,
     read_policy, sample_states, Decided, Expectation, Expected, Sample, Variant, EIGHT_BIT,
-    GENERAL, ROLE, SEARCH_ANNULUS, TEN_BIT, TIED,
+    GENERAL, ROLE, SEARCH_ANNULUS, SEARCH_T, TEN_BIT, TIED,
 };
 use tests::figures::{compiler_of, thousands, Figures, Outcome};
 use tests::playback::{driving_zumo, frames_since_boot, play, Observed, Stimulus};
@@ -479,4 +481,9 @@ fn the_firmware_of_the_searched_annulus_policy_decides_as_the_simulator() {
 #[test]
 fn the_firmware_of_the_general_policy_decides_as_the_simulator() {
     equivalence(&GENERAL);
+}
+
+#[test]
+fn the_firmware_of_the_searched_t_policy_with_9_bit_states_decides_as_the_simulator() {
+    equivalence(&SEARCH_T);
 }
