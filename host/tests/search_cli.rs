@@ -72,6 +72,59 @@ fn a_small_search_writes_a_policy_that_host_run_drives_and_a_json_log() {
 }
 
 #[test]
+fn a_searched_table_records_its_senses_so_that_flash_refuses_one_searched_with_discs() {
+    let dir = tempfile::tempdir().unwrap();
+    let search = |sensors: &str, name: &str| {
+        let out = host()
+            .current_dir(dir.path())
+            .args(["search", "--sensors", sensors, "--arena", "tv75"])
+            .args([
+                "--start",
+                "random",
+                "--generations",
+                "1",
+                "--population",
+                "2",
+            ])
+            .args([
+                "--elites",
+                "1",
+                "--fitness-seeds",
+                "1",
+                "--fitness-steps",
+                "300",
+            ])
+            .args(["--validation-seeds", "1", "--validation-steps", "300"])
+            .args(["--out", "s", "--name", name])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    };
+    search("robot", "robot");
+    search("disc", "disc");
+    let inspect = host()
+        .current_dir(dir.path())
+        .args(["policy", "inspect", "s/robot.policy"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(inspect.stdout).unwrap();
+    let line = text.lines().find(|l| l.starts_with("for ")).unwrap();
+    assert!(line.contains("robot") && line.contains("tv75"), "{line}");
+    let flash = host()
+        .current_dir(dir.path())
+        .args(["flash", "--dry-run", "--policy", "s/disc.policy"])
+        .output()
+        .unwrap();
+    assert!(!flash.status.success());
+    let e = String::from_utf8(flash.stderr).unwrap();
+    assert!(e.contains("sensor model disc"), "{e}");
+}
+
+#[test]
 fn bad_search_settings_are_refused_naming_them() {
     let dir = tempfile::tempdir().unwrap();
     for (args, says) in [

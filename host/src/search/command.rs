@@ -187,7 +187,10 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
     let table = PolicyTable::from_packed(config.learn.hasher.0, &log.result)
         .context("the result does not fit the run's hasher")?;
     let provenance = Provenance::new(&field_label(&config.field), &name, log.steps, config.seed)?;
-    crate::policy_file::write(&policy, &PolicyBlob::new(actions, table, provenance)?)?;
+    // the blob says which senses and arena it was searched for, so that
+    // `host flash` refuses a table searched with the discs' senses
+    let blob = PolicyBlob::new(actions, table, provenance)?.with_trained_for(config.trained_for());
+    crate::policy_file::write(&policy, &blob)?;
     let json = serde_json::to_vec_pretty(&log).context("cannot encode the search log")?;
     crate::atomic::write(&log_file, &json)?;
     Ok(SearchReport {
