@@ -7,44 +7,35 @@ fn host() -> Command {
     Command::cargo_bin("host").unwrap()
 }
 
-#[test]
-fn a_small_search_writes_a_policy_that_host_run_drives_and_a_json_log() {
-    let dir = tempfile::tempdir().unwrap();
+/// Runs a one-generation search of two candidates on worlds of `steps`
+/// steps in `dir`, writing `s/NAME.policy`; `args` adds the world's flags.
+fn tiny_search(dir: &std::path::Path, args: &[&str], steps: &str, name: &str) {
     let out = host()
-        .current_dir(dir.path())
-        .args([
-            "search",
-            "--sensors",
-            "robot",
-            "--noise",
-            "1",
-            "--start",
-            "random",
-            "--generations",
-            "1",
-            "--population",
-            "2",
-            "--elites",
-            "1",
-            "--fitness-seeds",
-            "1",
-            "--fitness-steps",
-            "500",
-            "--validation-seeds",
-            "1",
-            "--validation-steps",
-            "500",
-            "--out",
-            "s",
-            "--name",
-            "tiny",
-        ])
+        .current_dir(dir)
+        .arg("search")
+        .args(args)
+        .args(["--start", "random", "--generations", "1"])
+        .args(["--population", "2", "--elites", "1"])
+        .args(["--fitness-seeds", "1", "--fitness-steps", steps])
+        .args(["--validation-seeds", "1", "--validation-steps", steps])
+        .args(["--out", "s", "--name", name])
         .output()
         .unwrap();
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn a_small_search_writes_a_policy_that_host_run_drives_and_a_json_log() {
+    let dir = tempfile::tempdir().unwrap();
+    tiny_search(
+        dir.path(),
+        &["--sensors", "robot", "--noise", "1"],
+        "500",
+        "tiny",
     );
     let log: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("s/tiny.search.json")).unwrap())
@@ -74,38 +65,14 @@ fn a_small_search_writes_a_policy_that_host_run_drives_and_a_json_log() {
 #[test]
 fn a_searched_table_records_its_senses_so_that_flash_refuses_one_searched_with_discs() {
     let dir = tempfile::tempdir().unwrap();
-    let search = |sensors: &str, name: &str| {
-        let out = host()
-            .current_dir(dir.path())
-            .args(["search", "--sensors", sensors, "--arena", "tv75"])
-            .args([
-                "--start",
-                "random",
-                "--generations",
-                "1",
-                "--population",
-                "2",
-            ])
-            .args([
-                "--elites",
-                "1",
-                "--fitness-seeds",
-                "1",
-                "--fitness-steps",
-                "300",
-            ])
-            .args(["--validation-seeds", "1", "--validation-steps", "300"])
-            .args(["--out", "s", "--name", name])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+    for sensors in ["robot", "disc"] {
+        tiny_search(
+            dir.path(),
+            &["--sensors", sensors, "--arena", "tv75"],
+            "300",
+            sensors,
         );
-    };
-    search("robot", "robot");
-    search("disc", "disc");
+    }
     let inspect = host()
         .current_dir(dir.path())
         .args(["policy", "inspect", "s/robot.policy"])
