@@ -33,6 +33,7 @@ NAMES = {
     "thesis-T-bits9-more.policy": "search from distilled OC, 9-bit state, continued",
     "thesis-T-bits9-again.policy": "search from distilled OC, 9-bit state, continued twice",
     "thesis-T-bits9-third.policy": "search from distilled OC, 9-bit state, continued three times",
+    "thesis-T-bits9-wide.policy": "search from distilled OC, 9-bit state, continued twice, then with 12 candidates",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
     "thesis-T-obstacle-more.policy": "search from distilled OC, 10-bit state (robots seen), continued",
 }
