@@ -34,6 +34,8 @@ NAMES = {
     "thesis-T-bits9-again.policy": "search from distilled OC, 9-bit state, continued twice",
     "thesis-T-bits9-third.policy": "search from distilled OC, 9-bit state, continued three times",
     "thesis-T-bits9-wide.policy": "search from distilled OC, 9-bit state, continued twice, then with 12 candidates",
+    "thesis-T-bits9-robust.policy": "search from distilled OC, 9-bit state, continued, then at the default noise and twice it",
+    "letter-I-robust-both.policy": "search from Q-learning's table, at twice the noise, then at the default noise and twice it",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
     "thesis-T-obstacle-more.policy": "search from distilled OC, 10-bit state (robots seen), continued",
 }
@@ -71,6 +73,8 @@ def publish(out, results_path):
             # a general search's fields, the first the worlds' own
             "field": " + ".join([log["world"]["field"], *log["search"].get("also_field", [])]),
             "sensors": log["world"]["sensors"],
+            # the noise levels it was scored at, the run's own first
+            "noise": " + ".join(f"{n:g}" for n in [log["world"]["noise"], *log["search"].get("also_noise", [])]),
             "hasher": log["world"]["learn"]["hasher"],
             "start": log["search"]["start"],
             "generations": len(log["generations"]),
@@ -117,12 +121,12 @@ def tables(results):
         if field == "thesis:L":
             need = max(need, 1.5 * oc)
         lines.append(f"| {field}: >= {need:,.1f} per million | best learned / million steps | {found:,.1f} | {'yes' if found >= need else 'no'} |")
-    lines += ["", "| search | field | senses | hasher | start | generations | steps | validation: start | validation: result | result / start |",
-              "|---|---|---|---|---|---:|---:|---:|---:|---:|"]
+    lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
+              "|---|---|---|---|---|---|---:|---:|---:|---:|---:|"]
     for s in results["searches"]:
         ratio = f"{s['result_validation'] / s['start_validation']:.2f}" if s["start_validation"] else "-"
         lines.append(
-            f"| {s['name']} | {s['field']} | {s['sensors']} | {s['hasher']} | {s['start']} | {s['generations']} | {s['steps']:,} "
+            f"| {s['name']} | {s['field']} | {s['sensors']} | {s['noise']} | {s['hasher']} | {s['start']} | {s['generations']} | {s['steps']:,} "
             f"| {s['start_validation']} | {s['result_validation']} | {ratio} |")
     return "\n".join(lines)
 

@@ -123,19 +123,28 @@ impl std::fmt::Display for SearchReport {
 }
 
 /// The worlds' settings: the file, then the flags, on the run's field and
-/// then on each `--also-field`; on a screen each shape's puck count
-/// ([`tv_pucks`]) unless `--pucks` is given.
+/// then on each `--also-field`, each at the run's noise and then at each
+/// `--also-noise`; on a screen each shape's puck count ([`tv_pucks`])
+/// unless `--pucks` is given. The first is the run's own world.
 fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
     let mut base = match &request.config {
         Some(path) => TrainConfig::from_file(path)?,
         None => TrainConfig::default(),
     };
     request.flags.apply(&mut base)?;
+    for &noise in &request.search.also_noise {
+        sim::base::ranges::NOISE.check_as("also-noise", noise)?;
+    }
     let fields = std::iter::once(base.field.clone()).chain(request.search.also_field.clone());
+    let noises: Vec<f64> = std::iter::once(base.noise)
+        .chain(request.search.also_noise.iter().copied())
+        .collect();
     fields
-        .map(|field| {
+        .flat_map(|field| noises.iter().map(move |&noise| (field.clone(), noise)))
+        .map(|(field, noise)| {
             let mut config = TrainConfig {
                 field,
+                noise,
                 ..base.clone()
             };
             if base.pucks.is_none() && config.arena_choice().screen().is_ok() {
@@ -286,6 +295,26 @@ mod tests {
         small_over(threads, start, Vec::new())
     }
 
+    /// The small search's settings, on one field at one noise level.
+    fn small_settings(threads: usize, start: Start) -> SearchConfig {
+        SearchConfig {
+            start,
+            generations: 3,
+            population: 4,
+            elites: 2,
+            fitness_seeds: 2,
+            fitness_steps: 8000,
+            validation_seeds: 2,
+            validation_steps: 8000,
+            keep: 0.8,
+            rate: 0.5,
+            floor: 0.01,
+            threads,
+            also_field: Vec::new(),
+            also_noise: Vec::new(),
+        }
+    }
+
     /// [`small`], also scored on `also_field`.
     fn small_over(threads: usize, start: Start, also_field: Vec<FieldSource>) -> SearchLog {
         let flags = TrainFlags::parse([
@@ -303,19 +332,8 @@ mod tests {
             config: None,
             flags,
             search: SearchConfig {
-                start,
-                generations: 3,
-                population: 4,
-                elites: 2,
-                fitness_seeds: 2,
-                fitness_steps: 8000,
-                validation_seeds: 2,
-                validation_steps: 8000,
-                keep: 0.8,
-                rate: 0.5,
-                floor: 0.01,
-                threads,
                 also_field,
+                ..small_settings(threads, start)
             },
         };
         let configs = worlds(&request).unwrap();
@@ -369,6 +387,36 @@ mod tests {
             [Some(12), Some(11)],
             "each shape's own count on the TV"
         );
+    }
+
+    #[test]
+    fn each_field_is_also_scored_at_each_extra_noise_and_a_bad_level_is_named() {
+        let search = |also_noise: Vec<f64>| SearchRequest {
+            config: None,
+            flags: TrainFlags::parse(["--sensors", "robot", "--noise", "1"]).unwrap(),
+            search: SearchConfig {
+                also_field: vec!["letter:I".parse().unwrap()],
+                also_noise,
+                ..small_settings(1, Start::Random)
+            },
+        };
+        let configs = worlds(&search(vec![2.0])).unwrap();
+        let worlds_seen: Vec<_> = configs
+            .iter()
+            .map(|c| (field_label(&c.field), c.noise, c.pucks))
+            .collect();
+        assert_eq!(
+            worlds_seen,
+            [
+                ("annulus".to_string(), 1.0, Some(12)),
+                ("annulus".to_string(), 2.0, Some(12)),
+                ("letter:I".to_string(), 1.0, Some(11)),
+                ("letter:I".to_string(), 2.0, Some(11)),
+            ],
+            "the run's own world first, then every field at every level"
+        );
+        let error = worlds(&search(vec![-1.0])).unwrap_err().to_string();
+        assert!(error.contains("also-noise"), "{error}");
     }
 
     #[test]

@@ -102,6 +102,12 @@ pub struct SearchConfig {
     #[arg(long = "also-field", value_name = "FIELD")]
     #[serde(default)]
     pub also_field: Vec<FieldSource>,
+    /// Another noise level (multiples of the default, repeatable) every
+    /// field is also scored at, ranked like --also-field: a table that
+    /// keeps its count when the world is noisier than the run's --noise.
+    #[arg(long = "also-noise", value_name = "MULTIPLE")]
+    #[serde(default)]
+    pub also_noise: Vec<f64>,
 }
 
 impl SearchConfig {
