@@ -38,6 +38,7 @@ NAMES = {
     "thesis-T-bits9-twice.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise",
     "thesis-T-bits9-twice-both.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both",
     "thesis-T-bits9-both-more.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice",
+    "letter-I-robust-three.policy": "search from Q-learning's table, at twice the noise, then at the default noise, twice and 2.5 times it",
     "letter-I-robust-both.policy": "search from Q-learning's table, at twice the noise, then at the default noise and twice it",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
     "thesis-T-obstacle-more.policy": "search from distilled OC, 10-bit state (robots seen), continued",
