@@ -102,6 +102,11 @@ def run(args) -> dict:
             q, formations, env = tabular_q.train(steps=args.steps, seed=1, reward=reward)
             return q, int(formations), env
         learned("tabular Q (tabular_q.py)", reward, tabular)
+    for initial_q, epsilon in args.tabular_exploration:
+        def explored(initial_q=initial_q, epsilon=epsilon):
+            q, formations, env = tabular_q.train(steps=args.steps, seed=1, initial_q=initial_q, epsilon=epsilon)
+            return q, int(formations), env
+        learned(f"tabular Q (tabular_q.py), initial Q {initial_q:g}, epsilon {epsilon:g}", "reference", explored)
     if args.neural:
         import marl_ppo
 
@@ -157,6 +162,17 @@ def render(results: dict) -> str:
     return head + "\n".join(lines) + "\n"
 
 
+def exploration(text: str) -> tuple[float, float]:
+    """An `--tabular-exploration` pair: initial Q-value and epsilon."""
+    try:
+        initial_q, epsilon = (float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not INITIAL_Q,EPSILON (two numbers, e.g. 1,0.1)") from None
+    if not 0.0 <= epsilon <= 1.0:
+        raise argparse.ArgumentTypeError(f"epsilon {epsilon} in {text!r} is not between 0 and 1")
+    return initial_q, epsilon
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--render", metavar="JSON")
@@ -167,6 +183,9 @@ def main() -> None:
     p.add_argument("--marl-rewards", nargs="*", default=["reference", "per-robot", "success-shaped"])
     p.add_argument("--sb3-rewards", nargs="*", default=["success-shaped"])
     p.add_argument("--marl-q-rewards", nargs="*", default=["reference"])
+    p.add_argument("--tabular-exploration", action="append", default=[], type=exploration, metavar="INITIAL_Q,EPSILON",
+                   help="a tabular Q-learning row (reference reward) with another initial value or exploration; "
+                        "repeatable, written with = for a negative value (--tabular-exploration=-10,0)")
     p.add_argument("--no-neural", dest="neural", action="store_false")
     p.add_argument("--out", default="docs/python-learning.json")
     args = p.parse_args()

@@ -76,3 +76,18 @@ def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_
     assert shared["formations"] >= tabular["formations"] / 4 > 0
     assert shared["final_eval"] > max(still["final_eval"], random["final_eval"])
     assert shared["exported_formations"] >= 0.9 * shared["trained_formations"]
+
+
+def test_the_exploration_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
+    learning = benchmark(repo, "learning")
+    results = json.loads((repo / "docs" / "python-learning-exploration.json").read_text())
+    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    rows = {r["learner"]: r for r in results["rows"]}
+    greedy = rows["tabular Q (tabular_q.py)"]
+    variant = lambda initial_q, epsilon: rows[f"tabular Q (tabular_q.py), initial Q {initial_q}, epsilon {epsilon}"]
+    assert variant(0, 0)["formations"] >= greedy["formations"] / 2 > 0
+    pessimistic = variant(-10, 0)
+    assert pessimistic["formations"] == pessimistic["trained_formations"] == pessimistic["exported_formations"] == 0
+    for epsilon in (0.1, 0.01):
+        explored = variant(1, epsilon)
+        assert explored["formations"] == explored["exported_formations"] == 0, epsilon
