@@ -1,5 +1,6 @@
-//! The every-shape report (`experiments/every-shape.toml`) is measured on
-//! worlds that no policy it reports was trained, searched or selected on:
+//! The every-shape report (`experiments/every-shape.toml`) and the T's
+//! noise experiment (`experiments/t-noise.toml`) are measured on worlds
+//! that no policy they report was trained, searched or selected on:
 //! none of its trial seeds is a seed of a published search's fitness or
 //! validation worlds (`docs/policy-search/runs/*.search.json`), nor a
 //! training run's seed (1 to 6), its selection world's or its
@@ -58,22 +59,25 @@ fn search_seeds(runs: &Path) -> BTreeSet<u64> {
 }
 
 #[test]
-fn no_trial_of_the_every_shape_report_runs_on_a_world_a_policy_was_trained_or_selected_on() {
+fn no_trial_of_the_every_shape_report_or_the_t_noise_experiment_runs_on_a_world_a_policy_was_trained_or_selected_on(
+) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut used = search_seeds(&root.join("docs/policy-search/runs"));
     for run in 1..=6u64 {
         used.extend([run, run ^ EVALUATION_STREAM, run ^ DISTIL_STREAM]);
     }
-    let spec = ExperimentSpec::load("every-shape").expect("the built-in every-shape experiment");
-    for arm in &spec.arms {
-        for t in 0..TRIALS {
-            let seed = trial_seed(spec.seed, &arm.name, t);
-            assert!(
-                !used.contains(&seed),
-                "{} trial {t} runs on seed {seed}, which a search or training run used",
-                arm.name
-            );
+    for (name, arms) in [("every-shape", 7 * 4), ("t-noise", 9)] {
+        let spec = ExperimentSpec::load(name).expect("a built-in experiment");
+        for arm in &spec.arms {
+            for t in 0..TRIALS {
+                let seed = trial_seed(spec.seed, &arm.name, t);
+                assert!(
+                    !used.contains(&seed),
+                    "{name}: {} trial {t} runs on seed {seed}, which a search or training run used",
+                    arm.name
+                );
+            }
         }
+        assert!(spec.arms.len() >= arms, "{name}: {} arms", spec.arms.len());
     }
-    assert!(spec.arms.len() >= 7 * 4, "{} arms", spec.arms.len());
 }

@@ -56,6 +56,7 @@ pub const DOCUMENTS: [Document; 2] = [
             "wedge",
             "wedge-sweep",
             "every-shape",
+            "t-noise",
         ],
     },
 ];

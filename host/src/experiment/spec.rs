@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 16] = [
+pub const BUILT_IN: [(&str, &str); 17] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
@@ -72,6 +72,7 @@ pub const BUILT_IN: [(&str, &str); 16] = [
         "every-shape",
         include_str!("../../../experiments/every-shape.toml"),
     ),
+    ("t-noise", include_str!("../../../experiments/t-noise.toml")),
 ];
 
 /// A parsed experiment file.
