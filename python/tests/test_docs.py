@@ -2,8 +2,11 @@
 measured: the example files verbatim, and the throughput table rendered
 from the results file of the benchmark (python/benchmarks/throughput.py)."""
 
+import argparse
 import importlib.util
 import json
+
+import pytest
 
 
 def benchmark(repo, name):
@@ -91,3 +94,11 @@ def test_the_exploration_table_is_rendered_and_what_the_docs_say_of_it_holds(rep
     for epsilon in (0.1, 0.01):
         explored = variant(1, epsilon)
         assert explored["formations"] == explored["exported_formations"] == 0, epsilon
+
+
+def test_a_bad_exploration_setting_of_the_learning_benchmark_is_named(repo):
+    learning = benchmark(repo, "learning")
+    assert learning.exploration("-10,0.1") == (-10.0, 0.1)
+    for text, words in [("1", "INITIAL_Q,EPSILON"), ("a,b", "INITIAL_Q,EPSILON"), ("1,1.5", "epsilon 1.5")]:
+        with pytest.raises(argparse.ArgumentTypeError, match=words):
+            learning.exploration(text)

@@ -28,3 +28,12 @@ def test_python_q_learning_forms_an_annulus_where_random_actions_form_none(repo)
             _, _, terminated, _, info = env.step(actions)
             assert not terminated.any()
     assert info["formations"][0] == 0 and info["total_steps"][0] >= BUDGET - 1
+
+
+def test_from_a_pessimistic_start_the_same_learner_forms_nothing(repo):
+    sys.path.insert(0, str(repo / "python" / "examples"))
+    import tabular_q
+
+    q, formations, _ = tabular_q.train(steps=BUDGET, seed=SEED, initial_q=-10.0)
+    assert formations == 0
+    assert not np.all(q == -10.0), "the table was updated"
