@@ -4,6 +4,16 @@ shared by every robot of every world, over the vector env.
 Each robot sees its own hashed state (observation="state"), so the trained
 policy is a table: its greedy action for each state, exported as a policy
 blob that `host run --controller policy:FILE` and `host flash` take.
+
+Exploration is consistent in time: each world acts on its own draw of the
+policy, a table drawn by the Gumbel-max trick (the argmax of the logits
+plus Gumbel noise fixed per world and state), the noise redrawn every
+--redraw updates. Every action is still a sample of the current policy
+(for any logits, the argmax with Gumbel noise is distributed as the
+softmax), so PPO's ratios are as usual; but a state's action stays the same
+for hundreds of steps, as a greedy learner's does. With actions sampled
+afresh at every step (--redraw 0) no setting we measured formed an annulus
+(docs/python.md, "How the greedy learner explores").
 """
 import argparse
 
@@ -19,18 +29,22 @@ def parse(argv=None):
     p.add_argument("--steps", type=int, default=1_000_000, help="world-steps, all worlds together")
     p.add_argument("--worlds", type=int, default=16)
     p.add_argument("--rollout", type=int, default=128, help="steps per world between updates")
-    p.add_argument("--reward", default="per-robot")
+    p.add_argument("--reward", default="reference")
     p.add_argument("--max-steps", type=int, default=10_000, help="episode truncation")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--lr", type=float, default=1e-3)
-    p.add_argument("--gamma", type=float, default=0.99)
-    p.add_argument("--gae-lambda", type=float, default=0.95)
+    p.add_argument("--gamma", type=float, default=0.9)
+    p.add_argument("--gae-lambda", type=float, default=0.9)
     p.add_argument("--epochs", type=int, default=4)
     p.add_argument("--minibatches", type=int, default=4)
     p.add_argument("--clip", type=float, default=0.2)
-    p.add_argument("--ent-coef", type=float, default=0.01)
+    p.add_argument("--ent-coef", type=float, default=0.0)
+    p.add_argument("--redraw", type=int, default=5, help="updates between draws of each world's exploration noise (0: sample every step)")
     p.add_argument("--out", default="out/marl-annulus.policy")
-    return p.parse_args(argv)
+    args = p.parse_args(argv)
+    if args.redraw < 0:
+        p.error(f"--redraw {args.redraw}: expected a number of updates, 0 or more")
+    return args
 
 
 class Agent(nn.Module):
@@ -67,13 +81,18 @@ def train(args):
     obs = torch.as_tensor(env.reset(seed=args.seed)[0])
     log = {"episodes": [], "formations": 0}
     for update in range(max(1, args.steps // (W * T))):
+        if args.redraw and update % args.redraw == 0:  # each world's draw of the policy: Gumbel noise per state
+            gumbel = -torch.log(-torch.log(torch.rand(W, batch.num_states, len(batch.angular_speeds)).clamp_min(1e-12)))
         states, actions, logps, values = (torch.zeros((T, W, R), dtype=d) for d in (torch.long, torch.long, torch.float, torch.float))
         rewards, dones = torch.zeros((T, W, R)), torch.zeros((T, W))
         for t in range(T):
             with torch.no_grad():
                 logits, value = agent(obs)
             dist = torch.distributions.Categorical(logits=logits)
-            action = dist.sample()
+            if args.redraw:
+                action = (logits + gumbel[torch.arange(W)[:, None], obs]).argmax(-1)
+            else:
+                action = dist.sample()
             states[t], actions[t], logps[t], values[t] = obs, action, dist.log_prob(action), value
             next_obs, reward, terminated, truncated, info = env.step(action.numpy())
             rewards[t], dones[t] = torch.as_tensor(reward, dtype=torch.float), torch.as_tensor(terminated | truncated, dtype=torch.float)
