@@ -120,9 +120,8 @@ def run(args) -> dict:
             import ppo_sb3
         for reward in args.sb3_rewards:
             def sb3(reward=reward):
-                model, env = ppo_sb3.train(steps=args.steps, seed=1, reward=reward)
-                formations = env.venv.formations  # counted before distil steps the worlds on
-                return ppo_sb3.distil(model, env), formations, env.venv.venv
+                _, env, table = ppo_sb3.train(steps=args.steps, seed=1, reward=reward)
+                return table, env.venv.formations, env.venv.venv
             learned("SB3 PPO (ppo_sb3.py)", reward, sb3)
         import marl_q
 
@@ -181,7 +180,7 @@ def main() -> None:
     p.add_argument("--host", help="the host binary, to run each exported blob as a robot would")
     p.add_argument("--tabular-rewards", nargs="*", default=["reference", "thesis", "success-shaped"])
     p.add_argument("--marl-rewards", nargs="*", default=["reference", "per-robot", "success-shaped"])
-    p.add_argument("--sb3-rewards", nargs="*", default=["success-shaped"])
+    p.add_argument("--sb3-rewards", nargs="*", default=["reference"])
     p.add_argument("--marl-q-rewards", nargs="*", default=["reference"])
     p.add_argument("--tabular-exploration", action="append", default=[], type=exploration, metavar="INITIAL_Q,EPSILON",
                    help="a tabular Q-learning row (reference reward) with another initial value or exploration; "

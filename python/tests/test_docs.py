@@ -46,12 +46,10 @@ def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results
     assert tabular["trained_formations"] > 0 and tabular["exported_formations"] > 0 and tabular["formations"] > 0
     assert tabular["final_eval"] > baselines
     assert by[("tabular Q", "thesis")]["formations"] == by[("tabular Q", "success-shaped")]["formations"] == 0
-    shared = by[("shared-policy PPO", "reference")]
-    assert shared["formations"] > 0 and shared["exported_formations"] > 0 and shared["trained_formations"] == 0
-    assert shared["final_eval"] > baselines
+    for ppo in (by[("shared-policy PPO", "reference")], by[("SB3 PPO", "reference")]):
+        assert ppo["formations"] > 0 and ppo["exported_formations"] > 0 and ppo["trained_formations"] == 0
+        assert ppo["final_eval"] > baselines
     assert by[("shared-policy PPO", "per-robot")]["formations"] == by[("shared-policy PPO", "success-shaped")]["formations"] == 0
-    sb3 = by[("SB3 PPO", "success-shaped")]
-    assert sb3["formations"] == sb3["trained_formations"] == 0 and abs(sb3["final_eval"] - still["final_eval"]) < 0.01
     network = by[("shared Q-network", "reference")]
     assert network["trained_formations"] > 0 and network["formations"] == 0
     assert random["final_eval"] < still["final_eval"]
@@ -64,16 +62,14 @@ def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it
     assert results["budget_steps"] <= 1_000_000 and len(results["eval_seeds"]) == 10
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
     still, random = by[("robots standing still", None)], by[("random actions", None)]
-    tabular, shared = by[("tabular Q", "reference")], by[("shared-policy PPO", "reference")]
+    tabular = by[("tabular Q", "reference")]
     assert tabular["exported_formations"] >= 0.9 * tabular["trained_formations"] > 0
-    assert shared["formations"] >= tabular["formations"] / 4 > 0
-    assert shared["final_eval"] > max(still["final_eval"], random["final_eval"])
-    assert shared["exported_formations"] > shared["trained_formations"] > 0
+    for ppo in (by[("shared-policy PPO", "reference")], by[("SB3 PPO", "reference")]):
+        assert ppo["formations"] >= tabular["formations"] / 4 > 0
+        assert ppo["final_eval"] > max(still["final_eval"], random["final_eval"])
+        assert ppo["exported_formations"] > ppo["trained_formations"] > 0
     for reward in ("per-robot", "success-shaped"):
         assert by[("shared-policy PPO", reward)]["formations"] == by[("shared-policy PPO", reward)]["trained_formations"] == 0
-    sb3 = by[("SB3 PPO", "success-shaped")]
-    assert sb3["formations"] == sb3["trained_formations"] == 0
-    assert sb3["final_eval"] > still["final_eval"] > random["final_eval"]
 
 
 def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):

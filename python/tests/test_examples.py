@@ -1,5 +1,5 @@
 """The neural examples run end to end at a small step count: they train,
-log episode returns and Eval, and their distilled policy round-trips
+log episode returns and Eval, and their exported table round-trips
 through a policy blob. Their learning figures are a benchmark's
 (python/benchmarks/learning.py), not a test's. PyTorch and
 Stable-Baselines3 are large and not in the test environment
@@ -64,14 +64,20 @@ def test_the_shared_q_network_example_trains_logs_and_exports_its_table(tmp_path
     assert (best.sum(axis=1) > 1).any(), "states never met keep their four tied actions"
 
 
-def test_the_sb3_ppo_example_logs_returns_and_eval_and_distils_into_a_blob(tmp_path):
+def test_the_sb3_ppo_example_logs_returns_and_eval_and_exports_its_table(tmp_path):
     pytest.importorskip("stable_baselines3")
     import ppo_sb3
 
-    model, env = ppo_sb3.train(steps=1024, worlds=4, max_steps=100)
+    model, env, selected = ppo_sb3.train(steps=1024, worlds=4, max_steps=100, select_steps=100)
     episodes = list(model.ep_info_buffer)
     assert len(episodes) >= 4 and all("r" in e and 0.0 < e["eval"] <= 1.0 for e in episodes)
-    table = ppo_sb3.distil(model, env, steps=50)
+    assert model.policy.noise is not None, "the worlds explored on their own draws"
+    table = model.policy.table()
     assert table.shape == (256,)
+    robots = env.venv.venv.batch.robots
+    for mixed in np.random.default_rng(1).integers(0, 256, (5, robots)):
+        acted, _ = model.predict(mixed[None, :], deterministic=True)
+        assert np.array_equal(acted[0], table[mixed]), "each robot acts as the table says for its own state"
+    assert np.array_equal(selected, table), "with one check, at the end, the last table is the selected one"
     path = zumo_swarm.export_policy(tmp_path / "ppo.policy", table, env=env.venv.venv, trainer_steps=1024)
     assert np.array_equal(zumo_swarm.load_policy(path).table, table)
