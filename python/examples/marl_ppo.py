@@ -12,7 +12,7 @@ plus Gumbel noise fixed per world and state), the noise redrawn every
 (for any logits, the argmax with Gumbel noise is distributed as the
 softmax), so PPO's ratios are as usual; but a state's action stays the same
 for hundreds of steps, as a greedy learner's does. With actions sampled
-afresh at every step (--redraw 0) no setting we measured formed an annulus
+afresh at every step (--redraw 0) no setting we tried formed an annulus
 (docs/python.md, "How the greedy learner explores").
 """
 import argparse
