@@ -80,8 +80,18 @@ fn reset_with_a_seed_reproduces_the_same_frames() {
     let mut page = Browser::open(&format!("http://{address}/"), SIZE);
     page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
     let mut picture = |seed: u64| {
+        let before = page
+            .eval("document.documentElement.dataset.generation")
+            .as_str()
+            .unwrap()
+            .to_string();
         page.eval(&format!("document.getElementById('resetSeed').value = '{seed}'; document.getElementById('reset').click()"));
-        page.wait_for("document.documentElement.dataset.step === '0'", 30);
+        // the reset's new generation, not the step 0 the page may show already
+        // (a step request overtaking the page's reset would be undone by it)
+        page.wait_for(
+            &format!("document.documentElement.dataset.generation !== '{before}' && document.documentElement.dataset.step === '0'"),
+            30,
+        );
         let (status, body) = request(address, "POST", "/control?action=step&steps=40", b"");
         assert_eq!(status, 200, "{body}");
         wait_for_step(address, 40);
