@@ -97,16 +97,17 @@ def run(args) -> dict:
     baseline("random actions")
     import tabular_q
 
+    def tabular(reward, **settings):
+        def train_and_table():
+            q, formations, env = tabular_q.train(steps=args.steps, seed=1, reward=reward, **settings)
+            return q, int(formations), env
+        return train_and_table
+
     for reward in args.tabular_rewards:
-        def tabular(reward=reward):
-            q, formations, env = tabular_q.train(steps=args.steps, seed=1, reward=reward)
-            return q, int(formations), env
-        learned("tabular Q (tabular_q.py)", reward, tabular)
+        learned("tabular Q (tabular_q.py)", reward, tabular(reward))
     for initial_q, epsilon in args.tabular_exploration:
-        def explored(initial_q=initial_q, epsilon=epsilon):
-            q, formations, env = tabular_q.train(steps=args.steps, seed=1, initial_q=initial_q, epsilon=epsilon)
-            return q, int(formations), env
-        learned(f"tabular Q (tabular_q.py), initial Q {initial_q:g}, epsilon {epsilon:g}", "reference", explored)
+        learned(f"tabular Q (tabular_q.py), initial Q {initial_q:g}, epsilon {epsilon:g}", "reference",
+                tabular("reference", initial_q=initial_q, epsilon=epsilon))
     if args.neural:
         import marl_ppo
 

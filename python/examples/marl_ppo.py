@@ -47,6 +47,11 @@ def parse(argv=None):
     return args
 
 
+def gumbel_noise(shape, generator=None):
+    """Standard Gumbel noise: added to logits, its argmax is a sample of their softmax."""
+    return -torch.log(-torch.log(torch.rand(shape, generator=generator).clamp_min(1e-12)))
+
+
 class Agent(nn.Module):
     """Actor and critic over one robot's hashed state (one-hot)."""
 
@@ -82,7 +87,7 @@ def train(args):
     log = {"episodes": [], "formations": 0}
     for update in range(max(1, args.steps // (W * T))):
         if args.redraw and update % args.redraw == 0:  # each world's draw of the policy: Gumbel noise per state
-            gumbel = -torch.log(-torch.log(torch.rand(W, batch.num_states, len(batch.angular_speeds)).clamp_min(1e-12)))
+            gumbel = gumbel_noise((W, batch.num_states, len(batch.angular_speeds)))
         states, actions, logps, values = (torch.zeros((T, W, R), dtype=d) for d in (torch.long, torch.long, torch.float, torch.float))
         rewards, dones = torch.zeros((T, W, R)), torch.zeros((T, W))
         for t in range(T):

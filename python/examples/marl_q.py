@@ -73,10 +73,9 @@ def greedy(q, generator):
     return torch.where(best, torch.rand(q.shape, generator=generator), -1.0).argmax(-1)
 
 
-def evaluation(values, seed, steps):
-    """Formations of a frozen table acting greedily (the lowest of equal
-    actions) in a new world of `seed`, over `steps` steps."""
-    table = values.argmax(-1)
+def greedy_formations(table, seed, steps):
+    """Formations of a frozen table (one action per state) acting in a new
+    world of `seed`, over `steps` steps."""
     env = zumo_swarm.vector_env(1, observation="state", seed=seed)
     obs, _ = env.reset(seed=seed)
     for _ in range(steps):
@@ -121,7 +120,7 @@ def train(args):
             log["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
         if (call + 1) % every == 0 or call == calls - 1:
             values = q.values()
-            formed = evaluation(values, judge_seed, args.select_steps)
+            formed = greedy_formations(values.argmax(-1), judge_seed, args.select_steps)  # the lowest of equal actions
             if formed > log["selected_formations"]:
                 log.update(selected=values, selected_step=(call + 1) * args.worlds, selected_formations=formed)
         if call % 25_000 == 0 or call == calls - 1:

@@ -23,7 +23,8 @@ from stable_baselines3.common.vec_env import VecMonitor
 from torch import nn
 
 import zumo_swarm
-from marl_q import evaluation  # formations of a table acting greedily in one world
+from marl_ppo import gumbel_noise
+from marl_q import greedy_formations
 from zumo_swarm.sb3 import SB3VecEnv
 
 
@@ -97,7 +98,7 @@ class Redraw(BaseCallback):
         if self.rollouts % self.every == 0:
             policy, space = self.model.policy, self.model.action_space
             shape = (self.training_env.num_envs, len(space.nvec), policy.features_extractor.states, int(space.nvec[0]))
-            policy.noise = -torch.log(-torch.log(torch.rand(shape, generator=self.generator).clamp_min(1e-12)))
+            policy.noise = gumbel_noise(shape, self.generator)
         self.rollouts += 1
 
 
@@ -115,7 +116,7 @@ class SelectTable(BaseCallback):
 
     def _judge(self):
         table = self.model.policy.table()
-        formed = evaluation(np.eye(int(self.model.action_space.nvec[0]))[table], self.seed, self.steps)
+        formed = greedy_formations(table, self.seed, self.steps)
         if formed > self.formed:
             self.selected, self.formed = table, formed
 
