@@ -9,6 +9,7 @@ writes RESULTS (JSON) and renders the tables of DOC between its
 """
 import glob
 import json
+import math
 import os
 import sys
 
@@ -103,6 +104,28 @@ def publish(out, results_path):
     os.replace(results_path + ".tmp", results_path)
 
 
+# the shapes the general tables are searched on
+GENERAL_SHAPES = ["annulus", "thesis:T", "thesis:L", "thesis:X"]
+
+
+def general_ranking(results):
+    """The general tables (runs named general*) on the shapes they were
+    searched on, best first by the search's own measure: the sum over the
+    shapes of ln(1 + formations), here per million steps."""
+    runs = {}
+    for field in GENERAL_SHAPES:
+        for c in results["shapes"].get(field, {}).values():
+            run = os.path.basename(c["policy"])[: -len(".policy")]
+            if run.startswith("general"):
+                runs.setdefault(run, {})[field] = c["per_million"]
+    ranked = []
+    for run, counts in runs.items():
+        if len(counts) == len(GENERAL_SHAPES):
+            row = [counts[f] for f in GENERAL_SHAPES]
+            ranked.append((run, row, sum(math.log1p(c) for c in row)))
+    return sorted(ranked, key=lambda r: -r[2])
+
+
 def tables(results):
     lines = ["| shape | controller | formations per million steps | / OC |", "|---|---|---:|---:|"]
     for field, shape in results["shapes"].items():
@@ -133,6 +156,12 @@ def tables(results):
         if field == "thesis:L":
             need = max(need, 1.5 * oc)
         lines.append(f"| {field}: >= {need:,.1f} per million | best learned / million steps | {found:,.1f} | {'yes' if found >= need else 'no'} |")
+    ranked = general_ranking(results)
+    if ranked:
+        lines += ["", "| general table | " + " | ".join(GENERAL_SHAPES) + " | sum of ln(1 + per million) |",
+                  "|---|" + "---:|" * (len(GENERAL_SHAPES) + 1)]
+        for run, counts, measure in ranked:
+            lines.append(f"| {run} | " + " | ".join(f"{c:,.1f}" for c in counts) + f" | {measure:.2f} |")
     lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
               "|---|---|---|---|---|---|---:|---:|---:|---:|---:|"]
     for s in results["searches"]:

@@ -2,14 +2,35 @@
 //! docs/policy-search/results.json holds (the JSON `scripts/policy-search`
 //! publishes; `scripts/policy-search-publish.py` renders the page).
 
-use std::path::Path;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn results() -> serde_json::Value {
+    let text = std::fs::read_to_string(root().join("docs/policy-search/results.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// A controller's formations per million steps over its report seeds.
+fn per_million(controller: &serde_json::Value) -> f64 {
+    let formations: Vec<f64> = controller["formations"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_f64().unwrap())
+        .collect();
+    let steps = controller["steps_per_seed"].as_f64().unwrap();
+    formations.iter().sum::<f64>() * 1e6 / (steps * formations.len() as f64)
+}
 
 #[test]
 fn every_measured_cell_of_the_policy_search_page_is_the_published_figure() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let root = root();
     let page = std::fs::read_to_string(root.join("docs/policy-search.md")).unwrap();
-    let text = std::fs::read_to_string(root.join("docs/policy-search/results.json")).unwrap();
-    let results: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let results = results();
     let shapes = results["shapes"].as_object().unwrap();
     assert!(
         shapes.len() >= 7,
@@ -19,15 +40,7 @@ fn every_measured_cell_of_the_policy_search_page_is_the_published_figure() {
     let mut cells = 0;
     for (field, controllers) in shapes {
         for (name, c) in controllers.as_object().unwrap() {
-            let formations: Vec<f64> = c["formations"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .map(|f| f.as_f64().unwrap())
-                .collect();
-            let steps = c["steps_per_seed"].as_f64().unwrap();
-            let per_million =
-                formations.iter().sum::<f64>() * 1e6 / (steps * formations.len() as f64);
+            let per_million = per_million(c);
             let prefix = format!("| {field} | {name} | ");
             let row = page
                 .lines()
@@ -46,4 +59,39 @@ fn every_measured_cell_of_the_policy_search_page_is_the_published_figure() {
         }
     }
     assert!(cells >= 14, "{cells}");
+}
+
+/// The general policy is chosen on the shapes it was searched on alone,
+/// by the search's own measure, never on the shapes it is evaluated on.
+#[test]
+fn the_shipped_general_policy_is_the_general_table_that_ranks_first_on_the_shapes_it_was_searched_on(
+) {
+    let searched_on = ["annulus", "thesis:T", "thesis:L", "thesis:X"];
+    let results = results();
+    // run -> (shapes measured, sum of ln(1 + formations per million))
+    let mut measure: BTreeMap<String, (usize, f64)> = BTreeMap::new();
+    for field in searched_on {
+        for c in results["shapes"][field].as_object().unwrap().values() {
+            let policy = Path::new(c["policy"].as_str().unwrap());
+            let run = policy.file_stem().unwrap().to_str().unwrap();
+            if run.starts_with("general") {
+                let m = measure.entry(run.to_string()).or_default();
+                m.0 += 1;
+                m.1 += per_million(c).ln_1p();
+            }
+        }
+    }
+    let best = measure
+        .iter()
+        .filter(|(_, (shapes, _))| *shapes == searched_on.len())
+        .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
+        .map(|(run, _)| run.clone())
+        .expect("general tables in the quick evaluation");
+    let shipped = std::fs::read(root().join("policies/robot-general.policy")).unwrap();
+    let ranked_first =
+        std::fs::read(root().join(format!("docs/policy-search/runs/{best}.policy"))).unwrap();
+    assert!(
+        shipped == ranked_first,
+        "policies/robot-general.policy is not {best}, the general table that ranks first: {measure:?}"
+    );
 }
