@@ -104,24 +104,27 @@ def publish(out, results_path):
     os.replace(results_path + ".tmp", results_path)
 
 
-# the shapes the general tables are searched on
-GENERAL_SHAPES = ["annulus", "thesis:T", "thesis:L", "thesis:X"]
+def general_shapes(results):
+    """The shapes the general tables are searched on: the general search's
+    fields, as its log names them."""
+    search = next((s for s in results["searches"] if s["name"] == "general"), None)
+    return search["field"].split(" + ") if search else []
 
 
-def general_ranking(results):
-    """The general tables (runs named general*) on the shapes they were
-    searched on, best first by the search's own measure: the sum over the
-    shapes of ln(1 + formations), here per million steps."""
+def general_ranking(results, shapes):
+    """The general tables (runs named general*) on `shapes`, best first by
+    the search's own measure: the sum over the shapes of ln(1 +
+    formations), here per million steps."""
     runs = {}
-    for field in GENERAL_SHAPES:
+    for field in shapes:
         for c in results["shapes"].get(field, {}).values():
             run = os.path.basename(c["policy"])[: -len(".policy")]
             if run.startswith("general"):
                 runs.setdefault(run, {})[field] = c["per_million"]
     ranked = []
     for run, counts in runs.items():
-        if len(counts) == len(GENERAL_SHAPES):
-            row = [counts[f] for f in GENERAL_SHAPES]
+        if len(counts) == len(shapes):
+            row = [counts[f] for f in shapes]
             ranked.append((run, row, sum(math.log1p(c) for c in row)))
     return sorted(ranked, key=lambda r: -r[2])
 
@@ -156,10 +159,11 @@ def tables(results):
         if field == "thesis:L":
             need = max(need, 1.5 * oc)
         lines.append(f"| {field}: >= {need:,.1f} per million | best learned / million steps | {found:,.1f} | {'yes' if found >= need else 'no'} |")
-    ranked = general_ranking(results)
+    shapes = general_shapes(results)
+    ranked = general_ranking(results, shapes)
     if ranked:
-        lines += ["", "| general table | " + " | ".join(GENERAL_SHAPES) + " | sum of ln(1 + per million) |",
-                  "|---|" + "---:|" * (len(GENERAL_SHAPES) + 1)]
+        lines += ["", "| general table | " + " | ".join(shapes) + " | sum of ln(1 + per million) |",
+                  "|---|" + "---:|" * (len(shapes) + 1)]
         for run, counts, measure in ranked:
             lines.append(f"| {run} | " + " | ".join(f"{c:,.1f}" for c in counts) + f" | {measure:.2f} |")
     lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
