@@ -6,8 +6,8 @@ use sim::control::random::RandomTurns;
 use sim::{
     base::vec2::Vec2, config::disc_sensors::DiscSensorConfig, config::SimConfig,
     fields::ScalarField, physics::body::RobotKind, sensors::disc::DiscSensors,
-    sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors, sensors::SensorModel,
-    simulation::Simulation, world::World,
+    sensors::robot::RobotSensorConfig, sensors::robot::RobotSensors,
+    sensors::robot_noise::RobotNoise, sensors::SensorModel, simulation::Simulation, world::World,
 };
 use std::sync::Arc;
 
@@ -125,4 +125,40 @@ fn a_noisy_run_resumed_from_its_snapshot_goes_on_exactly() {
     .build(fresh.config());
     let mut resumed = Simulation::resume(state, Arc::new(fresh.field().clone()), sensors);
     assert_eq!(trajectory(&mut resumed, 1500), whole);
+}
+
+/// The robot senses' noise of a scenario on `tv75` whose panel shows
+/// `share` of its unevenness, at twice the default noise.
+fn noise_on_a_panel_showing(share: f64) -> Result<RobotNoise, String> {
+    use sim::scenario::{arena::ArenaSpec, sensor_setup::SensorSetup, Arena, Scenario};
+    let scenario = Scenario {
+        arena: Arena::Screen(Box::new(ArenaSpec {
+            brightness_unevenness: share,
+            ..ArenaSpec::tv75()
+        })),
+        sensors: SensorSetup::Robot(Box::default()),
+        noise: 2.0,
+        ..Scenario::default()
+    };
+    match scenario.prepare().map_err(|e| e.to_string())?.sensors() {
+        SensorSetup::Robot(robot) => Ok(robot.noise.clone()),
+        other => Err(format!("not the robot's senses: {other:?}")),
+    }
+}
+
+#[test]
+fn a_flat_field_corrected_panel_shows_its_share_of_the_unevenness_and_no_other_noise_changes() {
+    let panel = noise_on_a_panel_showing(1.0).unwrap();
+    assert_eq!(panel, RobotNoise::randomised().scaled(2.0));
+    let flattened = noise_on_a_panel_showing(0.2).unwrap();
+    assert!((flattened.brightness - 0.2 * panel.brightness).abs() < 1e-15);
+    assert_eq!(
+        RobotNoise {
+            brightness: panel.brightness,
+            ..flattened
+        },
+        panel
+    );
+    let e = noise_on_a_panel_showing(1.5).unwrap_err();
+    assert!(e.contains("arena.brightness_unevenness"), "{e}");
 }

@@ -14,7 +14,7 @@ use sim::base::vec2::Vec2;
 use sim::config::Thresholds;
 use sim::episodes::eval::eval;
 use sim::fields::source::FieldSource;
-use sim::scenario::shape_pucks::{tv_pucks, tv_shapes};
+use sim::scenario::shape_pucks::{training_shapes, tv_pucks, tv_shapes};
 use sim::scenario::{arena::ArenaSpec, Arena, Scenario};
 use sim::world::World;
 
@@ -127,6 +127,27 @@ fn eleven_pucks_on_our_i_reach_success_and_twelve_do_not() {
 }
 
 #[test]
+fn ten_pucks_on_our_t_reach_success_and_eleven_do_not() {
+    check("letter:T");
+}
+
+#[test]
+fn twelve_pucks_on_our_l_reach_success() {
+    check("letter:L");
+}
+
+#[test]
+fn twelve_pucks_on_our_x_reach_success() {
+    check("letter:X");
+}
+
+#[test]
+fn every_shape_searched_on_but_not_reported_is_checked_above() {
+    let names: Vec<String> = training_shapes().map(|(f, _)| f.to_string()).collect();
+    assert_eq!(names, ["letter:T", "letter:L", "letter:X"]);
+}
+
+#[test]
 fn every_shape_of_the_report_is_checked_above() {
     let names: Vec<String> = tv_shapes().map(|(f, _)| f.to_string()).collect();
     assert_eq!(
@@ -141,7 +162,7 @@ fn the_policy_search_page_gives_every_count() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/policy-search.md"),
     )
     .unwrap();
-    for (field, pucks) in tv_shapes() {
+    for (field, pucks) in tv_shapes().chain(training_shapes()) {
         let row = format!("| {field} | {pucks} |");
         assert!(page.contains(&row), "docs/policy-search.md lacks {row}");
     }

@@ -656,6 +656,15 @@ pub const GAMMA: Range = Range::closed(
     "displays are 1.8 to 2.6; the light curve's is 2.2",
 );
 
+/// The share of a panel's brightness unevenness its robots see.
+pub const UNEVENNESS: Range = Range::closed(
+    &["arena.brightness_unevenness"],
+    0.0,
+    1.0,
+    "",
+    "1 for a panel as it comes; a flat-field correction (the shown image divided by the panel's measured gain) leaves less, never more",
+);
+
 /// Seconds the calibration sequence holds white and black.
 pub const HOLD_S: Range = Range::closed(
     &["--hold"],
@@ -826,6 +835,7 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &SCREEN_PX,
             &BODY_RADIUS_MM,
             &GAMMA,
+            &UNEVENNESS,
             &HOLD_S,
             &FIELD_IMAGE_SIDE,
             &PHOTO_SIDE,

@@ -98,6 +98,12 @@ pub struct ArenaSpec {
     /// The display's gamma: its light is `pixel ^ display_gamma` of full
     /// white (for measuring it, the display page shows grey patches).
     pub display_gamma: f64,
+    /// The share of the panel's brightness unevenness (the robot senses'
+    /// `noise.brightness`) the robots see: 1 for a panel as it comes, less
+    /// for one whose shown image is divided by its measured gain (a
+    /// flat-field correction, `docs/robot-sensors.md`, "Which noise costs
+    /// the T").
+    pub brightness_unevenness: f64,
     /// Robot radius, mm: the Zumo in its skirt (a wedge's round back).
     pub robot_radius_mm: f64,
     /// The skirt's outline.
@@ -148,6 +154,7 @@ impl ArenaSpec {
             screen_px: [3840, 2160],
             fit: FieldFit::Contain,
             display_gamma: 2.2,
+            brightness_unevenness: 1.0,
             robot_radius_mm: 65.0,
             robot_shape: SkirtShape::thesis_wedge(),
             puck_radius_mm: 65.0,
@@ -186,6 +193,7 @@ impl ArenaSpec {
             ranges::SCREEN_PX.check_count(&format!("arena.screen_px[{i}]"), u64::from(*px))?;
         }
         ranges::GAMMA.check(self.display_gamma)?;
+        ranges::UNEVENNESS.check(self.brightness_unevenness)?;
         ranges::BODY_RADIUS_MM.check(self.robot_radius_mm)?;
         ranges::BODY_RADIUS_MM.check_as("arena.puck_radius_mm", self.puck_radius_mm)?;
         for (i, mm) in self.screen_mm.iter().enumerate() {

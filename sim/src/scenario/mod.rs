@@ -287,6 +287,13 @@ impl Scenario {
         } else {
             self.sensors.clone()
         };
+        // a flat-field corrected panel shows less of its unevenness
+        let sensors = match &self.arena {
+            Arena::Screen(spec) if spec.brightness_unevenness != 1.0 => {
+                sensors.with_unevenness(spec.brightness_unevenness)
+            }
+            _ => sensors,
+        };
         sensors.validate()?;
         let field = Arc::new(self.arena.load(&self.field)?);
         let config = self.config(&field);

@@ -51,9 +51,24 @@ impl SensorSetup {
     /// This setup with the robot sensor model's noise set to `noise`
     /// (in every part of a mix; the disc models have none).
     pub(crate) fn with_noise(&self, noise: &RobotNoise) -> SensorSetup {
+        self.map_noise(&|_| noise.clone())
+    }
+
+    /// This setup with the screen's brightness unevenness of the robot
+    /// sensor model's noise times `share` (a flat-field corrected panel).
+    pub(crate) fn with_unevenness(&self, share: f64) -> SensorSetup {
+        self.map_noise(&|noise| RobotNoise {
+            brightness: noise.brightness * share,
+            ..noise.clone()
+        })
+    }
+
+    /// This setup with the robot sensor model's noise replaced by `f` of
+    /// it, in every part of a mix.
+    fn map_noise(&self, f: &dyn Fn(&RobotNoise) -> RobotNoise) -> SensorSetup {
         match self {
             SensorSetup::Robot(robot) => SensorSetup::Robot(Box::new(RobotSensorConfig {
-                noise: noise.clone(),
+                noise: f(&robot.noise),
                 ..(**robot).clone()
             })),
             SensorSetup::Mixed {
@@ -61,9 +76,9 @@ impl SensorSetup {
                 pucks,
                 obstacles,
             } => SensorSetup::Mixed {
-                field: Box::new(field.with_noise(noise)),
-                pucks: Box::new(pucks.with_noise(noise)),
-                obstacles: Box::new(obstacles.with_noise(noise)),
+                field: Box::new(field.map_noise(f)),
+                pucks: Box::new(pucks.map_noise(f)),
+                obstacles: Box::new(obstacles.map_noise(f)),
             },
             other => other.clone(),
         }
