@@ -4,8 +4,9 @@
 //! Fixed here before any training, the same for orbital construction and
 //! every policy. The general table is also searched on our generated T, L
 //! and X (the same shapes as the thesis' images, drawn as our I is), whose
-//! counts follow the same rule ([`TRAINING_SHAPE_PUCKS`]). `sim/tests/shape_pucks.rs` places each count (and one
-//! more) and checks it; `docs/policy-search.md` gives the table.
+//! counts follow the same rule ([`TRAINING_SHAPE_PUCKS`]).
+//! `sim/tests/shape_pucks.rs` places each count (and one more) and checks
+//! it; `docs/policy-search.md` gives the tables.
 
 use crate::fields::source::FieldSource;
 
