@@ -156,9 +156,10 @@ def tables(results):
     if oc and learned:
         n, best = max(learned, key=lambda nc: nc[1])
         lines.append(f"| annulus: a learned policy >= 1.15x OC | best ({n}) / OC | {best / oc:.3f} | {'yes' if best >= 1.15 * oc else 'no'} |")
+    reported = report_shapes()
     for field, shape in results["shapes"].items():
         # the annulus' target is above; shapes only searched on have none
-        if field == "annulus" or field not in report_shapes():
+        if field == "annulus" or field not in reported:
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
         # every table learned for the letter (each search, whatever its

@@ -289,10 +289,8 @@ impl Scenario {
         };
         // a flat-field corrected panel shows less of its unevenness
         let sensors = match &self.arena {
-            Arena::Screen(spec) if spec.brightness_unevenness != 1.0 => {
-                sensors.with_unevenness(spec.brightness_unevenness)
-            }
-            _ => sensors,
+            Arena::Screen(spec) => sensors.with_unevenness(spec.brightness_unevenness),
+            Arena::Square(_) => sensors,
         };
         sensors.validate()?;
         let field = Arc::new(self.arena.load(&self.field)?);
