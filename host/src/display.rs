@@ -1,23 +1,39 @@
 //! `host display`: a local web server showing the field on the TV (the
-//! TV's own browser, or a computer's on HDMI), its calibration sequence and
-//! grey patches for measuring the display's gamma (`docs/display.md`).
+//! TV's own browser, or a computer's on HDMI), its calibration sequence,
+//! grey patches for measuring the display's gamma and marks for measuring
+//! the panel's brightness gain (`docs/display.md`).
 //!
-//! It serves three things and nothing else: the page (`/`, plain HTML and
+//! It serves four things and nothing else: the page (`/`, plain HTML and
 //! JavaScript built into the binary, so no internet is needed), the panel
-//! image (`/field.png`, [`crate::panel_file`]) and the page's settings
+//! image (`/field.png`, [`crate::panel_file`]), the calibration's white
+//! screen (`/white.png`; both evened out for the panel's measured gain when
+//! given one, [`crate::flat_field`]) and the page's settings
 //! (`/settings.json`). It binds where it is told, loopback by default.
 
+use crate::flat_field::MarkGrid;
 use crate::panel_file;
 use anyhow::{Context, Result};
 use serde::Serialize;
+use sim::base::gain_grid::GainGrid;
 use sim::base::ranges;
 use sim::fields::source::FieldSource;
-use sim::scenario::arena::ArenaSpec;
+use sim::scenario::arena::{ArenaSpec, SkirtShape};
 use std::net::{SocketAddr, TcpListener};
 use tiny_http::{Header, Method, Request, Response, Server};
 
 /// The page, built in.
 const PAGE: &str = include_str!("display.html");
+
+/// The gap between the skirt's reach and a mark's ticks, mm.
+const MARK_MARGIN_MM: f64 = 20.0;
+
+/// The farthest the skirt reaches from a robot's centre, mm.
+fn skirt_reach_mm(arena: &ArenaSpec) -> f64 {
+    match arena.robot_shape {
+        SkirtShape::Disc => arena.robot_radius_mm,
+        SkirtShape::Wedge { tip_mm } => tip_mm.max(arena.robot_radius_mm),
+    }
+}
 
 /// What to show and where to listen.
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +46,10 @@ pub struct DisplaySettings {
     pub bind: SocketAddr,
     /// How long the calibration sequence holds white and black, ms.
     pub hold_ms: u32,
+    /// The panel's measured gain, to even out what it shows.
+    pub gain: Option<GainGrid>,
+    /// The marks screen's grid.
+    pub marks: MarkGrid,
 }
 
 /// The page's settings, as `/settings.json` gives them.
@@ -40,6 +60,13 @@ struct PageSettings {
     panel: [u32; 2],
     hold_ms: u32,
     display_gamma: f64,
+    /// Whether the images are evened out for a measured gain.
+    flat: bool,
+    screen_mm: [f64; 2],
+    /// How far from a mark's centre its ticks start: clear of the skirt.
+    mark_clear_mm: f64,
+    /// The marks' centres, mm from the screen's top-left, row by row.
+    marks: Vec<[f64; 2]>,
 }
 
 /// A display server, listening.
@@ -47,6 +74,7 @@ pub struct Display {
     server: Server,
     address: SocketAddr,
     png: Vec<u8>,
+    white_png: Vec<u8>,
     settings_json: String,
 }
 
@@ -60,14 +88,23 @@ impl Display {
         arena
             .validate()
             .with_context(|| format!("arena {}", arena.name))?;
-        let image = panel_file::panel_image(arena, &settings.field)?;
+        let gain = settings.gain.as_ref();
+        if let Some(grid) = gain {
+            grid.validate().context("the panel's gain")?;
+        }
+        let image = panel_file::panel_image(arena, &settings.field, gain)?;
         let png = panel_file::encode_png(&image)?;
+        let white_png = panel_file::encode_png(&sim::scenario::panel::white_image(arena, gain))?;
         let page = PageSettings {
             arena: arena.name.clone(),
             field: settings.field.to_string(),
             panel: arena.screen_px,
             hold_ms: hold,
             display_gamma: arena.display_gamma,
+            flat: gain.is_some(),
+            screen_mm: arena.screen_mm,
+            mark_clear_mm: skirt_reach_mm(arena) + MARK_MARGIN_MM,
+            marks: settings.marks.points_mm(arena),
         };
         let settings_json =
             serde_json::to_string(&page).context("cannot encode the page's settings")?;
@@ -82,6 +119,7 @@ impl Display {
             server,
             address,
             png,
+            white_png,
             settings_json,
         })
     }
@@ -118,10 +156,11 @@ impl Display {
         let (body, kind) = match path.as_str() {
             "/" | "/index.html" => (PAGE.as_bytes().to_vec(), "text/html; charset=utf-8"),
             "/field.png" => (self.png.clone(), "image/png"),
+            "/white.png" => (self.white_png.clone(), "image/png"),
             "/settings.json" => (self.settings_json.as_bytes().to_vec(), "application/json"),
             _ => {
                 let text = format!(
-                    "not found: {path} (this server has /, /field.png and /settings.json)\n"
+                    "not found: {path} (this server has /, /field.png, /white.png and /settings.json)\n"
                 );
                 return request.respond(Response::from_string(text).with_status_code(404));
             }

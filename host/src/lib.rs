@@ -8,6 +8,7 @@ pub mod bench;
 pub mod display;
 pub mod experiment;
 pub mod flashed;
+pub mod flat_field;
 pub mod inspect;
 pub mod learn;
 pub mod observe;

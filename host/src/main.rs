@@ -7,7 +7,7 @@ use anyhow::{Context, Result};
 use clap::Parser;
 use cli::learn::{ExperimentAction, ExperimentArgs, SearchArgs, TrainArgs};
 use cli::robot::{FlashArgs, MonitorArgs, ReplayArgs};
-use cli::screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
+use cli::screen::{DisplayArgs, FieldExportArgs, FieldGainArgs, ObserveArgs};
 use cli::simulate::{BenchArgs, RenderArgs, RunArgs};
 use cli::view::ViewArgs;
 use cli::{Cli, Command, FieldCommand, PolicyCommand};
@@ -59,6 +59,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Replay(args) => replay(args),
         Command::Flash(args) => flash(args),
         Command::Field(FieldCommand::Export(args)) => export_field(args),
+        Command::Field(FieldCommand::Gain(args)) => field_gain(args),
         Command::Display(args) => display(args),
         Command::Observe(args) => observe(args),
         Command::View(args) => view(args),
@@ -245,12 +246,54 @@ fn flash(args: FlashArgs) -> Result<()> {
 
 fn export_field(args: FieldExportArgs) -> Result<()> {
     let arena = args.screen.arena.screen()?;
-    let (w, h) = host::panel_file::export(&arena, &args.screen.field, args.band, &args.out)?;
+    let gain = args.gain.read()?;
+    let picture = args.picture();
+    let (w, h) = host::panel_file::export(
+        &arena,
+        &args.screen.field,
+        picture,
+        gain.as_ref(),
+        &args.out,
+    )?;
+    let what = match picture {
+        host::panel_file::Picture::White => "full white".to_string(),
+        _ => args.screen.field.to_string(),
+    };
+    let flat = if gain.is_some() {
+        ", evened out for the panel's gain"
+    } else {
+        ""
+    };
     println!(
-        "wrote {} ({w} x {h}: {} on {})",
+        "wrote {} ({w} x {h}: {what} on {}{flat})",
         args.out.display(),
-        args.screen.field,
         arena.name
+    );
+    Ok(())
+}
+
+fn field_gain(args: FieldGainArgs) -> Result<()> {
+    let (arena, photo) = args.robot()?;
+    let grid = host::flat_field::measure(&arena, args.marks.marks, &photo, &args.logs)?;
+    let (least, most) = (
+        grid.min(),
+        grid.gains.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+    );
+    host::flat_field::write(
+        &args.out,
+        &grid,
+        &format!(
+            "brightness gain of {}'s panel at {} marks, measured by host field gain from {} logs",
+            arena.name,
+            args.marks.marks,
+            args.logs.len()
+        ),
+    )?;
+    println!(
+        "wrote {}: gains {least:.3} to {most:.3} of the mean at {} marks; `host display --gain {}` evens the panel out",
+        args.out.display(),
+        args.marks.marks,
+        args.out.display()
     );
     Ok(())
 }

@@ -1,5 +1,7 @@
 //! The panel image of a field on a screen arena as a PNG file
-//! (`host field export`) or bytes (`host display` serves them): the
+//! (`host field export`) or bytes (`host display` serves them), evened out
+//! for the panel's measured gain when one is given
+//! ([`sim::scenario::flat_field`]): the
 //! picture [`sim::scenario::panel::panel_image`] defines, one 8-bit grey pixel per
 //! panel pixel, with no colour profile or gamma chunk (a browser shows the
 //! levels as they are).
@@ -7,29 +9,40 @@
 use anyhow::{Context, Result};
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use image::{DynamicImage, GrayImage, ImageBuffer, Pixel, PixelWithColorType, RgbImage};
+use sim::base::gain_grid::GainGrid;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
 use std::path::Path;
 
 /// The panel image of `source` on `arena`, the field loaded as the
-/// arena shows it ([`ArenaSpec::load_field`]).
-pub fn panel_image(arena: &ArenaSpec, source: &FieldSource) -> Result<GrayImage> {
+/// arena shows it ([`ArenaSpec::load_field`]), evened out for the panel's
+/// measured gain `flat` if given.
+pub fn panel_image(
+    arena: &ArenaSpec,
+    source: &FieldSource,
+    flat: Option<&GainGrid>,
+) -> Result<GrayImage> {
     let field = arena.load_field(source)?;
-    Ok(sim::scenario::panel::panel_image(arena, &field))
+    Ok(sim::scenario::panel::panel_image(arena, &field, flat))
 }
 
 /// The panel image of `source` on `arena` in colour, with the outline of
 /// the field's target band ([`sim::scenario::field_thresholds`]) drawn
 /// over it in [`sim::render::BAND`]: a picture to look at, not to show the
 /// robots (they would read the outline as field).
-pub fn panel_image_with_band(arena: &ArenaSpec, source: &FieldSource) -> Result<RgbImage> {
+pub fn panel_image_with_band(
+    arena: &ArenaSpec,
+    source: &FieldSource,
+    flat: Option<&GainGrid>,
+) -> Result<RgbImage> {
     let field = arena.load_field(source)?;
     let (layout, thresholds) = (
         arena.field_layout(&field),
         sim::scenario::field_thresholds(source),
     );
     let mut image =
-        DynamicImage::ImageLuma8(sim::scenario::panel::panel_image(arena, &field)).into_rgb8();
+        DynamicImage::ImageLuma8(sim::scenario::panel::panel_image(arena, &field, flat))
+            .into_rgb8();
     sim::render::outline_region(&mut image, sim::render::BAND, |i, j| {
         let value = field.shown(arena.panel_pixel_centre(i, j), &layout);
         sim::episodes::eval::in_band(value, &thresholds)
@@ -51,21 +64,40 @@ where
     Ok(bytes)
 }
 
-/// Writes the panel image of `source` on `arena` to `out` (atomically),
-/// with the target band outlined if `band` ([`panel_image_with_band`]);
-/// returns its size in pixels.
+/// Which picture `host field export` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Picture {
+    /// The field, as the TV shows it.
+    Field,
+    /// The field with its target band outlined ([`panel_image_with_band`]).
+    Band,
+    /// Full white: the calibration's white screen.
+    White,
+}
+
+/// Writes `picture` of `source` on `arena`, evened out for the panel's
+/// measured gain `flat` if given, to `out` (atomically); returns its size
+/// in pixels.
 pub fn export(
     arena: &ArenaSpec,
     source: &FieldSource,
-    band: bool,
+    picture: Picture,
+    flat: Option<&GainGrid>,
     out: &Path,
 ) -> Result<(u32, u32)> {
-    let (png, size) = if band {
-        let image = panel_image_with_band(arena, source)?;
-        (encode_png(&image)?, image.dimensions())
-    } else {
-        let image = panel_image(arena, source)?;
-        (encode_png(&image)?, image.dimensions())
+    let (png, size) = match picture {
+        Picture::Band => {
+            let image = panel_image_with_band(arena, source, flat)?;
+            (encode_png(&image)?, image.dimensions())
+        }
+        Picture::Field => {
+            let image = panel_image(arena, source, flat)?;
+            (encode_png(&image)?, image.dimensions())
+        }
+        Picture::White => {
+            let image = sim::scenario::panel::white_image(arena, flat);
+            (encode_png(&image)?, image.dimensions())
+        }
     };
     crate::atomic::write(out, &png)?;
     Ok(size)
@@ -84,15 +116,21 @@ mod tests {
             ..ArenaSpec::tv75()
         };
         let source = FieldSource::Letter(sim::fields::letters::Letter::T);
-        assert_eq!(export(&arena, &source, false, &out).unwrap(), (96, 54));
+        assert_eq!(
+            export(&arena, &source, Picture::Field, None, &out).unwrap(),
+            (96, 54)
+        );
         let back = image::open(&out).unwrap();
         assert_eq!(back.color(), image::ColorType::L8);
         assert_eq!(
             back.into_luma8(),
-            sim::scenario::panel::panel_image(&arena, &arena.load_field(&source).unwrap())
+            sim::scenario::panel::panel_image(&arena, &arena.load_field(&source).unwrap(), None)
         );
         let missing = FieldSource::Image("/no/such/field.png".into());
-        let e = format!("{:#}", export(&arena, &missing, false, &out).unwrap_err());
+        let e = format!(
+            "{:#}",
+            export(&arena, &missing, Picture::Field, None, &out).unwrap_err()
+        );
         assert!(e.contains("/no/such/field.png"), "{e}");
     }
 
@@ -103,8 +141,8 @@ mod tests {
             ..ArenaSpec::tv75()
         };
         let source = FieldSource::Annulus;
-        let grey = panel_image(&arena, &source).unwrap();
-        let outlined = panel_image_with_band(&arena, &source).unwrap();
+        let grey = panel_image(&arena, &source, None).unwrap();
+        let outlined = panel_image_with_band(&arena, &source, None).unwrap();
         let field = arena.load_field(&source).unwrap();
         let layout = arena.field_layout(&field);
         let thresholds = sim::scenario::field_thresholds(&source);

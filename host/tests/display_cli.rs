@@ -3,7 +3,9 @@
 //! what it shows at panel size is the exported image pixel for pixel, the
 //! calibration sequence shows white, black and the field in that order for
 //! the hold each, timed by the browser's virtual time (no wall-clock
-//! sleeps), and the grey patches show their levels.
+//! sleeps), the grey patches show their levels, a measured gain evens out
+//! the white and the field as exported, and the marks leave the robot's
+//! sensors on white.
 
 #[path = "../../view/tests/browser/mod.rs"]
 mod browser;
@@ -289,6 +291,82 @@ fn grey_patches_show_their_levels_unchanged() {
         500,
     );
     assert!(uniform(&one, 77), "level 77 full-screen");
+}
+
+/// A measured gain (`host field gain`'s file): the top-left point 10 %
+/// dimmer than the rest.
+fn gain_file(dir: &Path) -> String {
+    let path = dir.join("gain.toml");
+    let mut gains = ["1.0"; 12];
+    gains[0] = "0.9";
+    let text = format!("columns = 4\nrows = 3\ngains = [{}]\n", gains.join(", "));
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+#[test]
+fn with_a_measured_gain_the_calibrations_white_and_the_field_are_evened_out_as_exported() {
+    let dir = tempfile::tempdir().unwrap();
+    let (arena, gain) = (&small_arena(dir.path()), &gain_file(dir.path()));
+    let white = export(dir.path(), &["--arena", arena, "--white", "--gain", gain]);
+    // dimmer wherever the panel is brighter than its dimmest point
+    assert_eq!(white.get_pixel(0, 0).0, [255; 3]);
+    assert!(white.get_pixel(639, 359).0[0] < 255);
+    let field = export(
+        dir.path(),
+        &["--arena", arena, "--field", "annulus", "--gain", gain],
+    );
+    let plain = export(dir.path(), &["--arena", arena, "--field", "annulus"]);
+    assert!(differences(&field, &plain).0 > 0);
+    let server = display(&[
+        "--arena", arena, "--field", "annulus", "--hold", "1.5", "--gain", gain,
+    ]);
+    let url = format!("{}?mode=calibrate", server.url);
+    assert_same(
+        &screenshot(&url, (640, 360), 700),
+        &white,
+        "white, evened out",
+    );
+    assert!(uniform(&screenshot(&url, (640, 360), 2200), 0), "black");
+    assert_same(
+        &screenshot(&url, (640, 360), 3800),
+        &field,
+        "the field, evened out",
+    );
+}
+
+#[test]
+fn the_marks_screen_is_white_where_the_robots_sensors_stand_with_a_cross_under_its_centre() {
+    let dir = tempfile::tempdir().unwrap();
+    // tv75's 1,650 x 928 mm on 640 x 360 pixels: 0.388 pixels per mm
+    let server = display(&["--arena", &small_arena(dir.path()), "--marks", "4x3"]);
+    let shot = screenshot(&format!("{}?mode=marks", server.url), (640, 360), 500);
+    let px_per_mm = 640.0 / 1650.0;
+    for k in 0..12 {
+        let (x, y) = ((k % 4) as f64 * 160.0 + 80.0, (k / 4) as f64 * 120.0 + 60.0);
+        let at = |dx_mm: f64, dy_mm: f64| {
+            shot.get_pixel(
+                (x + dx_mm * px_per_mm) as u32,
+                (y + dy_mm * px_per_mm) as u32,
+            )
+            .0
+        };
+        assert!(
+            at(0.0, 0.0)[0] < 200,
+            "mark {}: no cross at its centre",
+            k + 1
+        );
+        // the sensors of a robot facing the top: left and right 45
+        // degrees off its heading on its 65 mm back, mid 80 mm ahead
+        for (dx, dy) in [(-46.0, -46.0), (46.0, -46.0), (0.0, -80.0)] {
+            assert_eq!(
+                at(dx, dy),
+                [255; 3],
+                "mark {}: a sensor's place at ({dx}, {dy}) mm",
+                k + 1
+            );
+        }
+    }
 }
 
 /// One raw HTTP/1.0 request; the status code and body.

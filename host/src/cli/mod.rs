@@ -12,7 +12,7 @@ pub mod view;
 use clap::{Parser, Subcommand};
 use learn::{ExperimentArgs, SearchArgs, TrainArgs};
 use robot::{FlashArgs, MonitorArgs, ReplayArgs};
-use screen::{DisplayArgs, FieldExportArgs, ObserveArgs};
+use screen::{DisplayArgs, FieldExportArgs, FieldGainArgs, ObserveArgs};
 use simulate::{BenchArgs, RenderArgs, RunArgs};
 use std::path::PathBuf;
 use view::ViewArgs;
@@ -85,6 +85,10 @@ pub enum FieldCommand {
     /// Write the exact panel image the simulator's arena model assumes
     /// (one pixel per panel pixel, pre-compensated for the display's gamma).
     Export(FieldExportArgs),
+    /// Measure the panel's brightness gain from a robot's logs at the
+    /// display's marks, for evening out what it shows (docs/display.md,
+    /// "Flat-field correction").
+    Gain(FieldGainArgs),
 }
 
 #[derive(Subcommand)]

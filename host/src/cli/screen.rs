@@ -1,15 +1,22 @@
-//! The field on the TV: `host field export`, `host display` and `host
-//! observe`.
+//! The field on the TV: `host field export`, `host field gain`, `host
+//! display` and `host observe`.
 
 use super::scenario::train_config_args;
-use anyhow::Result;
+use anyhow::{bail, Result};
 use clap::error::ErrorKind;
 use clap::{ArgMatches, Args, FromArgMatches};
 use host::display::DisplaySettings;
+use host::flat_field::MarkGrid;
 use host::observe::ObserveSettings;
+use host::panel_file::Picture;
+use sim::base::gain_grid::GainGrid;
 use sim::base::ranges;
 use sim::fields::source::FieldSource;
+use sim::scenario::arena::ArenaSpec;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::sensor_choice::SensorChoice;
+use sim::scenario::sensor_setup::SensorSetup;
+use sim::sensors::photo::PhotoSensorConfig;
 use std::net::{IpAddr, SocketAddr};
 use std::path::PathBuf;
 
@@ -24,16 +31,33 @@ pub struct ScreenArgs {
     pub field: FieldSource,
 }
 
+/// A training config's flags `ids` with these defaults.
+fn with_defaults(command: clap::Command, defaults: &[(&str, &'static str)]) -> clap::Command {
+    let ids: Vec<&str> = defaults.iter().map(|(id, _)| *id).collect();
+    command.args(train_config_args(&ids).into_iter().map(|a| {
+        let default = defaults
+            .iter()
+            .find(|(id, _)| a.get_id() == *id)
+            .map_or("", |(_, d)| *d);
+        a.default_value(default)
+    }))
+}
+
+/// The value of flag `id`, which has a default.
+fn value<T: Clone + Send + Sync + 'static>(m: &ArgMatches, id: &str) -> Result<T, clap::Error> {
+    m.get_one::<T>(id).cloned().ok_or_else(|| {
+        clap::Error::raw(
+            ErrorKind::MissingRequiredArgument,
+            format!("--{id} is missing"),
+        )
+    })
+}
+
+const SCREEN_DEFAULTS: [(&str, &str); 2] = [("arena", "tv75"), ("field", "annulus")];
+
 impl Args for ScreenArgs {
     fn augment_args(command: clap::Command) -> clap::Command {
-        command.args(train_config_args(&["arena", "field"]).into_iter().map(|a| {
-            let default = if a.get_id() == "arena" {
-                "tv75"
-            } else {
-                "annulus"
-            };
-            a.default_value(default)
-        }))
+        with_defaults(command, &SCREEN_DEFAULTS)
     }
 
     fn augment_args_for_update(command: clap::Command) -> clap::Command {
@@ -43,27 +67,110 @@ impl Args for ScreenArgs {
 
 impl FromArgMatches for ScreenArgs {
     fn from_arg_matches(matches: &ArgMatches) -> Result<ScreenArgs, clap::Error> {
-        let missing = |id| {
-            clap::Error::raw(
-                ErrorKind::MissingRequiredArgument,
-                format!("--{id} is missing"),
-            )
-        };
         Ok(ScreenArgs {
-            arena: matches
-                .get_one::<ArenaChoice>("arena")
-                .cloned()
-                .ok_or_else(|| missing("arena"))?,
-            field: matches
-                .get_one::<FieldSource>("field")
-                .cloned()
-                .ok_or_else(|| missing("field"))?,
+            arena: value(matches, "arena")?,
+            field: value(matches, "field")?,
         })
     }
 
     fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
         *self = ScreenArgs::from_arg_matches(matches)?;
         Ok(())
+    }
+}
+
+/// The robot on the screen whose panel `host field gain` measures: a
+/// training config's `--arena` (`tv75` by default) and `--sensors` (a
+/// robot model; `robot` by default).
+#[derive(Clone, Debug)]
+pub struct RobotOnScreenArgs {
+    /// The screen arena.
+    pub arena: ArenaChoice,
+    /// The robot's sensors.
+    pub sensors: SensorChoice,
+}
+
+const ROBOT_ON_SCREEN_DEFAULTS: [(&str, &str); 2] = [("arena", "tv75"), ("sensors", "robot")];
+
+impl Args for RobotOnScreenArgs {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        with_defaults(command, &ROBOT_ON_SCREEN_DEFAULTS)
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        RobotOnScreenArgs::augment_args(command)
+    }
+}
+
+impl FromArgMatches for RobotOnScreenArgs {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<RobotOnScreenArgs, clap::Error> {
+        Ok(RobotOnScreenArgs {
+            arena: value(matches, "arena")?,
+            sensors: value(matches, "sensors")?,
+        })
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        *self = RobotOnScreenArgs::from_arg_matches(matches)?;
+        Ok(())
+    }
+}
+
+/// The panel's measured gain (`host field gain`'s file), for the tools
+/// that show the field.
+#[derive(Args)]
+pub struct GainArgs {
+    /// Even out what the panel shows by its measured brightness gain, a
+    /// file `host field gain` wrote (docs/display.md, "Flat-field
+    /// correction").
+    #[arg(long, value_name = "FILE")]
+    pub gain: Option<PathBuf>,
+}
+
+impl GainArgs {
+    /// The gain read, if given.
+    pub fn read(&self) -> Result<Option<GainGrid>> {
+        self.gain.as_deref().map(host::flat_field::read).transpose()
+    }
+}
+
+/// The grid of marks the panel's gain is measured at.
+#[derive(Args)]
+pub struct MarksArgs {
+    /// Marks across and down, COLUMNSxROWS, at the centres of equal tiles
+    /// of the screen.
+    #[arg(long, default_value = "4x3")]
+    pub marks: MarkGrid,
+}
+
+/// `host field gain`'s options.
+#[derive(Args)]
+pub struct FieldGainArgs {
+    #[command(flatten)]
+    pub robot: RobotOnScreenArgs,
+    #[command(flatten)]
+    pub marks: MarksArgs,
+    /// One log per mark, row by row from the top-left (mark 1 first): the
+    /// robot standing in the mark on `host display`'s marks screen,
+    /// recorded with `host monitor --log`.
+    #[arg(required = true, value_name = "LOG")]
+    pub logs: Vec<PathBuf>,
+    /// Gain file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+impl FieldGainArgs {
+    /// The arena and the robot's field sensors.
+    pub fn robot(&self) -> Result<(ArenaSpec, PhotoSensorConfig)> {
+        let arena = self.robot.arena.screen()?;
+        match self.robot.sensors.setup()? {
+            SensorSetup::Robot(config) => Ok((arena, config.field)),
+            _ => bail!(
+                "--sensors {}: the gain is measured with a robot's field sensors (robot or robot:FILE)",
+                self.robot.sensors
+            ),
+        }
     }
 }
 
@@ -76,9 +183,26 @@ pub struct FieldExportArgs {
     /// for the TV (the robots would read the outline as field).
     #[arg(long)]
     pub band: bool,
+    /// Full white instead of the field: the calibration's white screen
+    /// (evened out by --gain), for showing the field from a file.
+    #[arg(long, conflicts_with = "band")]
+    pub white: bool,
+    #[command(flatten)]
+    pub gain: GainArgs,
     /// PNG file to write.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+impl FieldExportArgs {
+    /// Which picture to write.
+    pub fn picture(&self) -> Picture {
+        match (self.band, self.white) {
+            (true, _) => Picture::Band,
+            (_, true) => Picture::White,
+            _ => Picture::Field,
+        }
+    }
 }
 
 /// `host display`'s options.
@@ -96,6 +220,10 @@ pub struct DisplayArgs {
     /// Seconds the calibration sequence holds white, then black.
     #[arg(long, default_value_t = 3.0)]
     pub hold: f64,
+    #[command(flatten)]
+    pub gain: GainArgs,
+    #[command(flatten)]
+    pub marks: MarksArgs,
 }
 
 /// `--bind`: an address with or without a port.
@@ -133,9 +261,11 @@ impl DisplayArgs {
         let hold_ms = (self.hold * 1000.0).round() as u32;
         Ok(DisplaySettings {
             arena: self.screen.arena.screen()?,
+            gain: self.gain.read()?,
             field: self.screen.field,
             bind,
             hold_ms,
+            marks: self.marks.marks,
         })
     }
 }

@@ -1,5 +1,5 @@
 //! What every room uses: plane vectors, our own `sin_cos`, floor and
-//! rounding without libm, bit sets, the seeded generator, the
+//! rounding without libm, bit sets, a smooth gain over a rectangle, the seeded generator, the
 //! counter-based draws of the noise models, [`crate::text_form!`], the one
 //! way a named choice (a field, a sensor model, an arena, a reward, a
 //! hasher) reads from and writes to config files, and [`ranges`], the
@@ -7,6 +7,7 @@
 //! Depends on nothing else in the crate.
 
 pub mod bitset;
+pub mod gain_grid;
 pub mod noise;
 pub mod ranges;
 pub mod rng;

@@ -7,6 +7,7 @@
 pub mod arena;
 pub mod arena_choice;
 pub mod choices;
+pub mod flat_field;
 pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;

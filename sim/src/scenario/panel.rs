@@ -14,8 +14,11 @@
 //! assumes (`field.gamma`, 2.2 by default). With a display gamma equal to
 //! `LIGHT_GAMMA` the level is `round(255 v)`.
 
+use crate::base::gain_grid::GainGrid;
+use crate::base::vec2::Vec2;
 use crate::fields::ScalarField;
 use crate::scenario::arena::ArenaSpec;
+use crate::scenario::flat_field;
 use image::{GrayImage, Luma};
 use shared::calibration::LIGHT_GAMMA;
 
@@ -46,15 +49,28 @@ fn level_of(v: f64, exponent: f64) -> u8 {
 }
 
 /// The panel image of `field` on `arena`: `screen_px` pixels, each the
-/// `panel_level` of the field value at its centre.
-pub fn panel_image(arena: &ArenaSpec, field: &ScalarField) -> GrayImage {
+/// `panel_level` of the field value at its centre; with the panel's
+/// measured gain `flat`, the value times its [`flat_field::value_scale`]
+/// (an evenly lit panel).
+pub fn panel_image(arena: &ArenaSpec, field: &ScalarField, flat: Option<&GainGrid>) -> GrayImage {
     let layout = arena.field_layout(field);
+    image_of(arena, flat, |p| field.shown(p, &layout))
+}
+
+/// Full white on `arena`, evened out for the panel's measured gain `flat`
+/// if given: the white screen of the robots' calibration, which must be
+/// the field's white.
+pub fn white_image(arena: &ArenaSpec, flat: Option<&GainGrid>) -> GrayImage {
+    image_of(arena, flat, |_| 1.0)
+}
+
+fn image_of(arena: &ArenaSpec, flat: Option<&GainGrid>, value: impl Fn(Vec2) -> f64) -> GrayImage {
     let exponent = level_exponent(arena.display_gamma);
+    let size = arena.size();
     GrayImage::from_fn(arena.screen_px[0], arena.screen_px[1], |i, j| {
-        Luma([level_of(
-            field.shown(arena.panel_pixel_centre(i, j), &layout),
-            exponent,
-        )])
+        let p = arena.panel_pixel_centre(i, j);
+        let scale = flat.map_or(1.0, |grid| flat_field::value_scale(grid, p, size));
+        Luma([level_of(value(p) * scale, exponent)])
     })
 }
 
@@ -96,7 +112,7 @@ mod tests {
             ..ArenaSpec::tv75()
         };
         let field = ScalarField::new(2, 2, vec![0.0, 1.0, 0.5, 1.0]).unwrap();
-        let image = panel_image(&arena, &field);
+        let image = panel_image(&arena, &field, None);
         assert_eq!(image.dimensions(), (8, 4));
         let row = |j| (0..8).map(|i| image.get_pixel(i, j)[0]).collect::<Vec<_>>();
         // Row 0 lies on the field's top row (edge pixels extend to the border).
@@ -107,8 +123,40 @@ mod tests {
             fit: FieldFit::Stretch,
             ..arena
         };
-        let image = panel_image(&stretched, &field);
+        let image = panel_image(&stretched, &field, None);
         assert_eq!(image.get_pixel(0, 0)[0], 0);
         assert_eq!(image.get_pixel(7, 0)[0], 255);
+    }
+
+    #[test]
+    fn a_measured_gain_dims_each_pixel_to_the_dimmest_points_light_and_white_alike() {
+        // 8 x 6 pixels, gain 0.9 at the top-left point, 1 elsewhere: where
+        // the panel is brighter, the level shows less, so the light
+        // (p / 255)^2.2 times the gain is the dimmest point's
+        let arena = ArenaSpec {
+            screen_mm: [80.0, 60.0],
+            screen_px: [8, 6],
+            fit: FieldFit::Stretch,
+            ..ArenaSpec::tv75()
+        };
+        let mut gain = GainGrid::uniform(4, 3, 1.0);
+        gain.gains[0] = 0.9;
+        let white = white_image(&arena, Some(&gain));
+        assert_eq!(white.get_pixel(0, 0)[0], 255);
+        let far = f64::from(white.get_pixel(7, 5)[0]);
+        assert_eq!(far, (255.0 * 0.9f64.powf(1.0 / 2.2)).round());
+        assert!(white_image(&arena, None).pixels().all(|p| p[0] == 255));
+        let field = ScalarField::new(2, 2, vec![0.5; 4]).unwrap();
+        let grey = panel_image(&arena, &field, Some(&gain));
+        let size = arena.size();
+        for (i, j, level) in grey.enumerate_pixels() {
+            let g = gain.at(arena.panel_pixel_centre(i, j), size);
+            let light = (f64::from(level[0]) / 255.0).powf(2.2) * g;
+            // within a level's rounding of half grey's light on the dimmest point
+            assert!(
+                (light / (0.5f64.powf(2.2) * 0.9) - 1.0).abs() < 0.02,
+                "{i},{j}"
+            );
+        }
     }
 }

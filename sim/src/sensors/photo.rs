@@ -27,6 +27,7 @@
 //! Steps 4 and 5 are the firmware's, so the simulator and the robot hash
 //! identical inputs identically.
 
+use crate::base::gain_grid::GainGrid;
 use crate::base::ranges;
 use crate::base::rng::SimRng;
 use crate::base::rounding;
@@ -83,7 +84,7 @@ pub(crate) struct PhotoNoise<'a> {
     /// The noise's settings.
     pub noise: &'a RobotNoise,
     /// The brightness gains ([`RobotNoise::brightness_grid`]).
-    pub grid: &'a [f64],
+    pub grid: &'a GainGrid,
     /// The arena's size, over which the gains lie.
     pub arena: Vec2,
     /// The generator of this reading's jitter.
@@ -325,8 +326,8 @@ impl PhotoSensors {
             r.discharge_us[i] = match noise.as_mut() {
                 None => self.response[i].discharge_us(shown[i], self.gamma),
                 Some(n) => {
-                    let light = shown[i].clamp(0.0, 1.0).powf(self.gamma)
-                        * RobotNoise::gain_at(n.grid, point, n.arena);
+                    let light =
+                        shown[i].clamp(0.0, 1.0).powf(self.gamma) * n.grid.at(point, n.arena);
                     n.noise
                         .jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
                 }

@@ -24,6 +24,7 @@
 //! the firmware binary. The whole model is configured by a
 //! [`RobotSensorConfig`] (JSON, every field optional; `docs/robot-sensors.md`).
 
+use crate::base::gain_grid::GainGrid;
 use crate::base::noise::{self, Purpose};
 use crate::base::vec2::Vec2;
 use crate::config::validate::ConfigError;
@@ -98,7 +99,7 @@ pub struct RobotSensors {
     latency_frames: u8,
     noise: RobotNoise,
     /// The screen's brightness gains and the (seed, episode) they are of.
-    brightness: Option<(u64, u64, Vec<f64>)>,
+    brightness: Option<(u64, u64, GainGrid)>,
     /// Each robot's camera link.
     links: Vec<CameraMemory>,
     /// Each robot's observation of the last sensing.
@@ -206,15 +207,17 @@ impl RobotSensors {
 /// The screen's brightness gains of an episode, from `cache` if it holds
 /// that episode's (computed once per episode).
 fn brightness_grid<'a>(
-    cache: &'a mut Option<(u64, u64, Vec<f64>)>,
+    cache: &'a mut Option<(u64, u64, GainGrid)>,
     noise: &RobotNoise,
     seed: u64,
     episode: u64,
-) -> &'a [f64] {
+) -> &'a GainGrid {
     if !matches!(cache, Some((s, e, _)) if *s == seed && *e == episode) {
-        *cache = Some((seed, episode, noise.brightness_grid(seed, episode)));
+        *cache = None;
     }
-    cache.as_ref().map_or(&[][..], |(_, _, grid)| &grid[..])
+    &cache
+        .get_or_insert_with(|| (seed, episode, noise.brightness_grid(seed, episode)))
+        .2
 }
 
 impl SensorModel for RobotSensors {

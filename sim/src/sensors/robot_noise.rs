@@ -6,11 +6,11 @@
 //! [`crate::base::noise`], a function of the world's seed, the episode or step
 //! and the robot.
 
+use crate::base::gain_grid::GainGrid;
 use crate::base::noise::{self, Purpose};
 use crate::base::ranges;
 use crate::base::rng::SimRng;
 use crate::base::rounding::round_half_away;
-use crate::base::vec2::Vec2;
 use crate::config::validate::ConfigError;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
@@ -27,7 +27,7 @@ pub struct RobotNoise {
     pub rc_jitter: f64,
     /// Standard deviation of the screen's brightness, relative to its
     /// mean, at the 4 x 3 points of a smooth gain drawn per episode
-    /// (bilinear between them): an unevenly lit panel.
+    /// (bilinear between them, [`GainGrid`]): an unevenly lit panel.
     pub brightness: f64,
     /// Standard deviation of each block's centre and size, pixels.
     pub block_jitter_px: f64,
@@ -101,34 +101,21 @@ impl RobotNoise {
         Ok(())
     }
 
-    /// The screen's brightness gains of an episode: `BRIGHTNESS_GRID`
-    /// points, row by row.
-    pub(crate) fn brightness_grid(&self, seed: u64, episode: u64) -> Vec<f64> {
-        let (cols, rows) = BRIGHTNESS_GRID;
+    /// The screen's brightness gains of an episode at `BRIGHTNESS_GRID`
+    /// points.
+    pub(crate) fn brightness_grid(&self, seed: u64, episode: u64) -> GainGrid {
+        let (columns, rows) = BRIGHTNESS_GRID;
         if self.brightness == 0.0 {
-            return vec![1.0; cols * rows];
+            return GainGrid::uniform(columns, rows, 1.0);
         }
         let mut rng = noise::stream(seed, Purpose::Brightness, episode, 0);
-        (0..cols * rows)
-            .map(|_| 1.0 + self.brightness * noise::normal(&mut rng))
-            .collect()
-    }
-
-    /// The gain at `p` of an arena of `size`: bilinear between the grid's
-    /// points, which sit at the centres of `cols x rows` equal tiles.
-    pub(crate) fn gain_at(grid: &[f64], p: Vec2, size: Vec2) -> f64 {
-        let (cols, rows) = BRIGHTNESS_GRID;
-        let split = |t: f64, n: usize| {
-            let t = (t * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-            let i = (t as usize).min(n - 2);
-            (i, t - i as f64)
-        };
-        let (i, tx) = split(p.x / size.x, cols);
-        let (j, ty) = split(p.y / size.y, rows);
-        let at = |i: usize, j: usize| grid[j * cols + i];
-        let top = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
-        let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
-        top + (bottom - top) * ty
+        GainGrid {
+            columns,
+            rows,
+            gains: (0..columns * rows)
+                .map(|_| 1.0 + self.brightness * noise::normal(&mut rng))
+                .collect(),
+        }
     }
 
     /// A discharge time with its jitter.
@@ -209,25 +196,17 @@ mod tests {
         let mut frame = blocks.clone();
         n.perturb_frame(&mut frame, 1, 2, &mut rng);
         assert_eq!(frame, blocks);
-        assert!(n.brightness_grid(1, 3).iter().all(|g| *g == 1.0));
+        assert!(n.brightness_grid(1, 3).gains.iter().all(|g| *g == 1.0));
     }
 
     #[test]
-    fn the_brightness_gain_is_smooth_between_its_points_and_drawn_per_episode() {
+    fn the_brightness_gain_is_drawn_per_episode_at_its_grid_points() {
         let n = RobotNoise::randomised();
         let grid = n.brightness_grid(4, 0);
         assert_ne!(grid, n.brightness_grid(4, 1));
         assert_eq!(grid, n.brightness_grid(4, 0));
-        let size = Vec2::new(400.0, 300.0);
-        // At a tile's centre the gain is its point's; between, in between.
-        assert!((RobotNoise::gain_at(&grid, Vec2::new(50.0, 50.0), size) - grid[0]).abs() < 1e-12);
-        let mid = RobotNoise::gain_at(&grid, Vec2::new(100.0, 50.0), size);
-        assert!((mid - (grid[0] + grid[1]) / 2.0).abs() < 1e-12);
-        // Past the outermost centres the edge values hold.
-        assert_eq!(
-            RobotNoise::gain_at(&grid, Vec2::new(0.0, 0.0), size),
-            grid[0]
-        );
+        assert_eq!((grid.columns, grid.rows), BRIGHTNESS_GRID);
+        assert_eq!(grid.validate(), Ok(()));
     }
 
     #[test]

@@ -1,0 +1,198 @@
+//! A smooth gain over a rectangle: values at the centres of `columns x
+//! rows` equal tiles, bilinear between them, the edge values held beyond
+//! the outermost centres. The screen's brightness in the robot sensors'
+//! noise model is one, drawn per episode; a panel's measured brightness
+//! (`host field gain`, [`crate::scenario::flat_field`]) is another.
+//!
+//! File form (TOML), the points row by row from the rectangle's origin
+//! (a panel's top-left):
+//!
+//! ```toml
+//! columns = 4
+//! rows = 3
+//! gains = [1.02, 0.98, 1.01, 0.97, 1.0, 1.03, 0.99, 1.0, 1.01, 0.98, 1.0, 1.01]
+//! ```
+
+use crate::base::vec2::Vec2;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Fewest points along a side (bilinear needs two).
+pub const MIN_SIDE: usize = 2;
+/// Most points along a side.
+pub const MAX_SIDE: usize = 32;
+
+/// Gains at the centres of `columns x rows` equal tiles, row by row.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GainGrid {
+    /// Tiles across.
+    pub columns: usize,
+    /// Tiles down.
+    pub rows: usize,
+    /// The gain at each tile's centre, row by row.
+    pub gains: Vec<f64>,
+}
+
+/// Why a gain grid is not usable.
+#[derive(Clone, Debug, PartialEq)]
+pub enum GainGridError {
+    /// A side outside [`MIN_SIDE`, `MAX_SIDE`].
+    Side {
+        /// "columns" or "rows".
+        side: &'static str,
+        /// The value given.
+        value: usize,
+    },
+    /// Not `columns x rows` gains.
+    Count {
+        /// `columns x rows`.
+        expected: usize,
+        /// The number given.
+        found: usize,
+    },
+    /// A gain that is not a positive finite number.
+    Gain {
+        /// Its index, row by row.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
+impl fmt::Display for GainGridError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            GainGridError::Side { side, value } => {
+                write!(f, "{side} = {value} is outside [{MIN_SIDE}, {MAX_SIDE}]")
+            }
+            GainGridError::Count { expected, found } => write!(
+                f,
+                "{found} gains given, expected columns x rows = {expected}"
+            ),
+            GainGridError::Gain { index, value } => write!(
+                f,
+                "gain {} (row by row from 1) is {value}: expected a positive number",
+                index + 1
+            ),
+        }
+    }
+}
+
+impl core::error::Error for GainGridError {}
+
+impl GainGrid {
+    /// The same gain `value` everywhere.
+    pub fn uniform(columns: usize, rows: usize, value: f64) -> GainGrid {
+        GainGrid {
+            columns,
+            rows,
+            gains: vec![value; columns * rows],
+        }
+    }
+
+    /// Checks the sides, the count and every gain.
+    pub fn validate(&self) -> Result<(), GainGridError> {
+        for (side, value) in [("columns", self.columns), ("rows", self.rows)] {
+            if !(MIN_SIDE..=MAX_SIDE).contains(&value) {
+                return Err(GainGridError::Side { side, value });
+            }
+        }
+        let expected = self.columns * self.rows;
+        if self.gains.len() != expected {
+            return Err(GainGridError::Count {
+                expected,
+                found: self.gains.len(),
+            });
+        }
+        match self.gains.iter().position(|g| !(g.is_finite() && *g > 0.0)) {
+            Some(index) => Err(GainGridError::Gain {
+                index,
+                value: self.gains[index],
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Point `k` (row by row) of a rectangle of `size`: its tile's centre.
+    pub fn point(&self, k: usize, size: Vec2) -> Vec2 {
+        let (i, j) = (k % self.columns, k / self.columns);
+        Vec2::new(
+            (i as f64 + 0.5) * size.x / self.columns as f64,
+            (j as f64 + 0.5) * size.y / self.rows as f64,
+        )
+    }
+
+    /// The least gain (bilinear values lie between their points').
+    pub fn min(&self) -> f64 {
+        self.gains.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The gain at `p` of a rectangle of `size`.
+    pub fn at(&self, p: Vec2, size: Vec2) -> f64 {
+        let split = |t: f64, n: usize| {
+            let t = (t * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+            let i = (t as usize).min(n - 2);
+            (i, t - i as f64)
+        };
+        let cols = self.columns;
+        let (i, tx) = split(p.x / size.x, cols);
+        let (j, ty) = split(p.y / size.y, self.rows);
+        let at = |i: usize, j: usize| self.gains[j * cols + i];
+        let top = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
+        let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
+        top + (bottom - top) * ty
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid() -> GainGrid {
+        GainGrid {
+            columns: 4,
+            rows: 3,
+            gains: (0..12).map(|k| 1.0 + 0.01 * k as f64).collect(),
+        }
+    }
+
+    #[test]
+    fn the_gain_is_its_points_at_the_tile_centres_and_bilinear_between() {
+        let (g, size) = (grid(), Vec2::new(400.0, 300.0));
+        for k in 0..12 {
+            assert!((g.at(g.point(k, size), size) - g.gains[k]).abs() < 1e-12);
+        }
+        let mid = g.at(Vec2::new(100.0, 50.0), size);
+        assert!((mid - (g.gains[0] + g.gains[1]) / 2.0).abs() < 1e-12);
+        // past the outermost centres the edge values hold
+        assert_eq!(g.at(Vec2::new(0.0, 0.0), size), g.gains[0]);
+        assert_eq!(g.at(size, size), g.gains[11]);
+        assert_eq!(g.min(), 1.0);
+    }
+
+    #[test]
+    fn a_grid_of_the_wrong_size_or_with_a_gain_that_is_not_positive_is_refused() {
+        assert_eq!(grid().validate(), Ok(()));
+        let short = GainGrid {
+            gains: vec![1.0; 11],
+            ..grid()
+        };
+        assert!(short
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("11 gains"));
+        let one_row = GainGrid::uniform(4, 1, 1.0);
+        assert!(one_row
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("rows = 1"));
+        let mut dark = grid();
+        dark.gains[5] = 0.0;
+        assert!(dark.validate().unwrap_err().to_string().contains("gain 6"));
+        dark.gains[5] = f64::NAN;
+        assert!(dark.validate().is_err());
+    }
+}
