@@ -4,7 +4,7 @@
 //! that `host display --gain` and `host field export --gain` read
 //! (`docs/display.md`, "Flat-field correction").
 //!
-//! A mark's log is a recording (`host monitor --log`) or a raw capture of
+//! A mark's log is a recording (`host monitor --out`) or a raw capture of
 //! the robot standing in the mark on full white: its idle frames' raw
 //! times are averaged per sensor ([`flat_field::mean_ticks`]); the dark
 //! times come from the calibration the frames carry (every

@@ -152,7 +152,7 @@ pub struct FieldGainArgs {
     pub marks: MarksArgs,
     /// One log per mark, row by row from the top-left (mark 1 first): the
     /// robot standing in the mark on `host display`'s marks screen,
-    /// recorded with `host monitor --log`.
+    /// recorded with `host monitor --out`.
     #[arg(required = true, value_name = "LOG")]
     pub logs: Vec<PathBuf>,
     /// Gain file to write.

@@ -101,8 +101,7 @@ pub struct ArenaSpec {
     /// The share of the panel's brightness unevenness (the robot senses'
     /// `noise.brightness`) the robots see: 1 for a panel as it comes, less
     /// for one whose shown image is divided by its measured gain (a
-    /// flat-field correction, `docs/robot-sensors.md`, "Which noise costs
-    /// the T").
+    /// flat-field correction, `docs/display.md`).
     pub brightness_unevenness: f64,
     /// Robot radius, mm: the Zumo in its skirt (a wedge's round back).
     pub robot_radius_mm: f64,
