@@ -178,5 +178,8 @@ fn missing_marks_an_uncalibrated_robot_and_a_bad_gain_file_are_refused_naming_th
         "--marks".as_ref(),
         "4x1".as_ref(),
     ]);
-    assert!(e.contains("rows = 1 is outside [2, 32]"), "{e}");
+    assert!(
+        e.contains("gain.rows = 1: outside its plausible range [2, 32]"),
+        "{e}"
+    );
 }

@@ -13,14 +13,10 @@
 //! gains = [1.02, 0.98, 1.01, 0.97, 1.0, 1.03, 0.99, 1.0, 1.01, 0.98, 1.0, 1.01]
 //! ```
 
+use crate::base::ranges::{self, RangeError};
 use crate::base::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use std::fmt;
-
-/// Fewest points along a side (bilinear needs two).
-pub const MIN_SIDE: usize = 2;
-/// Most points along a side.
-pub const MAX_SIDE: usize = 32;
 
 /// Gains at the centres of `columns x rows` equal tiles, row by row.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -37,13 +33,9 @@ pub struct GainGrid {
 /// Why a gain grid is not usable.
 #[derive(Clone, Debug, PartialEq)]
 pub enum GainGridError {
-    /// A side outside [`MIN_SIDE`, `MAX_SIDE`].
-    Side {
-        /// "columns" or "rows".
-        side: &'static str,
-        /// The value given.
-        value: usize,
-    },
+    /// A side or a gain outside its range ([`ranges::GAIN_GRID_SIDE`],
+    /// [`ranges::PANEL_GAIN`]).
+    Range(RangeError),
     /// Not `columns x rows` gains.
     Count {
         /// `columns x rows`.
@@ -51,29 +43,15 @@ pub enum GainGridError {
         /// The number given.
         found: usize,
     },
-    /// A gain that is not a positive finite number.
-    Gain {
-        /// Its index, row by row.
-        index: usize,
-        /// The value.
-        value: f64,
-    },
 }
 
 impl fmt::Display for GainGridError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            GainGridError::Side { side, value } => {
-                write!(f, "{side} = {value} is outside [{MIN_SIDE}, {MAX_SIDE}]")
-            }
+            GainGridError::Range(e) => e.fmt(f),
             GainGridError::Count { expected, found } => write!(
                 f,
                 "{found} gains given, expected columns x rows = {expected}"
-            ),
-            GainGridError::Gain { index, value } => write!(
-                f,
-                "gain {} (row by row from 1) is {value}: expected a positive number",
-                index + 1
             ),
         }
     }
@@ -91,12 +69,13 @@ impl GainGrid {
         }
     }
 
-    /// Checks the sides, the count and every gain.
+    /// Checks the sides, the count and every gain (the error names the
+    /// gain by its place, row by row from 1).
     pub fn validate(&self) -> Result<(), GainGridError> {
-        for (side, value) in [("columns", self.columns), ("rows", self.rows)] {
-            if !(MIN_SIDE..=MAX_SIDE).contains(&value) {
-                return Err(GainGridError::Side { side, value });
-            }
+        for (key, side) in [("gain.columns", self.columns), ("gain.rows", self.rows)] {
+            ranges::GAIN_GRID_SIDE
+                .check_count(key, side as u64)
+                .map_err(GainGridError::Range)?;
         }
         let expected = self.columns * self.rows;
         if self.gains.len() != expected {
@@ -105,13 +84,12 @@ impl GainGrid {
                 found: self.gains.len(),
             });
         }
-        match self.gains.iter().position(|g| !(g.is_finite() && *g > 0.0)) {
-            Some(index) => Err(GainGridError::Gain {
-                index,
-                value: self.gains[index],
-            }),
-            None => Ok(()),
+        for (k, gain) in self.gains.iter().enumerate() {
+            ranges::PANEL_GAIN
+                .check_as(&format!("gain.gains[{}]", k + 1), *gain)
+                .map_err(GainGridError::Range)?;
         }
+        Ok(())
     }
 
     /// Point `k` (row by row) of a rectangle of `size`: its tile's centre.
@@ -191,7 +169,8 @@ mod tests {
             .contains("rows = 1"));
         let mut dark = grid();
         dark.gains[5] = 0.0;
-        assert!(dark.validate().unwrap_err().to_string().contains("gain 6"));
+        let e = dark.validate().unwrap_err().to_string();
+        assert!(e.starts_with("gain.gains[6] = 0: outside"), "{e}");
         dark.gains[5] = f64::NAN;
         assert!(dark.validate().is_err());
     }

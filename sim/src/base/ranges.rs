@@ -665,6 +665,26 @@ pub const UNEVENNESS: Range = Range::closed(
     "1 for a panel as it comes; a flat-field correction (the shown image divided by the panel's measured gain) leaves less, never more",
 );
 
+/// Points across and down of a panel's measured gain (`host field gain`'s
+/// marks).
+pub const GAIN_GRID_SIDE: Range = Range::closed(
+    &["gain.columns", "gain.rows"],
+    2.0,
+    32.0,
+    "",
+    "bilinear needs two points a side; 32 x 32 marks is more than anyone measures by hand",
+);
+
+/// A panel's measured gain at a point, relative to the mean.
+pub const PANEL_GAIN: Range = Range::closed(
+    &["gain.gains"],
+    0.0,
+    10.0,
+    "",
+    "a panel's points differ by tens of per cent; a gain of 0 would show nothing",
+)
+.above_min();
+
 /// Seconds the calibration sequence holds white and black.
 pub const HOLD_S: Range = Range::closed(
     &["--hold"],
@@ -836,6 +856,8 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &BODY_RADIUS_MM,
             &GAMMA,
             &UNEVENNESS,
+            &GAIN_GRID_SIDE,
+            &PANEL_GAIN,
             &HOLD_S,
             &FIELD_IMAGE_SIDE,
             &PHOTO_SIDE,
