@@ -99,12 +99,7 @@ fn mark_readings(path: &Path, mark: usize) -> Result<([f64; 3], Vec<FieldCalibra
     let mut ticks = [vec![], vec![], vec![]];
     let mut calibrations = vec![];
     for entry in &recording.entries {
-        let Some(frame) = entry
-            .frame
-            .as_ref()
-            .ok()
-            .and_then(|b| LogFrame::decode(b).ok())
-        else {
+        let Some(frame) = entry.log_frame() else {
             continue;
         };
         if frame.faults.contains(Faults::NO_CALIBRATION) {

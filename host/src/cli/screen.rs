@@ -31,7 +31,8 @@ pub struct ScreenArgs {
     pub field: FieldSource,
 }
 
-/// A training config's flags `ids` with these defaults.
+/// A training config's flags `ids` with these defaults (the help's own
+/// "[default: ...]", the training config's, dropped).
 fn with_defaults(command: clap::Command, defaults: &[(&str, &'static str)]) -> clap::Command {
     let ids: Vec<&str> = defaults.iter().map(|(id, _)| *id).collect();
     command.args(train_config_args(&ids).into_iter().map(|a| {
@@ -39,7 +40,13 @@ fn with_defaults(command: clap::Command, defaults: &[(&str, &'static str)]) -> c
             .iter()
             .find(|(id, _)| a.get_id() == *id)
             .map_or("", |(_, d)| *d);
-        a.default_value(default)
+        let help = a.get_help().map(|h| h.to_string()).unwrap_or_default();
+        let help = help
+            .split(" [default:")
+            .next()
+            .unwrap_or_default()
+            .to_string();
+        a.default_value(default).help(help)
     }))
 }
 

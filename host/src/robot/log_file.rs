@@ -20,6 +20,7 @@
 use super::frame_splitter::{Chunk, ChunkEnd, FrameSplitter, MAX_CHUNK};
 use anyhow::{bail, Context, Result};
 use crc::{Crc, CRC_16_IBM_3740};
+use shared::LogFrame;
 use sim::base::ranges;
 use std::fmt;
 use std::fs::{File, OpenOptions};
@@ -231,6 +232,13 @@ pub struct Entry {
     pub host_time_us: Option<u64>,
     /// The robot frame's bytes as received, or why the record was skipped.
     pub frame: Result<Vec<u8>, RecordError>,
+}
+
+impl Entry {
+    /// The robot's frame, if the record is whole and its frame decodes.
+    pub fn log_frame(&self) -> Option<LogFrame> {
+        LogFrame::decode(self.frame.as_ref().ok()?).ok()
+    }
 }
 
 /// A whole file, split into entries.

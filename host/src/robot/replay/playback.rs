@@ -14,7 +14,7 @@ use super::report::FrameCheck;
 use crate::robot::log_file::Recording;
 use serde::Serialize;
 use shared::camera::{ImageRegion, IMAGE_HEIGHT, IMAGE_WIDTH};
-use shared::{CameraConfig, Faults, LogFrame, PolicyBlob};
+use shared::{CameraConfig, Faults, PolicyBlob};
 use std::collections::BTreeMap;
 
 /// The checked log.
@@ -92,12 +92,7 @@ pub fn playback(
     let mut frames = Vec::new();
     let mut damaged = 0;
     for entry in &recording.entries {
-        let Some(frame) = entry
-            .frame
-            .as_ref()
-            .ok()
-            .and_then(|bytes| LogFrame::decode(bytes).ok())
-        else {
+        let Some(frame) = entry.log_frame() else {
             damaged += 1;
             continue;
         };
