@@ -50,6 +50,8 @@ NAMES = {
     "general-from-X.policy": "the general search from the X's table, at the default noise and twice it",
     "general-drawn.policy": "the general search, continued at twice the noise, then at both, then 2.5 times it as well, then on our drawn T, L and X as well, at both",
     "general-drawn-three.policy": "the general search, continued at twice the noise, then at both, then 2.5 times it as well, then on our drawn T, L and X as well, at both, then 2.5 times it as well",
+    "general-from-drawn-X.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone",
+    "general-from-drawn-X-more.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued",
     "thesis-T-bits9-both-again.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, three times",
     "thesis-T-bits9-three.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice, then 2.5 times it as well",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
@@ -124,6 +126,16 @@ def report_shapes():
     return re.findall(r'\("([^"]+)", \d+\)', table)
 
 
+def run_of(controller):
+    """The run a report controller's table came from (its file's stem)."""
+    return os.path.basename(controller["policy"])[: -len(".policy")]
+
+
+def is_general(controller):
+    """Whether a report controller is a general table (runs named general*)."""
+    return run_of(controller).startswith("general")
+
+
 def general_ranking(results, shapes):
     """The general tables (runs named general*) on `shapes`, best first by
     the search's own measure: the sum over the shapes of ln(1 +
@@ -131,9 +143,8 @@ def general_ranking(results, shapes):
     runs = {}
     for field in shapes:
         for c in results["shapes"].get(field, {}).values():
-            run = os.path.basename(c["policy"])[: -len(".policy")]
-            if run.startswith("general"):
-                runs.setdefault(run, {})[field] = c["per_million"]
+            if is_general(c):
+                runs.setdefault(run_of(c), {})[field] = c["per_million"]
     ranked = []
     for run, counts in runs.items():
         if len(counts) == len(shapes):
@@ -163,8 +174,9 @@ def tables(results):
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
         # every table learned for the letter (each search, whatever its
-        # state, and n-step Q-learning's)
-        learned = [c["per_million"] for n, c in shape.items() if n != NAMES["oc"]]
+        # state, and n-step Q-learning's; the general tables have their own
+        # tables below)
+        learned = [c["per_million"] for n, c in shape.items() if n != NAMES["oc"] and not is_general(c)]
         if not learned:
             continue
         found = max(learned)
@@ -181,6 +193,21 @@ def tables(results):
                   "|---|" + "---:|" * (len(shapes) + 1)]
         for run, counts, measure in ranked:
             lines.append(f"| {run} | " + " | ".join(f"{c:,.1f}" for c in counts) + f" | {measure:.2f} |")
+        # the report's shapes no general table was searched on, in the
+        # ranking's order: each general table's count and its share of the
+        # best of the shape's own tables
+        held_out = [f for f in reported if f not in shapes and f in results["shapes"]]
+        own = {f: max((c["per_million"] for n, c in results["shapes"][f].items()
+                       if n != NAMES["oc"] and not is_general(c)), default=0.0) for f in held_out}
+        lines += ["", "| general table, on shapes no general search saw | " + " | ".join(f"{f} (its own table {own[f]:,.1f})" for f in held_out) + " |",
+                  "|---|" + "---:|" * len(held_out)]
+        for run, _, _ in ranked:
+            cells = []
+            for f in held_out:
+                c = next((c for c in results["shapes"][f].values() if run_of(c) == run), None)
+                cells.append("-" if c is None else
+                             f"{c['per_million']:,.1f} ({c['per_million'] / own[f]:.2f})" if own[f] else f"{c['per_million']:,.1f}")
+            lines.append(f"| {run} | " + " | ".join(cells) + " |")
     lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
               "|---|---|---|---|---|---|---:|---:|---:|---:|---:|"]
     for s in results["searches"]:
