@@ -106,3 +106,22 @@ fn the_shipped_general_policy_is_the_general_table_that_ranks_first_on_the_shape
         "policies/robot-general.policy is not {best}, the general table that ranks first: {measure:?}"
     );
 }
+
+/// Every table of the page, the held-out shapes' and the targets' among
+/// them, is what the publisher renders from the published JSON.
+#[test]
+fn the_policy_search_pages_tables_are_what_the_publisher_renders_from_its_json() {
+    let root = root();
+    let output = std::process::Command::new("python3")
+        .arg(root.join("scripts/policy-search-publish.py"))
+        .arg("--check")
+        .arg(root.join("docs/policy-search/results.json"))
+        .arg(root.join("docs/policy-search.md"))
+        .output()
+        .expect("python3 runs the publisher");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
