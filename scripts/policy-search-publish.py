@@ -137,6 +137,13 @@ def is_general(controller):
     return run_of(controller).startswith("general")
 
 
+def own_counts(shape):
+    """Per million steps of every table learned for the shape itself (each
+    search, whatever its state, and Q-learning's): not OC, not a general
+    table."""
+    return [c["per_million"] for n, c in shape.items() if n != NAMES["oc"] and not is_general(c)]
+
+
 def general_ranking(results, shapes):
     """The general tables (runs named general*) on `shapes`, best first by
     the search's own measure: the sum over the shapes of ln(1 +
@@ -174,10 +181,8 @@ def tables(results):
         if field == "annulus" or field not in reported:
             continue
         oc = shape.get(NAMES["oc"], {}).get("per_million", 0.0)
-        # every table learned for the letter (each search, whatever its
-        # state, and n-step Q-learning's; the general tables have their own
-        # tables below)
-        learned = [c["per_million"] for n, c in shape.items() if n != NAMES["oc"] and not is_general(c)]
+        # the general tables have their own tables below
+        learned = own_counts(shape)
         if not learned:
             continue
         found = max(learned)
@@ -198,8 +203,7 @@ def tables(results):
         # ranking's order: each general table's count and its share of the
         # best of the shape's own tables
         held_out = [f for f in reported if f not in shapes and f in results["shapes"]]
-        own = {f: max((c["per_million"] for n, c in results["shapes"][f].items()
-                       if n != NAMES["oc"] and not is_general(c)), default=0.0) for f in held_out}
+        own = {f: max(own_counts(results["shapes"][f]), default=0.0) for f in held_out}
         lines += ["", "| general table, on shapes no general search saw | " + " | ".join(f"{f} (its own table {own[f]:,.1f})" for f in held_out) + " |",
                   "|---|" + "---:|" * len(held_out)]
         for run, _, _ in ranked:
