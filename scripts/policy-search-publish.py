@@ -54,6 +54,7 @@ NAMES = {
     "general-from-drawn-X-more.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued",
     "general-from-drawn-X-again.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice",
     "general-from-drawn-X-robust.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice, then 2.5 times the noise as well",
+    "general-from-drawn-X-robust-more.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice, then 2.5 times the noise as well, twice",
     "thesis-T-bits9-both-again.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, three times",
     "thesis-T-bits9-three.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice, then 2.5 times it as well",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",
