@@ -212,8 +212,12 @@ def tables(results):
             cells = []
             for f in held_out:
                 c = next((c for c in results["shapes"][f].values() if run_of(c) == run), None)
-                cells.append("-" if c is None else
-                             f"{c['per_million']:,.1f} ({c['per_million'] / own[f]:.2f})" if own[f] else f"{c['per_million']:,.1f}")
+                if c is None:
+                    cells.append("-")
+                elif own[f]:
+                    cells.append(f"{c['per_million']:,.1f} ({c['per_million'] / own[f]:.2f})")
+                else:
+                    cells.append(f"{c['per_million']:,.1f}")
             lines.append(f"| {run} | " + " | ".join(cells) + " |")
     lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
               "|---|---|---|---|---|---|---:|---:|---:|---:|---:|"]
