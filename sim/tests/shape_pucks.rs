@@ -14,7 +14,7 @@ use sim::base::vec2::Vec2;
 use sim::config::Thresholds;
 use sim::episodes::eval::eval;
 use sim::fields::source::FieldSource;
-use sim::scenario::shape_pucks::{training_shapes, tv_pucks, tv_shapes};
+use sim::scenario::shape_pucks::{training_shapes, turned_shapes, tv_pucks, tv_shapes};
 use sim::scenario::{arena::ArenaSpec, Arena, Scenario};
 use sim::world::World;
 
@@ -142,9 +142,39 @@ fn twelve_pucks_on_our_x_reach_success() {
 }
 
 #[test]
+fn nine_pucks_on_our_t_turned_a_quarter_reach_success_and_ten_do_not() {
+    check("letter:T@rot90");
+}
+
+#[test]
+fn ten_pucks_on_our_t_upside_down_reach_success_and_eleven_do_not() {
+    check("letter:T@rot180");
+}
+
+#[test]
+fn twelve_pucks_on_our_l_mirrored_reach_success() {
+    check("letter:L@mirror");
+}
+
+#[test]
+fn twelve_pucks_on_our_l_upside_down_reach_success() {
+    check("letter:L@rot180");
+}
+
+#[test]
 fn every_shape_searched_on_but_not_reported_is_checked_above() {
     let names: Vec<String> = training_shapes().map(|(f, _)| f.to_string()).collect();
     assert_eq!(names, ["letter:T", "letter:L", "letter:X"]);
+    let names: Vec<String> = turned_shapes().map(|(f, _)| f.to_string()).collect();
+    assert_eq!(
+        names,
+        [
+            "letter:T@rot90",
+            "letter:T@rot180",
+            "letter:L@mirror",
+            "letter:L@rot180"
+        ]
+    );
 }
 
 #[test]
@@ -162,7 +192,7 @@ fn the_policy_search_page_gives_every_count() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/policy-search.md"),
     )
     .unwrap();
-    for (field, pucks) in tv_shapes().chain(training_shapes()) {
+    for (field, pucks) in tv_shapes().chain(training_shapes()).chain(turned_shapes()) {
         let row = format!("| {field} | {pucks} |");
         assert!(page.contains(&row), "docs/policy-search.md lacks {row}");
     }

@@ -247,7 +247,7 @@ fn field(value: &str, allowed: &Allowed) -> Result<FieldSource, String> {
         .map_err(|e: sim::fields::source::FieldError| e.to_string())?;
     match &field {
         FieldSource::Image(path) if allowed.field_file.as_ref() != Some(path) => Err(
-            "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z)"
+            "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z), either turned (letter:L@mirror)"
                 .into(),
         ),
         _ => Ok(field),
@@ -368,6 +368,8 @@ mod tests {
         let d = ViewSettings::default();
         for (query, says) in [
             ("field=/etc/passwd", "field=/etc/passwd: a field image"),
+            // only built-in letters turn: a turned path is still a path
+            ("field=/etc/passwd@mirror", "a field image"),
             ("arena=/tmp/x.toml", "arena=/tmp/x.toml: an arena file"),
             ("sensors=robot:/tmp/x.json", "sensor settings file"),
             ("controller=policy:../x", "controller=policy:../x"),
@@ -383,6 +385,7 @@ mod tests {
             ..Allowed::default()
         };
         assert!(d.with_query("arena=/tmp/x.toml", &allowed, &[]).is_ok());
+        assert!(d.with_query("field=letter%3AL%40mirror", &none, &[]).is_ok());
         assert!(d.with_query("speed=max", &none, &["speed"]).is_ok());
     }
 }

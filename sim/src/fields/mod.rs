@@ -18,6 +18,7 @@
 
 pub mod letters;
 pub mod source;
+pub mod turn;
 
 use crate::base::rounding::floor;
 use crate::base::vec2::Vec2;

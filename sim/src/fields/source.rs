@@ -1,17 +1,19 @@
 //! Where a field comes from: the annulus, a generated letter, one of the
-//! thesis' own letter images (built in from `experiments/fields/`), or an
-//! image file (one cell per pixel, the mean of R, G and B over 255).
+//! thesis' own letter images (built in from `experiments/fields/`), either
+//! letter turned or mirrored (`letter:L@mirror`, [`Turn`]), or an image
+//! file (one cell per pixel, the mean of R, G and B over 255).
 
 use crate::base::ranges::{self, Range, RangeError};
 use crate::fields::letters::Letter;
+use crate::fields::turn::{Turn, UnknownTurn};
 use crate::fields::ScalarField;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
-/// Where a field comes from, by name: `annulus`, `letter:T`, or an image
-/// file's path.
+/// Where a field comes from, by name: `annulus`, `letter:T`, `thesis:T`,
+/// `letter:L@mirror`, or an image file's path.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum FieldSource {
@@ -23,6 +25,10 @@ pub enum FieldSource {
     /// I), built into the binary (`experiments/fields/README.md`: source and
     /// licence).
     Thesis(Letter),
+    /// A built-in letter, [`FieldSource::Letter`] or [`FieldSource::Thesis`]
+    /// (parsing builds no other), turned or mirrored: `letter:L@mirror`,
+    /// `thesis:T@rot180`.
+    Turned(Box<FieldSource>, Turn),
     /// A PNG or JPEG image (any other argument: its path).
     Image(PathBuf),
 }
@@ -45,6 +51,8 @@ pub enum FieldError {
     ImageFile(ImageFileError),
     /// `thesis:` followed by a letter the thesis has no image of.
     NoThesisImage(String),
+    /// A built-in letter followed by `@` and no turn's name.
+    UnknownTurn(UnknownTurn),
     /// Neither a field's name nor an existing file.
     Unknown(PathBuf),
 }
@@ -73,11 +81,12 @@ impl fmt::Display for FieldError {
                     THESIS_LETTERS.join(", ")
                 )
             }
+            FieldError::UnknownTurn(e) => write!(f, "in the field name: {e}"),
             FieldError::Unknown(path) => write!(
                 f,
                 "no field is named {:?} and there is no image file of that name: a field is \
-                 annulus, letter:X (X one of {}), thesis:X (X one of {}) or the path of a \
-                 PNG or JPEG image",
+                 annulus, letter:X (X one of {}), thesis:X (X one of {}), either letter \
+                 turned (letter:L@mirror) or the path of a PNG or JPEG image",
                 path.display().to_string(),
                 Letter::NAMES,
                 THESIS_LETTERS.join(", ")
@@ -91,9 +100,14 @@ impl std::error::Error for FieldError {}
 impl FromStr for FieldSource {
     type Err = FieldError;
 
-    /// `annulus`, `letter:X`, `thesis:X`, or a path.
+    /// `annulus`, `letter:X`, `thesis:X`, either with `@` and a turn, or a
+    /// path.
     fn from_str(s: &str) -> Result<FieldSource, FieldError> {
-        if s == "annulus" {
+        let built_in = s.starts_with("letter:") || s.starts_with("thesis:");
+        if let Some((letter, turn)) = s.split_once('@').filter(|_| built_in) {
+            let turn = turn.parse().map_err(FieldError::UnknownTurn)?;
+            Ok(FieldSource::Turned(Box::new(letter.parse()?), turn))
+        } else if s == "annulus" {
             Ok(FieldSource::Annulus)
         } else if let Some(letter) = s.strip_prefix("letter:") {
             letter
@@ -119,6 +133,7 @@ impl fmt::Display for FieldSource {
             FieldSource::Annulus => f.write_str("annulus"),
             FieldSource::Letter(l) => write!(f, "letter:{l}"),
             FieldSource::Thesis(l) => write!(f, "thesis:{l}"),
+            FieldSource::Turned(letter, turn) => write!(f, "{letter}@{turn}"),
             FieldSource::Image(p) => write!(f, "{}", p.display()),
         }
     }
@@ -140,6 +155,7 @@ impl FieldSource {
                 };
                 field_of(image::load_from_memory(bytes).map_err(err)?, &name)
             }
+            FieldSource::Turned(letter, turn) => Ok(turn.apply(&letter.load()?)),
             FieldSource::Image(path) => load_image(path),
         }
     }
@@ -289,6 +305,50 @@ mod tests {
         assert!(
             e.contains("\"square\"") && e.contains("annulus, letter:X"),
             "{e}"
+        );
+    }
+
+    #[test]
+    fn a_turned_letter_parses_prints_and_loads_as_its_letter_turned() {
+        for name in [
+            "letter:L@mirror",
+            "thesis:T@rot180",
+            "letter:T@mirror-rot90",
+        ] {
+            let source: FieldSource = name.parse().unwrap();
+            assert_eq!(source.to_string(), name);
+            let FieldSource::Turned(letter, turn) = &source else {
+                panic!("{name} parsed as {source:?}");
+            };
+            assert_eq!(source.load().unwrap(), turn.apply(&letter.load().unwrap()));
+        }
+        // our L's stem is on the left, so its bottom-left quarter is the
+        // brighter; mirrored, the bottom-right
+        let bottom_left_minus_right = |name: &str| -> f32 {
+            let f = name.parse::<FieldSource>().unwrap().load().unwrap();
+            let (w, h) = (f.width(), f.height());
+            let sign = |x: usize| if x < w / 2 { 1.0 } else { -1.0 };
+            (h / 2..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| sign(x) * f.values()[y * w + x])
+                .sum()
+        };
+        assert!(bottom_left_minus_right("letter:L") > 0.0);
+        assert!(bottom_left_minus_right("letter:L@mirror") < 0.0);
+        let e = "letter:L@rot45"
+            .parse::<FieldSource>()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("\"rot45\"") && e.contains("mirror"), "{e}");
+        let e = "thesis:I@mirror"
+            .parse::<FieldSource>()
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("\"I\""), "{e}");
+        // only built-in letters turn: anything else is a path
+        assert_eq!(
+            "annulus@mirror".parse::<FieldSource>().unwrap(),
+            FieldSource::Image(PathBuf::from("annulus@mirror"))
         );
     }
 

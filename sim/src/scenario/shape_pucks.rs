@@ -4,7 +4,8 @@
 //! Fixed here before any training, the same for orbital construction and
 //! every policy. The general table is also searched on our generated T, L
 //! and X (the same shapes as the thesis' images, drawn as our I is), whose
-//! counts follow the same rule ([`TRAINING_SHAPE_PUCKS`]).
+//! counts follow the same rule ([`TRAINING_SHAPE_PUCKS`]), and on our T
+//! and L turned or mirrored ([`TURNED_SHAPE_PUCKS`]).
 //! `sim/tests/shape_pucks.rs` places each count (and one more) and checks
 //! it; `docs/policy-search.md` gives the tables.
 
@@ -28,11 +29,25 @@ pub const TV_SHAPE_PUCKS: [(&str, usize); 7] = [
 pub const TRAINING_SHAPE_PUCKS: [(&str, usize); 3] =
     [("letter:T", 10), ("letter:L", 12), ("letter:X", 12)];
 
+/// Shapes searched on for geometry the letters as given lack, and their
+/// puck counts by the report's rule: our T and L turned or mirrored
+/// (`sim::fields::turn`). None is a turn of the report's held-out I, V or
+/// Z, and turning takes no puck count with it (our T takes 10, turned a
+/// quarter 9: the placement's grid meets the strokes differently).
+pub const TURNED_SHAPE_PUCKS: [(&str, usize); 4] = [
+    ("letter:T@rot90", 9),
+    ("letter:T@rot180", 10),
+    ("letter:L@mirror", 12),
+    ("letter:L@rot180", 12),
+];
+
 /// The puck count of `field` on the TV, if it is one of the report's
-/// shapes ([`TV_SHAPE_PUCKS`]) or searched on ([`TRAINING_SHAPE_PUCKS`]).
+/// shapes ([`TV_SHAPE_PUCKS`]) or searched on ([`TRAINING_SHAPE_PUCKS`],
+/// [`TURNED_SHAPE_PUCKS`]).
 pub fn tv_pucks(field: &FieldSource) -> Option<usize> {
     tv_shapes()
-        .chain(as_sources(&TRAINING_SHAPE_PUCKS))
+        .chain(training_shapes())
+        .chain(turned_shapes())
         .find(|(shape, _)| shape == field)
         .map(|(_, pucks)| pucks)
 }
@@ -45,6 +60,11 @@ pub fn tv_shapes() -> impl Iterator<Item = (FieldSource, usize)> {
 /// The training-only shapes as field sources, with their counts.
 pub fn training_shapes() -> impl Iterator<Item = (FieldSource, usize)> {
     as_sources(&TRAINING_SHAPE_PUCKS)
+}
+
+/// The turned training shapes as field sources, with their counts.
+pub fn turned_shapes() -> impl Iterator<Item = (FieldSource, usize)> {
+    as_sources(&TURNED_SHAPE_PUCKS)
 }
 
 /// A table of shape names and counts as field sources and counts.
@@ -69,9 +89,12 @@ mod tests {
         assert_eq!(tv_pucks(&FieldSource::Letter(Letter::T)), Some(10));
         assert_eq!(tv_pucks(&FieldSource::Letter(Letter::V)), None);
         assert_eq!(training_shapes().count(), TRAINING_SHAPE_PUCKS.len());
+        assert_eq!(turned_shapes().count(), TURNED_SHAPE_PUCKS.len());
+        assert_eq!(tv_pucks(&"letter:T@rot90".parse().unwrap()), Some(9));
         assert!(TV_SHAPE_PUCKS
             .iter()
             .chain(&TRAINING_SHAPE_PUCKS)
+            .chain(&TURNED_SHAPE_PUCKS)
             .all(|&(_, n)| (6..=12).contains(&n)));
     }
 }
