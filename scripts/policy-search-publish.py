@@ -55,6 +55,7 @@ NAMES = {
     "general-from-drawn-X-again.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice",
     "general-from-drawn-X-robust.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice, then 2.5 times the noise as well",
     "general-from-drawn-X-robust-more.policy": "the general search, on our drawn T, L and X as well, at both noises, from the table searched on our drawn X alone, continued twice, then 2.5 times the noise as well, twice",
+    "general-turned.policy": "the general search, on our drawn T, L and X and our T and L turned or mirrored as well, at three noises, from the table searched on our drawn X alone, continued four times",
     "thesis-T-bits9-both-again.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, three times",
     "thesis-T-bits9-three.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice, then 2.5 times it as well",
     "thesis-T-obstacle.policy": "search from distilled OC, 10-bit state (robots seen)",

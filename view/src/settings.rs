@@ -385,7 +385,9 @@ mod tests {
             ..Allowed::default()
         };
         assert!(d.with_query("arena=/tmp/x.toml", &allowed, &[]).is_ok());
-        assert!(d.with_query("field=letter%3AL%40mirror", &none, &[]).is_ok());
+        assert!(d
+            .with_query("field=letter%3AL%40mirror", &none, &[])
+            .is_ok());
         assert!(d.with_query("speed=max", &none, &["speed"]).is_ok());
     }
 }
