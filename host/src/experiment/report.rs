@@ -57,6 +57,7 @@ pub const DOCUMENTS: [Document; 2] = [
             "wedge-sweep",
             "every-shape",
             "t-noise",
+            "held-out-noise",
         ],
     },
 ];

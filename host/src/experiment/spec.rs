@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 
 /// The experiments shipped in `experiments/`, built into the binary so that
 /// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 17] = [
+pub const BUILT_IN: [(&str, &str); 18] = [
     ("annulus", include_str!("../../../experiments/annulus.toml")),
     (
         "transfer",
@@ -73,6 +73,10 @@ pub const BUILT_IN: [(&str, &str); 17] = [
         include_str!("../../../experiments/every-shape.toml"),
     ),
     ("t-noise", include_str!("../../../experiments/t-noise.toml")),
+    (
+        "held-out-noise",
+        include_str!("../../../experiments/held-out-noise.toml"),
+    ),
 ];
 
 /// A parsed experiment file.

@@ -40,7 +40,9 @@ pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
 #[serde(default, deny_unknown_fields)]
 pub struct TrainConfig {
     /// The field: annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the
-    /// thesis' T, L, V, X, Z) or an image file (PNG, JPEG) [default: annulus].
+    /// thesis' T, L, V, X, Z), either turned (letter:L@mirror; @rot90,
+    /// @rot180, @rot270 clockwise, @mirror, @mirror-rot90, ...) or an image
+    /// file (PNG, JPEG) [default: annulus].
     #[arg(long, required = false)]
     pub field: FieldSource,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with
