@@ -1,5 +1,6 @@
-//! The every-shape report (`experiments/every-shape.toml`) and the T's
-//! noise experiment (`experiments/t-noise.toml`) are measured on worlds
+//! The every-shape report (`experiments/every-shape.toml`) and its noise
+//! experiments (`experiments/t-noise.toml`, the T's table;
+//! `experiments/held-out-noise.toml`, the general table) are measured on worlds
 //! that no policy they report was trained, searched or selected on:
 //! none of its trial seeds is a seed of a published search's fitness or
 //! validation worlds (`docs/policy-search/runs/*.search.json`), nor a
@@ -59,14 +60,18 @@ fn search_seeds(runs: &Path) -> BTreeSet<u64> {
 }
 
 #[test]
-fn no_trial_of_the_every_shape_report_or_the_t_noise_experiment_runs_on_a_world_a_policy_was_trained_or_selected_on(
+fn no_trial_of_the_every_shape_report_or_its_noise_experiments_runs_on_a_world_a_policy_was_trained_or_selected_on(
 ) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let mut used = search_seeds(&root.join("docs/policy-search/runs"));
     for run in 1..=6u64 {
         used.extend([run, run ^ EVALUATION_STREAM, run ^ DISTIL_STREAM]);
     }
-    for (name, arms) in [("every-shape", 7 * 4), ("t-noise", 9)] {
+    for (name, arms) in [
+        ("every-shape", 7 * 4),
+        ("t-noise", 9),
+        ("held-out-noise", 20),
+    ] {
         let spec = ExperimentSpec::load(name).expect("a built-in experiment");
         for arm in &spec.arms {
             for t in 0..TRIALS {

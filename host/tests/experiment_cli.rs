@@ -37,6 +37,15 @@ fn every_experiment_file_is_built_in() {
 }
 
 #[test]
+fn the_help_names_every_built_in_experiment() {
+    let out = host().args(["experiment", "--help"]).output().unwrap();
+    let help = String::from_utf8_lossy(&out.stdout);
+    for (name, _) in host::experiment::spec::BUILT_IN {
+        assert!(help.contains(name), "`host experiment --help` lacks {name}");
+    }
+}
+
+#[test]
 fn quick_runs_of_every_experiment_produce_tables_and_figures() {
     let out = tempfile::tempdir().unwrap();
     for file in experiment_files() {

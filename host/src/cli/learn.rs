@@ -157,9 +157,12 @@ pub enum ExperimentAction {
 /// `host experiment NAME`'s options.
 #[derive(Clone, Debug, Args)]
 pub struct ExperimentRunArgs {
-    /// annulus, transfer, letters, letters-ablation, letters-generated, state-bits, obstacle,
-    /// collisions (the files of experiments/, built in), or the path of a
-    /// TOML file.
+    /// The thesis' (annulus, transfer, letters, letters-ablation,
+    /// letters-generated, state-bits, obstacle, collisions) or the robot's
+    /// senses' (robot-senses-ablation, robot-senses-sweep, robustness,
+    /// robustness-thesis, robot-senses-letter, wedge, wedge-sweep,
+    /// every-shape, t-noise, held-out-noise): the files of experiments/,
+    /// built in; or the path of a TOML file.
     #[arg(required = true)]
     pub experiment: Option<String>,
     /// Trials per arm.
