@@ -40,6 +40,7 @@ NAMES = {
     "thesis-T-bits9-twice.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise",
     "thesis-T-bits9-twice-both.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both",
     "thesis-T-bits9-both-more.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice",
+    "thesis-T-bits9-both-twice.policy": "search from distilled OC, 9-bit state, the 12-candidate table continued at twice the noise, then at both, twice, then at twice the noise again",
     "letter-I-robust-three.policy": "search from Q-learning's table, at twice the noise, then at the default noise, twice and 2.5 times it",
     "letter-I-robust-both.policy": "search from Q-learning's table, at twice the noise, then at the default noise and twice it",
     "general.policy": "the general search (annulus, T, L, X), from distilled OC",
