@@ -72,10 +72,11 @@ def name_of(controller):
     return NAMES.get(base) or NAMES[ending]
 
 
-def publish(out, results_path):
-    runs = [json.loads(l) for l in open(os.path.join(out, "evaluate.jsonl")) if l.strip()]
+def evaluation(path):
+    """An evaluation's lines by shape and controller name, with each
+    controller's formations per million steps."""
     shapes = {}
-    for r in runs:
+    for r in (json.loads(l) for l in open(path) if l.strip()):
         shape = shapes.setdefault(r["field"], {})
         c = shape.setdefault(name_of(r["controller"]), {"policy": r["controller"], "seeds": [], "formations": []})
         c["seeds"].append(r["seed"])
@@ -84,6 +85,14 @@ def publish(out, results_path):
     for shape in shapes.values():
         for c in shape.values():
             c["per_million"] = round(sum(c["formations"]) * 1e6 / (c["steps_per_seed"] * len(c["formations"])), 1)
+    return shapes
+
+
+def publish(out, results_path):
+    shapes = evaluation(os.path.join(out, "evaluate.jsonl"))
+    # the general tables at twice the noise (scripts/policy-search evaluate-2x)
+    twice = os.path.join(out, "evaluate-2x.jsonl")
+    shapes_2x = evaluation(twice) if os.path.exists(twice) else {}
     searches = []
     for path in sorted(glob.glob(os.path.join(out, "*.search.json"))):
         log = json.load(open(path))
@@ -107,7 +116,7 @@ def publish(out, results_path):
             "start_validation": f(log["start_validation"]),
             "result_validation": f(log["result_validation"]),
         })
-    results = {"command": "scripts/policy-search", "shapes": shapes, "searches": searches}
+    results = {"command": "scripts/policy-search", "shapes": shapes, "shapes_2x": shapes_2x, "searches": searches}
     with open(results_path + ".tmp", "w") as fh:
         json.dump(results, fh, indent=1, sort_keys=True)
         fh.write("\n")
@@ -148,13 +157,14 @@ def own_counts(shape):
     return [c["per_million"] for n, c in shape.items() if n != NAMES["oc"] and not is_general(c)]
 
 
-def general_ranking(results, shapes):
+def general_ranking(results, shapes, evaluation="shapes"):
     """The general tables (runs named general*) on `shapes`, best first by
     the search's own measure: the sum over the shapes of ln(1 +
-    formations), here per million steps."""
+    formations), here per million steps, in `evaluation` (`shapes` at the
+    default noise, `shapes_2x` at twice it)."""
     runs = {}
     for field in shapes:
-        for c in results["shapes"].get(field, {}).values():
+        for c in results.get(evaluation, {}).get(field, {}).values():
             if is_general(c):
                 runs.setdefault(run_of(c), {})[field] = c["per_million"]
     ranked = []
@@ -221,6 +231,23 @@ def tables(results):
                 else:
                     cells.append(f"{c['per_million']:,.1f}")
             lines.append(f"| {run} | " + " | ".join(cells) + " |")
+        # the same tables at twice the noise, where evaluated: ranked by
+        # the measure at both levels, and each held-out shape's 2x / default
+        ranked_2x = {run: (row, measure) for run, row, measure in general_ranking(results, shapes, "shapes_2x")}
+        if ranked_2x:
+            both = sorted(((run, measure, ranked_2x[run][1]) for run, _, measure in ranked if run in ranked_2x),
+                          key=lambda r: -(r[1] + r[2]))
+            lines += ["", "| general table | sum at the default noise | sum at twice it | both | "
+                      + " | ".join(f"{f}: 2x / default" for f in held_out) + " |",
+                      "|---|" + "---:|" * (3 + len(held_out))]
+            for run, default, twice in both:
+                cells = []
+                for f in held_out:
+                    c1 = next((c for c in results["shapes"][f].values() if run_of(c) == run), None)
+                    c2 = next((c for c in results["shapes_2x"].get(f, {}).values() if run_of(c) == run), None)
+                    cells.append(f"{c2['per_million'] / c1['per_million']:.2f}" if c1 and c2 and c1["per_million"] else "-")
+                lines.append(f"| {run} | {default:.2f} | {twice:.2f} | {default + twice:.2f} | " + " | ".join(cells) + " |")
+            lines += ["", f"Ranked by the sum at both noise levels, the first is `{both[0][0]}`; by the default noise alone, `{ranked[0][0]}`."]
     lines += ["", "| search | field | senses | noise | hasher | start | generations | steps | validation: start | validation: result | result / start |",
               "|---|---|---|---|---|---|---:|---:|---:|---:|---:|"]
     for s in results["searches"]:
