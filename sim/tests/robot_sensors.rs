@@ -162,3 +162,43 @@ fn a_flat_field_corrected_panel_shows_its_share_of_the_unevenness_and_no_other_n
     let e = noise_on_a_panel_showing(1.5).unwrap_err();
     assert!(e.contains("arena.brightness_unevenness"), "{e}");
 }
+
+/// The motion noise and the senses' noise of a scenario on `tv75` whose
+/// robots show `share` of the motion noise, at `noise` times the default.
+fn noises_of_robots_showing(
+    share: f64,
+    noise: f64,
+) -> Result<(sim::config::actuation::ActuationNoise, RobotNoise), String> {
+    use sim::scenario::{arena::ArenaSpec, sensor_setup::SensorSetup, Arena, Scenario};
+    let scenario = Scenario {
+        arena: Arena::Screen(Box::new(ArenaSpec {
+            motion_noise: share,
+            ..ArenaSpec::tv75()
+        })),
+        sensors: SensorSetup::Robot(Box::default()),
+        noise,
+        ..Scenario::default()
+    };
+    let prepared = scenario.prepare().map_err(|e| e.to_string())?;
+    match prepared.sensors() {
+        SensorSetup::Robot(robot) => Ok((
+            prepared.config().world.actuation.clone(),
+            robot.noise.clone(),
+        )),
+        other => Err(format!("not the robot's senses: {other:?}")),
+    }
+}
+
+#[test]
+fn robots_showing_half_the_motion_noise_at_twice_the_noise_move_as_at_the_default_and_sense_at_twice_it(
+) {
+    let (default_motion, default_senses) = noises_of_robots_showing(1.0, 1.0).unwrap();
+    let (motion, senses) = noises_of_robots_showing(0.5, 2.0).unwrap();
+    assert_eq!(motion, default_motion);
+    assert!(!motion.is_none());
+    assert_eq!(senses, default_senses.scaled(2.0));
+    let (still, _) = noises_of_robots_showing(0.0, 2.0).unwrap();
+    assert!(still.is_none(), "{still:?}");
+    let e = noises_of_robots_showing(1.5, 1.0).unwrap_err();
+    assert!(e.contains("arena.motion_noise"), "{e}");
+}

@@ -665,6 +665,15 @@ pub const UNEVENNESS: Range = Range::closed(
     "1 for a panel as it comes; a flat-field correction (the shown image divided by the panel's measured gain) leaves less, never more",
 );
 
+/// The share of the robots' motion noise they show on a screen.
+pub const MOTION_NOISE_SHARE: Range = Range::closed(
+    &["arena.motion_noise"],
+    0.0,
+    1.0,
+    "",
+    "1 for open-loop motor commands, as the firmware drives them; wheel speeds held on the encoders would leave less, never more",
+);
+
 /// Points across and down of a panel's measured gain (`host field gain`'s
 /// marks).
 pub const GAIN_GRID_SIDE: Range = Range::closed(
@@ -856,6 +865,7 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &BODY_RADIUS_MM,
             &GAMMA,
             &UNEVENNESS,
+            &MOTION_NOISE_SHARE,
             &GAIN_GRID_SIDE,
             &PANEL_GAIN,
             &HOLD_S,

@@ -103,6 +103,12 @@ pub struct ArenaSpec {
     /// for one whose shown image is divided by its measured gain (a
     /// flat-field correction, `docs/display.md`).
     pub brightness_unevenness: f64,
+    /// The share of the robots' motion noise (`--noise`'s wheel speeds,
+    /// turning bias, period jitter and drops) they show: 1 for the
+    /// firmware's open-loop motor commands, less for robots that hold their
+    /// wheel speeds on the encoders (0.5 at `--noise 2` is the default
+    /// motion beside twice the senses' noise).
+    pub motion_noise: f64,
     /// Robot radius, mm: the Zumo in its skirt (a wedge's round back).
     pub robot_radius_mm: f64,
     /// The skirt's outline.
@@ -154,6 +160,7 @@ impl ArenaSpec {
             fit: FieldFit::Contain,
             display_gamma: 2.2,
             brightness_unevenness: 1.0,
+            motion_noise: 1.0,
             robot_radius_mm: 65.0,
             robot_shape: SkirtShape::thesis_wedge(),
             puck_radius_mm: 65.0,
@@ -193,6 +200,7 @@ impl ArenaSpec {
         }
         ranges::GAMMA.check(self.display_gamma)?;
         ranges::UNEVENNESS.check(self.brightness_unevenness)?;
+        ranges::MOTION_NOISE_SHARE.check(self.motion_noise)?;
         ranges::BODY_RADIUS_MM.check(self.robot_radius_mm)?;
         ranges::BODY_RADIUS_MM.check_as("arena.puck_radius_mm", self.puck_radius_mm)?;
         for (i, mm) in self.screen_mm.iter().enumerate() {

@@ -221,8 +221,13 @@ impl Scenario {
         if let Some(walls) = self.walls {
             c.physics.walls = walls;
         }
-        if self.noise > 0.0 {
-            c.world.actuation = ActuationNoise::randomised().scaled(self.noise);
+        // robots on a screen may show only a share of the motion noise
+        let motion = match &self.arena {
+            Arena::Screen(spec) => self.noise * spec.motion_noise,
+            Arena::Square(_) => self.noise,
+        };
+        if motion > 0.0 {
+            c.world.actuation = ActuationNoise::randomised().scaled(motion);
         }
         if self.controller == ControllerChoice::Orbital {
             c.world.innies = orbital_innies(&self.field, c.world.robots);
