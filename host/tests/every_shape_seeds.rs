@@ -69,7 +69,7 @@ fn no_trial_of_the_every_shape_report_or_its_noise_experiments_runs_on_a_world_a
     }
     for (name, arms) in [
         ("every-shape", 7 * 4),
-        ("t-noise", 15),
+        ("t-noise", 16),
         ("held-out-noise", 24),
     ] {
         let spec = ExperimentSpec::load(name).expect("a built-in experiment");
