@@ -157,6 +157,12 @@ def own_counts(shape):
     return [c["per_million"] for n, c in shape.items() if n != NAMES["oc"] and not is_general(c)]
 
 
+def count_of(results, evaluation, field, run):
+    """A run's controller on `field` in `evaluation` (`shapes` or
+    `shapes_2x`), or None."""
+    return next((c for c in results.get(evaluation, {}).get(field, {}).values() if run_of(c) == run), None)
+
+
 def general_ranking(results, shapes, evaluation="shapes"):
     """The general tables (runs named general*) on `shapes`, best first by
     the search's own measure: the sum over the shapes of ln(1 +
@@ -223,7 +229,7 @@ def tables(results):
         for run, _, _ in ranked:
             cells = []
             for f in held_out:
-                c = next((c for c in results["shapes"][f].values() if run_of(c) == run), None)
+                c = count_of(results, "shapes", f, run)
                 if c is None:
                     cells.append("-")
                 elif own[f]:
@@ -233,9 +239,9 @@ def tables(results):
             lines.append(f"| {run} | " + " | ".join(cells) + " |")
         # the same tables at twice the noise, where evaluated: ranked by
         # the measure at both levels, and each held-out shape's 2x / default
-        ranked_2x = {run: (row, measure) for run, row, measure in general_ranking(results, shapes, "shapes_2x")}
+        ranked_2x = {run: measure for run, _, measure in general_ranking(results, shapes, "shapes_2x")}
         if ranked_2x:
-            both = sorted(((run, measure, ranked_2x[run][1]) for run, _, measure in ranked if run in ranked_2x),
+            both = sorted(((run, measure, ranked_2x[run]) for run, _, measure in ranked if run in ranked_2x),
                           key=lambda r: -(r[1] + r[2]))
             lines += ["", "| general table | sum at the default noise | sum at twice it | both | "
                       + " | ".join(f"{f}: 2x / default" for f in held_out) + " |",
@@ -243,8 +249,8 @@ def tables(results):
             for run, default, twice in both:
                 cells = []
                 for f in held_out:
-                    c1 = next((c for c in results["shapes"][f].values() if run_of(c) == run), None)
-                    c2 = next((c for c in results["shapes_2x"].get(f, {}).values() if run_of(c) == run), None)
+                    c1 = count_of(results, "shapes", f, run)
+                    c2 = count_of(results, "shapes_2x", f, run)
                     cells.append(f"{c2['per_million'] / c1['per_million']:.2f}" if c1 and c2 and c1["per_million"] else "-")
                 lines.append(f"| {run} | {default:.2f} | {twice:.2f} | {default + twice:.2f} | " + " | ".join(cells) + " |")
             lines += ["", f"Ranked by the sum at both noise levels, the first is `{both[0][0]}`; by the default noise alone, `{ranked[0][0]}`."]
