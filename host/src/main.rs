@@ -128,8 +128,23 @@ fn bench(args: BenchArgs) -> Result<()> {
 }
 
 fn train(args: TrainArgs) -> Result<()> {
-    let report = host::train::train(&args.request())?;
-    println!("{report}");
+    let mut request = args.request();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = stop.clone();
+    // Ctrl-C and SIGTERM: the state reached is written before exiting
+    ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst))
+        .context("cannot install the Ctrl-C and SIGTERM handler")?;
+    request.stop = Some(stop);
+    let report = host::train::train(&request, |report| {
+        println!("{report}");
+        std::io::stdout()
+            .flush()
+            .context("cannot write the summary")
+    })?;
+    if report.interrupted {
+        // 128 + SIGINT, as a shell reports a command stopped by Ctrl-C
+        std::process::exit(130);
+    }
     Ok(())
 }
 

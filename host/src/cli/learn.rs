@@ -45,6 +45,7 @@ impl TrainArgs {
             resume: self.resume,
             init_from: self.init_from,
             view: self.view.map(|b| b.or_port(8077)),
+            stop: None,
         }
     }
 }

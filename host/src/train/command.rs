@@ -1,6 +1,16 @@
 //! `host train`: settings from a file and flags, a new or resumed run with
 //! a progress bar (and with `--view` the live view's page, [`super::watch`]),
-//! periodic atomic checkpoints, the policy blob, and a summary.
+//! periodic atomic checkpoints, the policy blob, and a summary beside
+//! orbital construction's formations on the same settings.
+//!
+//! Nothing is lost. A new run whose `<name>.policy` or `<name>.ckpt`
+//! already exists keeps them as `<name>.N.policy` and `<name>.N.ckpt` (the
+//! smallest N free for both) and says so on stderr; a resumed run replaces
+//! the files of the checkpoint it continues. When the request's stop flag
+//! is raised (Ctrl-C or SIGTERM, installed by `main`), the run stops at the
+//! next chunk boundary and writes the policy and checkpoint of the state
+//! reached, atomically, as at the end. With `--view` the page keeps serving
+//! the final state until the stop flag is raised.
 
 use super::checkpoint;
 use super::config::{TrainConfig, TrainFlags};
@@ -11,12 +21,16 @@ use anyhow::{bail, Context, Result};
 use indicatif::{HumanCount, ProgressBar, ProgressDrawTarget, ProgressState, ProgressStyle};
 use shared::PolicyBlob;
 use sim::base::ranges;
+use sim::control::orbital::{OrbitalConfig, OrbitalConstruction};
 use sim::scenario::sensor_setup::SelectedSensors;
 use std::fmt;
 use std::io::{IsTerminal, Write};
 use std::net::SocketAddr;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 /// Steps between progress-bar updates.
 const PROGRESS_CHUNK: u64 = 20_000;
@@ -36,6 +50,9 @@ pub struct TrainRequest {
     pub init_from: Option<PathBuf>,
     /// Serve the run on the live view's page at this address ([`watch`]).
     pub view: Option<SocketAddr>,
+    /// Raised to stop: training ends at the next chunk with its files
+    /// written, and a view stops serving.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 /// What a training session did.
@@ -43,10 +60,18 @@ pub struct TrainRequest {
 pub struct TrainReport {
     /// Steps run in this session.
     pub steps: u64,
+    /// Steps this session was asked to run (more than `steps` when
+    /// interrupted).
+    pub planned: u64,
+    /// Stopped by the stop flag before `planned` steps.
+    pub interrupted: bool,
     /// Steps since the run began (resumed sessions included).
     pub total_steps: u64,
     /// Formations since the run began.
     pub formations: u64,
+    /// Orbital construction's formations on the run's settings and seed in
+    /// as many steps (`None` when interrupted).
+    pub orbital_formations: Option<u64>,
     /// Stuck episodes since the run began.
     pub stuck: u64,
     /// Speed of this session.
@@ -64,6 +89,9 @@ pub struct TrainReport {
     pub policy: PathBuf,
     /// The checkpoint written.
     pub checkpoint: PathBuf,
+    /// Earlier results this run would have replaced, and where they are
+    /// kept.
+    pub kept: Vec<(PathBuf, PathBuf)>,
 }
 
 impl fmt::Display for TrainReport {
@@ -73,7 +101,14 @@ impl fmt::Display for TrainReport {
             "steps                {} (run total {})",
             self.steps, self.total_steps
         )?;
-        writeln!(f, "formations           {}", self.formations)?;
+        match self.orbital_formations {
+            Some(oc) => writeln!(
+                f,
+                "formations           {} (orbital construction: {oc} in as many steps, same settings and seed)",
+                self.formations
+            )?,
+            None => writeln!(f, "formations           {}", self.formations)?,
+        }
         writeln!(f, "stuck episodes       {}", self.stuck)?;
         writeln!(f, "steps per second     {:.0}", self.steps_per_second)?;
         writeln!(
@@ -109,13 +144,36 @@ impl fmt::Display for TrainReport {
                 "selected policy      of step {step}: {formations} formations in its evaluation"
             )?;
         }
+        for (was, kept) in &self.kept {
+            writeln!(
+                f,
+                "kept                 the previous {} as {}",
+                was.display(),
+                kept.display()
+            )?;
+        }
         writeln!(f, "policy               {}", self.policy.display())?;
-        write!(f, "checkpoint           {}", self.checkpoint.display())
+        write!(f, "checkpoint           {}", self.checkpoint.display())?;
+        if self.interrupted {
+            write!(
+                f,
+                "\ninterrupted          after {} of {} steps; `host train --resume {} --steps {}` runs the rest",
+                self.steps,
+                self.planned,
+                self.checkpoint.display(),
+                self.planned - self.steps
+            )?;
+        }
+        Ok(())
     }
 }
 
-/// Runs `host train`.
-pub fn train(args: &TrainRequest) -> Result<TrainReport> {
+/// Runs `host train`, hands the report to `show`, then with `--view`
+/// serves the final state until the stop flag is raised.
+pub fn train(
+    args: &TrainRequest,
+    show: impl FnOnce(&TrainReport) -> Result<()>,
+) -> Result<TrainReport> {
     let (mut trainer, steps) = match &args.resume {
         Some(path) => resume(args, path)?,
         None => start(args)?,
@@ -129,6 +187,14 @@ pub fn train(args: &TrainRequest) -> Result<TrainReport> {
     trainer.config().validate()?;
     // a resumed run's output folder may be another than its checkpoint's
     crate::atomic::check_writable(&trainer.config().output.dir)?;
+    let kept = keep_previous(trainer.config(), args.resume.as_deref())?;
+    for (was, now) in &kept {
+        eprintln!(
+            "train: kept the previous {} as {}",
+            was.display(),
+            now.display()
+        );
+    }
     let mut view = match args.view {
         Some(bind) => {
             let view = TrainingView::start(bind, &trainer)?;
@@ -145,7 +211,66 @@ pub fn train(args: &TrainRequest) -> Result<TrainReport> {
         }
         None => None,
     };
-    run(&mut trainer, steps, view.as_mut())
+    let never = Arc::new(AtomicBool::new(false));
+    let stop = args.stop.as_ref().unwrap_or(&never);
+    let mut report = run(&mut trainer, steps, view.as_mut(), stop)?;
+    report.kept = kept;
+    show(&report)?;
+    if let (Some(view), Some(stop)) = (view, &args.stop) {
+        if !report.interrupted {
+            println!(
+                "view: training ended; {} keeps serving its final state until Ctrl-C",
+                view.url()
+            );
+            std::io::stdout()
+                .flush()
+                .context("cannot write to stdout")?;
+            while !stop.load(Ordering::SeqCst) {
+                std::thread::sleep(Duration::from_millis(100));
+            }
+        }
+    }
+    Ok(report)
+}
+
+/// Moves aside a new run's earlier `<name>.policy` and `<name>.ckpt`, to
+/// `<name>.N.policy` and `<name>.N.ckpt` with the smallest N free for
+/// both; a resumed run replaces the files of the checkpoint it continues.
+/// Returns each file moved and where to.
+fn keep_previous(config: &TrainConfig, resumed: Option<&Path>) -> Result<Vec<(PathBuf, PathBuf)>> {
+    let (dir, name) = (&config.output.dir, config.name());
+    let path = |suffix: &str| dir.join(format!("{name}{suffix}"));
+    let (policy, checkpoint) = (path(".policy"), path(".ckpt"));
+    let same_run = resumed.is_some_and(|r| {
+        matches!(
+            (r.canonicalize(), checkpoint.canonicalize()),
+            (Ok(a), Ok(b)) if a == b
+        )
+    });
+    let present: Vec<&PathBuf> = [&policy, &checkpoint]
+        .into_iter()
+        .filter(|p| p.exists())
+        .collect();
+    if same_run || present.is_empty() {
+        return Ok(Vec::new());
+    }
+    let free = (1u64..)
+        .find(|n| !path(&format!(".{n}.policy")).exists() && !path(&format!(".{n}.ckpt")).exists())
+        .unwrap_or(u64::MAX);
+    let mut kept = Vec::new();
+    for was in present {
+        let suffix = if *was == policy { "policy" } else { "ckpt" };
+        let now = path(&format!(".{free}.{suffix}"));
+        std::fs::rename(was, &now).with_context(|| {
+            format!(
+                "cannot keep the previous {} as {}",
+                was.display(),
+                now.display()
+            )
+        })?;
+        kept.push((was.clone(), now));
+    }
+    Ok(kept)
 }
 
 /// A new run from the config file, the flags and `--init-from`.
@@ -224,21 +349,24 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     Ok(table)
 }
 
-/// Runs `steps` steps with a progress bar, checkpointing on the way, then
-/// writes the policy and the final checkpoint.
+/// Runs `steps` steps (fewer when `stop` is raised) with a progress bar,
+/// checkpointing on the way, then writes the policy and the final
+/// checkpoint; orbital construction runs beside it for the comparison.
 fn run(
     trainer: &mut Trainer<SelectedSensors>,
     steps: u64,
     mut view: Option<&mut TrainingView>,
+    stop: &Arc<AtomicBool>,
 ) -> Result<TrainReport> {
     let out = trainer.config().output.clone();
     let name = trainer.config().name();
     let policy_path = out.dir.join(format!("{name}.policy"));
     let checkpoint_path = out.dir.join(format!("{name}.ckpt"));
+    let orbital = OrbitalRun::start(trainer.config(), trainer.totals().steps + steps)?;
     let bar = progress_bar(steps);
     let start = Instant::now();
     let mut done = 0;
-    while done < steps {
+    while done < steps && !stop.load(Ordering::SeqCst) {
         let total = trainer.totals().steps;
         let mut chunk = PROGRESS_CHUNK.min(steps - done);
         if out.checkpoint_every > 0 {
@@ -266,17 +394,22 @@ fn run(
     }
     let seconds = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
+    let interrupted = done < steps;
     checkpoint::save(&checkpoint_path, &trainer.state())?;
     crate::policy_file::write(&policy_path, &trainer.policy()?)?;
+    let orbital_formations = orbital.finish(interrupted)?;
     let totals = trainer.totals();
     let q = trainer.learner().table();
     Ok(TrainReport {
-        steps,
+        steps: done,
+        planned: steps,
+        interrupted,
         total_steps: totals.steps,
         formations: totals.formations,
+        orbital_formations,
         stuck: totals.stuck,
         steps_per_second: if seconds > 0.0 {
-            steps as f64 / seconds
+            done as f64 / seconds
         } else {
             f64::INFINITY
         },
@@ -286,7 +419,49 @@ fn run(
         selected: trainer.selected().map(|s| (s.step, s.formations)),
         policy: policy_path,
         checkpoint: checkpoint_path,
+        kept: Vec::new(),
     })
+}
+
+/// Orbital construction on a run's settings and seed, stepped on its own
+/// thread for as many steps as the run will have had.
+struct OrbitalRun {
+    cancel: Arc<AtomicBool>,
+    thread: JoinHandle<Result<u64>>,
+}
+
+impl OrbitalRun {
+    fn start(config: &TrainConfig, steps: u64) -> Result<OrbitalRun> {
+        let prepared = config.prepare()?;
+        let mut sim = prepared.simulation(config.seed)?;
+        let mut controller =
+            OrbitalConstruction::new(OrbitalConfig::default(), &prepared.config().thresholds);
+        let cancel = Arc::new(AtomicBool::new(false));
+        let cancelled = cancel.clone();
+        let thread = std::thread::Builder::new()
+            .name("train-orbital".into())
+            .spawn(move || {
+                let mut left = steps;
+                while left > 0 && !cancelled.load(Ordering::SeqCst) {
+                    let chunk = PROGRESS_CHUNK.min(left);
+                    sim.run(&mut controller, chunk);
+                    left -= chunk;
+                }
+                Ok(sim.totals().formations)
+            })
+            .context("cannot start orbital construction's thread")?;
+        Ok(OrbitalRun { cancel, thread })
+    }
+
+    /// Its formations, or `None` when cancelled (an interrupted run).
+    fn finish(self, cancel: bool) -> Result<Option<u64>> {
+        self.cancel.store(cancel, Ordering::SeqCst);
+        let formations = self
+            .thread
+            .join()
+            .map_err(|_| anyhow::anyhow!("orbital construction's thread panicked"))??;
+        Ok((!cancel).then_some(formations))
+    }
 }
 
 /// A bar on stderr with steps per second, hidden unless both stdout and
