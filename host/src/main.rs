@@ -22,7 +22,11 @@ use std::sync::Arc;
 
 fn main() -> ExitCode {
     end_quietly_on_a_closed_pipe();
-    match run(Cli::parse()) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return cli::refused(&e),
+    };
+    match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
@@ -83,8 +87,10 @@ fn simulate(args: RunArgs) -> Result<()> {
 }
 
 fn render(args: RenderArgs) -> Result<()> {
+    use host::render::{animate, run_until_formed, write_png, Drawn};
+    let every = args.every();
     ranges::RUN_STEPS.check_count("host render --steps", args.steps)?;
-    ranges::FRAME_EVERY.check_count("host render --every", args.every)?;
+    ranges::FRAME_EVERY.check_count("host render --every", every)?;
     ranges::RENDER_SIZE.check_count("--size", u64::from(args.size))?;
     warn_policy_mismatch(&args.scenario)?;
     let (mut sim, mut controller) = args.scenario.scenario()?.build()?;
@@ -93,21 +99,31 @@ fn render(args: RenderArgs) -> Result<()> {
         footprints: args.footprints,
         band: args.band,
     };
+    let legend = if args.band {
+        "; the band's edge cyan, the pucks in it green"
+    } else {
+        ""
+    };
     if let Some(path) = &args.gif {
-        host::render::animate(
-            &mut sim,
-            &mut controller,
-            args.steps,
-            args.every,
-            options,
-            path,
-        )?;
+        animate(&mut sim, &mut controller, args.steps, every, options, path)?;
+        println!(
+            "wrote {} ({} frames, one every {every} steps): at the end {}{legend}",
+            path.display(),
+            args.steps / every + 1,
+            Drawn::now(&sim)
+        );
     }
     if let Some(path) = &args.out {
-        if sim.totals().steps < args.steps {
-            sim.run(&mut controller, args.steps);
-        }
-        host::render::write_png(&sim, options, path)?;
+        let (formed, drawn) = if args.until_formed {
+            run_until_formed(&mut sim, &mut controller, args.steps)
+        } else {
+            if sim.totals().steps < args.steps {
+                sim.run(&mut controller, args.steps);
+            }
+            (None, Drawn::now(&sim))
+        };
+        let (w, h) = write_png(formed.as_ref().unwrap_or(&sim), options, path)?;
+        println!("wrote {} ({w} x {h}): {drawn}{legend}", path.display());
     }
     Ok(())
 }

@@ -2,14 +2,15 @@
 //! background (0 black, 1 white), pucks red, robots blue (discs, or their
 //! wedge-fronted outline) with a heading line, optionally the outline of
 //! the target band (cyan: the edge of the region whose field value lies
-//! between the thresholds, where Eval wants every puck) and each robot's
-//! sensor footprints. (Writing them as PNG or GIF files is the host's.)
+//! between the thresholds, where Eval wants every puck; the pucks Eval
+//! counts as in it are then drawn green) and each robot's sensor
+//! footprints. (Writing them as PNG or GIF files is the host's.)
 //!
 //! Room 11 of the simulator (`lib.rs`), at the top: it reads a simulation and
 //! changes nothing.
 
 use crate::base::vec2::Vec2;
-use crate::episodes::eval::in_band;
+use crate::episodes::eval::{in_band, pucks_in_band};
 use crate::fields::ScalarField;
 use crate::physics::outline::Outline;
 use crate::sensors::{FootprintKind, SensorModel};
@@ -19,6 +20,8 @@ use image::{Rgb, RgbImage};
 
 /// A puck's colour.
 pub const PUCK: Rgb<u8> = Rgb([200, 44, 44]);
+/// A puck's colour in the target band, when the band is drawn.
+pub const PUCK_IN_BAND: Rgb<u8> = Rgb([40, 190, 60]);
 const ROBOT: Rgb<u8> = Rgb([0, 100, 200]);
 const HEADING: Rgb<u8> = Rgb([255, 255, 255]);
 const PUCK_SENSOR: Rgb<u8> = Rgb([250, 200, 0]);
@@ -54,7 +57,12 @@ pub fn draw<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) -> RgbI
     let world = sim.world();
     let mut img = draw_ground(sim, options);
     let scale = scale_of(world, options.size);
-    draw_bodies(&mut img, world, scale);
+    let in_band: Vec<bool> = if options.band {
+        pucks_in_band(world, sim.field(), &sim.config().thresholds).collect()
+    } else {
+        Vec::new()
+    };
+    draw_bodies(&mut img, world, scale, &in_band);
     if !options.footprints {
         return img;
     }
@@ -100,7 +108,7 @@ pub fn draw_ground<S: SensorModel>(sim: &Simulation<S>, options: RenderOptions) 
 /// grey, as the world reads it), pucks, robots with their heading.
 pub fn draw_world(world: &World, field: &ScalarField, size: u32) -> RgbImage {
     let mut img = draw_field(world, field, size);
-    draw_bodies(&mut img, world, scale_of(world, size));
+    draw_bodies(&mut img, world, scale_of(world, size), &[]);
     img
 }
 
@@ -116,11 +124,17 @@ fn draw_field(world: &World, field: &ScalarField, size: u32) -> RgbImage {
     })
 }
 
-/// Pucks, then robots with their heading, `scale` pixels per unit.
-fn draw_bodies(img: &mut RgbImage, world: &World, scale: f64) {
+/// Pucks (those `in_band` says are in the target band green), then
+/// robots with their heading, `scale` pixels per unit.
+fn draw_bodies(img: &mut RgbImage, world: &World, scale: f64, in_band: &[bool]) {
     let to_px = |p: Vec2| p * scale;
-    for puck in world.pucks() {
-        fill_circle(img, to_px(puck.pos), puck.radius * scale, PUCK);
+    for (i, puck) in world.pucks().iter().enumerate() {
+        let colour = if in_band.get(i) == Some(&true) {
+            PUCK_IN_BAND
+        } else {
+            PUCK
+        };
+        fill_circle(img, to_px(puck.pos), puck.radius * scale, colour);
     }
     let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
     for (i, robot) in world.robots().iter().enumerate() {

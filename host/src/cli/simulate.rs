@@ -86,25 +86,38 @@ pub struct RenderArgs {
     /// The scenario.
     #[command(flatten)]
     pub scenario: ScenarioArgs,
-    /// Steps to run before drawing (or to animate, with --gif).
-    #[arg(long, default_value_t = 0)]
+    /// Steps to run before drawing (or to animate, with --gif; with
+    /// --until-formed, at most).
+    #[arg(long, default_value_t = 200_000)]
     pub steps: u64,
     /// PNG file to write.
     #[arg(long, required_unless_present = "gif")]
     pub out: Option<PathBuf>,
+    /// Draw the world at the moment the shape first forms (or at the end
+    /// of --steps if it never does, which the printed line says).
+    #[arg(long, conflicts_with = "gif")]
+    pub until_formed: bool,
     /// Animated GIF file to write instead, one frame every --every steps.
     #[arg(long)]
     pub gif: Option<PathBuf>,
-    /// Steps between GIF frames.
-    #[arg(long, default_value_t = 100)]
-    pub every: u64,
+    /// Steps between GIF frames [default: --steps / 100, at least 1].
+    #[arg(long)]
+    pub every: Option<u64>,
     /// Image side in pixels.
     #[arg(long, default_value_t = 800)]
     pub size: u32,
     /// Draw each robot's sensor discs and field points.
     #[arg(long)]
     pub footprints: bool,
-    /// Outline the target band (cyan): where Eval wants every puck.
+    /// Outline the target band (cyan), where Eval wants every puck, and
+    /// draw the pucks in it green.
     #[arg(long)]
     pub band: bool,
+}
+
+impl RenderArgs {
+    /// Steps between GIF frames: --every, or 100 frames over --steps.
+    pub fn every(&self) -> u64 {
+        self.every.unwrap_or((self.steps / 100).max(1))
+    }
 }
