@@ -26,27 +26,6 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-EVAL_SEEDS = list(range(1001, 1011))
-
-
-def evaluate(act, steps: int, **settings) -> dict:
-    """``act(states)`` (worlds x robots hashed states to action indices)
-    run for ``steps`` steps on each evaluation seed at once: formations in
-    all, the mean over seeds of the last Eval and of the mean Eval at the
-    formation checks."""
-    import numpy as np
-
-    import zumo_swarm
-
-    env = zumo_swarm.vector_env(len(EVAL_SEEDS), observation="state", **settings)
-    obs, _ = env.reset(seed=EVAL_SEEDS)
-    for _ in range(steps):
-        obs, _, _, _, info = env.step(act(obs))
-    return {
-        "formations": int(info["formations"].sum()),
-        "final_eval": float(info["eval"].mean()),
-        "mean_eval": float(info["mean_eval"].mean()),
-    }
 
 
 def host_formations(host: str, policy: Path, steps: int, seed: int) -> int:
@@ -70,6 +49,8 @@ def run(args) -> dict:
     import zumo_swarm
 
     sys.path.insert(0, str(HERE.parent / "examples"))
+    from run_log import EVAL_SEEDS, evaluate  # the examples' held-out evaluation
+
     rng = np.random.default_rng(0)
     random_act = lambda obs: rng.integers(0, 4, obs.shape)
     rows = []

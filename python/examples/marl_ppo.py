@@ -14,14 +14,22 @@ softmax), so PPO's ratios are as usual; but a state's action stays the same
 for hundreds of steps, as a greedy learner's does. With actions sampled
 afresh at every step (--redraw 0) no setting we tried formed an annulus
 (docs/python.md, "How the greedy learner explores").
+
+It prints a line every update, logs as CleanRL does (each ended episode's
+return, length and last Eval, the losses and steps per second, to
+runs/RUN/scalars.csv and to TensorBoard when it is installed: run_log.py),
+and ends with a summary that holds the held-out evaluation: the exported
+table run greedily on the evaluation seeds, none of them trained on.
 """
 import argparse
+import time
 
 import numpy as np
 import torch
 from torch import nn
 
 import zumo_swarm
+from run_log import RunLog, held_out
 
 
 def parse(argv=None):
@@ -41,6 +49,8 @@ def parse(argv=None):
     p.add_argument("--ent-coef", type=float, default=0.0)
     p.add_argument("--redraw", type=int, default=5, help="updates between draws of each world's exploration noise (0: sample every step)")
     p.add_argument("--out", default="out/marl-annulus.policy")
+    p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each evaluation seed")
+    p.add_argument("--run-dir", help="the log's directory (default runs/marl_ppo__SEED__TIME)")
     args = p.parse_args(argv)
     if args.redraw < 0:
         p.error(f"--redraw {args.redraw}: expected a number of updates, 0 or more")
@@ -72,7 +82,9 @@ class Agent(nn.Module):
             return self(torch.arange(self.states))[0].argmax(-1).numpy()
 
 
-def train(args):
+def train(args, log=None):
+    """The trained agent, its env and what it logged (``log``: a
+    :class:`run_log.RunLog`, or None to log nothing but the printed lines)."""
     torch.manual_seed(args.seed)
     torch.set_num_threads(1)  # small network: more threads only contend with the simulator's
     env = zumo_swarm.RecordRobotEpisodeStatistics(zumo_swarm.vector_env(
@@ -84,8 +96,10 @@ def train(args):
     optimiser = torch.optim.Adam(agent.parameters(), lr=args.lr)
     W, R, T = args.worlds, batch.robots, args.rollout
     obs = torch.as_tensor(env.reset(seed=args.seed)[0])
-    log = {"episodes": [], "formations": 0}
-    for update in range(max(1, args.steps // (W * T))):
+    record = {"episodes": [], "formations": 0}
+    scalar = log.scalar if log else lambda *_: None
+    updates, start = max(1, args.steps // (W * T)), time.perf_counter()
+    for update in range(updates):
         if args.redraw and update % args.redraw == 0:  # each world's draw of the policy: Gumbel noise per state
             gumbel = gumbel_noise((W, batch.num_states, len(batch.angular_speeds)))
         states, actions, logps, values = (torch.zeros((T, W, R), dtype=d) for d in (torch.long, torch.long, torch.float, torch.float))
@@ -105,8 +119,13 @@ def train(args):
             if "episode" in info:
                 ended = info["_episode"]
                 # an ended episode's return, and its last Eval (same-step autoreset reports the ending step's)
-                log["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
-        log["formations"] = int(info["formations"].sum())
+                record["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
+                step = (update * T + t + 1) * W
+                for world in np.flatnonzero(ended):
+                    scalar("charts/episodic_return", info["episode"]["r"][world], step)
+                    scalar("charts/episodic_length", info["episode"]["l"][world], step)
+                    scalar("charts/episodic_eval", info["eval"][world], step)
+        record["formations"] = int(info["formations"].sum())
         with torch.no_grad():  # generalised advantage estimation, robot by robot
             next_value = agent(obs)[1]
             advantages, last = torch.zeros_like(rewards), torch.zeros((W, R))
@@ -127,18 +146,46 @@ def train(args):
                 ratio = (dist.log_prob(a) - old).exp()
                 adv = (adv - adv.mean()) / (adv.std() + 1e-8)
                 policy_loss = torch.max(-adv * ratio, -adv * ratio.clamp(1 - args.clip, 1 + args.clip)).mean()
-                loss = policy_loss + 0.5 * ((value - ret) ** 2).mean() - args.ent_coef * dist.entropy().mean()
+                value_loss, entropy = 0.5 * ((value - ret) ** 2).mean(), dist.entropy().mean()
+                loss = policy_loss + value_loss - args.ent_coef * entropy
                 optimiser.zero_grad()
                 loss.backward()
                 nn.utils.clip_grad_norm_(agent.parameters(), 0.5)
                 optimiser.step()
-        if env.return_queue:
-            print(f"update {update}: {log['formations']} formed, mean episode return {np.mean(env.return_queue):.3f}, Eval {info['eval'].mean():.4f}")
-    return agent, env, log
+        step, sps = (update + 1) * T * W, (update + 1) * T * W / (time.perf_counter() - start)
+        with torch.no_grad():  # the last minibatch's, as CleanRL logs them
+            approx_kl = ((ratio - 1) - (ratio.log())).mean().item()
+            clipfrac = ((ratio - 1.0).abs() > args.clip).float().mean().item()
+        for tag, value in [("losses/policy_loss", policy_loss.item()), ("losses/value_loss", value_loss.item()),
+                           ("losses/entropy", entropy.item()), ("losses/approx_kl", approx_kl),
+                           ("losses/clipfrac", clipfrac), ("charts/formations", record["formations"]),
+                           ("charts/eval", info["eval"].mean()), ("charts/SPS", sps)]:
+            scalar(tag, value, step)
+        returns_so_far = f"{np.mean(env.return_queue):.3f}" if env.return_queue else "none ended yet"
+        print(f"update {update + 1}/{updates}, step {step:,}: {record['formations']} formed, "
+              f"mean episode return {returns_so_far}, Eval {info['eval'].mean():.4f}, {sps:,.0f} steps/s", flush=True)
+    return agent, env, record
+
+
+def main(argv=None):
+    """Trains, exports the greedy table, evaluates it on the held-out seeds
+    and prints the summary; returns the summary."""
+    args = parse(argv)
+    log = RunLog("marl_ppo", vars(args), args.run_dir)
+    agent, env, record = train(args, log)
+    seconds = log.seconds()
+    path = zumo_swarm.export_policy(args.out, agent.table(), env=env, trainer_steps=args.steps, seed=args.seed)
+    evaluation = held_out(zumo_swarm.load_policy(path).act, args.eval_steps, log, args.steps)
+    summary = {
+        "trained": f"{args.steps:,} world-steps in {seconds:.1f} s, reward {args.reward}, seed {args.seed}",
+        "while training": f"{record['formations']} formations, {env.episode_count} episodes ended"
+        + (f", mean return of the last {len(env.return_queue)} {np.mean(env.return_queue):.3f}" if env.return_queue else ""),
+        "held-out evaluation": evaluation,
+        "policy": str(path),
+    }
+    log.finish(summary)
+    return summary
 
 
 if __name__ == "__main__":
-    args = parse()
-    agent, env, log = train(args)
-    print(f"{log['formations']} annuli formed in {args.steps} world-steps")
-    zumo_swarm.export_policy(args.out, agent.table(), env=env, trainer_steps=args.steps, seed=args.seed)
+    main()

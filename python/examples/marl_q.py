@@ -20,6 +20,12 @@ exports, as `host train --select-every` keeps its best policy: the table
 of the last step need not be the best the learner passed through. It
 exports the Q-table: each state's best actions, among which the robot
 picks as the learner did.
+
+It logs as CleanRL does (each ended episode's return, length and last
+Eval, each evaluation, to runs/RUN/scalars.csv and to TensorBoard when it
+is installed: run_log.py) and ends with a summary that holds the held-out
+evaluation: the exported table run greedily on the evaluation seeds, none
+of them trained on (nor the world it selects on).
 """
 import argparse
 
@@ -28,6 +34,7 @@ import torch
 from torch import nn
 
 import zumo_swarm
+from run_log import RunLog, held_out
 
 
 def parse(argv=None):
@@ -43,6 +50,8 @@ def parse(argv=None):
     p.add_argument("--select-steps", type=int, default=50_000, help="steps of each evaluation")
     p.add_argument("--max-steps", type=int, help="episode truncation (default none: an episode ends when it forms or is stuck)")
     p.add_argument("--out", default="out/marl-q-annulus.policy")
+    p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each evaluation seed")
+    p.add_argument("--run-dir", help="the log's directory (default runs/marl_q__SEED__TIME)")
     return p.parse_args(argv)
 
 
@@ -83,7 +92,9 @@ def greedy_formations(table, seed, steps):
     return int(info["formations"][0])
 
 
-def train(args):
+def train(args, log=None):
+    """The Q-network, its env and what it logged (``log``: a
+    :class:`run_log.RunLog`, or None to log nothing but the printed lines)."""
     torch.manual_seed(args.seed)
     torch.set_num_threads(1)  # small network: more threads only contend with the simulator's
     generator = torch.Generator().manual_seed(args.seed)
@@ -96,7 +107,8 @@ def train(args):
     optimiser = torch.optim.SGD(q.parameters(), lr=args.lr)
     obs = torch.as_tensor(env.reset(seed=args.seed)[0])
     judge_seed = args.seed + 1_000_000  # the evaluation world's: no training world's
-    log = {"formations": 0, "episodes": [], "selected": q.values(), "selected_step": 0, "selected_formations": -1}
+    record = {"formations": 0, "episodes": [], "selected": q.values(), "selected_step": 0, "selected_formations": -1}
+    scalar = log.scalar if log else lambda *_: None
     calls = max(1, args.steps // args.worlds)
     every = max(1, args.select_every // args.worlds)
     for call in range(calls):
@@ -115,23 +127,50 @@ def train(args):
         loss.backward()
         optimiser.step()
         obs = torch.as_tensor(next_obs)
+        step = (call + 1) * args.worlds
         if "episode" in info:
             ended = info["_episode"]
-            log["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
+            record["episodes"].append((float(info["episode"]["r"][ended].mean()), float(info["eval"][ended].mean())))
+            for world in np.flatnonzero(ended):
+                scalar("charts/episodic_return", info["episode"]["r"][world], step)
+                scalar("charts/episodic_length", info["episode"]["l"][world], step)
+                scalar("charts/episodic_eval", info["eval"][world], step)
         if (call + 1) % every == 0 or call == calls - 1:
             values = q.values()
             formed = greedy_formations(values.argmax(-1), judge_seed, args.select_steps)  # the lowest of equal actions
-            if formed > log["selected_formations"]:
-                log.update(selected=values, selected_step=(call + 1) * args.worlds, selected_formations=formed)
+            scalar("eval/selection_formations", formed, step)
+            if formed > record["selected_formations"]:
+                record.update(selected=values, selected_step=step, selected_formations=formed)
+            print(f"step {step}: the greedy table formed {formed} on the selection world "
+                  f"(best so far: {record['selected_formations']}, of step {record['selected_step']})", flush=True)
         if call % 25_000 == 0 or call == calls - 1:
-            log["formations"] = int(info["formations"].sum())
-            print(f"step {(call + 1) * args.worlds}: {log['formations']} formed, Eval {info['eval'].mean():.4f}")
-    return q, env, log
+            record["formations"] = int(info["formations"].sum())
+            scalar("charts/formations", record["formations"], step)
+            scalar("charts/eval", info["eval"].mean(), step)
+            print(f"step {step}: {record['formations']} formed, Eval {info['eval'].mean():.4f}", flush=True)
+    return q, env, record
+
+
+def main(argv=None):
+    """Trains, exports the selected table, evaluates it on the held-out
+    seeds and prints the summary; returns the summary."""
+    args = parse(argv)
+    log = RunLog("marl_q", vars(args), args.run_dir)
+    q, env, record = train(args, log)
+    seconds = log.seconds()
+    path = zumo_swarm.export_policy(args.out, record["selected"], env=env, trainer_steps=args.steps, seed=args.seed)
+    evaluation = held_out(zumo_swarm.load_policy(path).act, args.eval_steps, log, args.steps)
+    summary = {
+        "trained": f"{args.steps:,} world-steps in {seconds:.1f} s, reward {args.reward}, seed {args.seed}",
+        "while training": f"{record['formations']} formations, {env.episode_count} episodes ended",
+        "selected": f"the table of step {record['selected_step']:,}, {record['selected_formations']} formations "
+        f"on the selection world",
+        "held-out evaluation": evaluation,
+        "policy": str(path),
+    }
+    log.finish(summary)
+    return summary
 
 
 if __name__ == "__main__":
-    args = parse()
-    q, env, log = train(args)
-    print(f"{log['formations']} annuli formed in {args.steps} world-steps; the table of step {log['selected_step']} "
-          f"formed {log['selected_formations']} on the evaluation world")
-    zumo_swarm.export_policy(args.out, log["selected"], env=env, trainer_steps=args.steps, seed=args.seed)
+    main()

@@ -6,12 +6,14 @@ is a table over hashed states, exactly what a robot looks up; the critic sees ev
 (the reward is the world's). Exploration is consistent in time, as in marl_ppo.py: each world acts
 on its own draw of the policy (Gumbel noise fixed per world, robot and state), redrawn every few
 rollouts; SB3 would sample every discrete action afresh, which learns nothing here (docs/python.md).
-VecMonitor logs each episode's return and last Eval (add tensorboard_log="runs" to PPO for
-TensorBoard). Every 100,000 steps the greedy table runs on one evaluation world, and the table that
-formed most there is the one exported as a policy blob (as marl_q.py and `host train --select-every`
-keep their best).
+VecMonitor measures each episode's return and last Eval; they are logged as CleanRL logs them, with
+each evaluation, to runs/RUN/scalars.csv and to TensorBoard when it is installed (run_log.py), and SB3
+prints its table every rollout. Every 100,000 steps the greedy table runs on one evaluation world, and
+the table that formed most there is the one exported as a policy blob (as marl_q.py and `host train
+--select-every` keep their best). The run ends with a summary that holds the held-out evaluation: the
+exported table run greedily on the evaluation seeds, none of them trained or selected on.
 """
-import sys
+import argparse
 
 import numpy as np
 import torch
@@ -25,6 +27,7 @@ from torch import nn
 import zumo_swarm
 from marl_ppo import gumbel_noise
 from marl_q import greedy_formations
+from run_log import RunLog, held_out
 from zumo_swarm.sb3 import SB3VecEnv
 
 
@@ -106,9 +109,9 @@ class SelectTable(BaseCallback):
     """Every `every` steps and at the end, runs the greedy table for `steps` steps on the evaluation
     world of `seed`; `selected` is the table that formed most there (the earliest of equals)."""
 
-    def __init__(self, every, steps, seed):
+    def __init__(self, every, steps, seed, log=None):
         super().__init__()
-        self.every, self.steps, self.seed, self.checks = every, steps, seed, 0
+        self.every, self.steps, self.seed, self.checks, self.log = every, steps, seed, 0, log
         self.selected, self.formed = None, -1
 
     def _on_step(self):
@@ -117,6 +120,8 @@ class SelectTable(BaseCallback):
     def _judge(self):
         table = self.model.policy.table()
         formed = greedy_formations(table, self.seed, self.steps)
+        if self.log:
+            self.log.scalar("eval/selection_formations", formed, self.num_timesteps)
         if formed > self.formed:
             self.selected, self.formed = table, formed
 
@@ -141,9 +146,24 @@ class LogEval(BaseCallback):
             self.logger.record("rollout/ep_eval_mean", float(np.mean(evals)))
 
 
+class LogEpisodes(BaseCallback):
+    """Logs each ended episode's return, length and last Eval as CleanRL does."""
+
+    def __init__(self, log):
+        super().__init__()
+        self.log = log
+
+    def _on_step(self):
+        for info in self.locals["infos"]:
+            if "episode" in info:
+                for key, tag in [("r", "episodic_return"), ("l", "episodic_length"), ("eval", "episodic_eval")]:
+                    self.log.scalar(f"charts/{tag}", info["episode"][key], self.num_timesteps)
+        return True
+
+
 def train(steps=1_000_000, seed=1, reward="reference", worlds=16, max_steps=10_000, gamma=0.9, redraw=5,
-          select_every=100_000, select_steps=50_000):
-    """The trained model, its env and the selected greedy table."""
+          select_every=100_000, select_steps=50_000, log=None):
+    """The trained model, its env and the selected greedy table (`log`: a run_log.RunLog, or None)."""
     torch.set_num_threads(1)  # small network: more threads only contend with the simulator's
     env = VecMonitor(
         SB3VecEnv(worlds, observation="state", reward=reward, gamma=gamma, max_steps=max_steps, seed=seed),
@@ -151,12 +171,34 @@ def train(steps=1_000_000, seed=1, reward="reference", worlds=16, max_steps=10_0
     )
     model = PPO(SharedRobotPolicy, env, n_steps=128, batch_size=512, n_epochs=4, learning_rate=1e-3,
                 gamma=gamma, gae_lambda=0.9, verbose=1, seed=seed)
-    select = SelectTable(select_every, select_steps, seed + 1_000_000)  # no training world's seed
-    model.learn(total_timesteps=steps, callback=[LogEval(), Redraw(redraw, seed), select])
+    select = SelectTable(select_every, select_steps, seed + 1_000_000, log)  # no training world's seed
+    callbacks = [LogEval(), Redraw(redraw, seed), select] + ([LogEpisodes(log)] if log else [])
+    model.learn(total_timesteps=steps, callback=callbacks)
     return model, env, select.selected
 
 
+def main(argv=None):
+    """Trains, exports the selected table, evaluates it on the held-out seeds and prints the summary."""
+    p = argparse.ArgumentParser(description=__doc__)
+    p.add_argument("steps", nargs="?", type=int, default=1_000_000, help="world-steps, all worlds together")
+    p.add_argument("--out", default="out/ppo-annulus.policy")
+    p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each seed")
+    p.add_argument("--run-dir", help="the log's directory (default runs/ppo_sb3__1__TIME)")
+    args = p.parse_args(argv)
+    log = RunLog("ppo_sb3", {**vars(args), "seed": 1}, args.run_dir)
+    model, env, table = train(args.steps, log=log)
+    seconds = log.seconds()
+    path = zumo_swarm.export_policy(args.out, table, env=env.venv.venv, trainer_steps=args.steps, seed=1)
+    summary = {
+        "trained": f"{args.steps:,} world-steps in {seconds:.1f} s, reward reference, seed 1",
+        "while training": f"{env.venv.formations} formations, mean return of the last {len(model.ep_info_buffer)} "
+        f"episodes {np.mean([e['r'] for e in model.ep_info_buffer] or [np.nan]):.3f}",
+        "held-out evaluation": held_out(zumo_swarm.load_policy(path).act, args.eval_steps, log, args.steps),
+        "policy": str(path),
+    }
+    log.finish(summary)
+    return summary
+
+
 if __name__ == "__main__":
-    steps = int(sys.argv[1]) if len(sys.argv) > 1 else 1_000_000
-    model, env, table = train(steps)
-    zumo_swarm.export_policy("out/ppo-annulus.policy", table, env=env.venv.venv, trainer_steps=steps, seed=1)
+    main()

@@ -43,6 +43,15 @@ fn step_error(e: StepError) -> PyErr {
     }
 }
 
+/// The seeds `reset` takes: the first world's, or one per world.
+#[derive(FromPyObject)]
+enum Seeds {
+    /// World `i`: this seed + `i`.
+    First(i64),
+    /// One per world.
+    Each(Vec<i64>),
+}
+
 /// Worlds of one configuration, stepped together.
 #[pyclass(module = "zumo_swarm._native", name = "Batch")]
 pub struct PyBatch {
@@ -156,15 +165,9 @@ impl PyBatch {
             actions: actions.unwrap_or_else(|| ActionTable::DEFAULT_ANGULAR.to_vec()),
             forward_speed,
         };
-        if num_worlds < 1 {
-            return Err(value_error(format!(
-                "num_worlds = {num_worlds}: must be a whole number of at least 1"
-            )));
-        }
         // before any world is allocated
-        sim::base::ranges::WORLDS
-            .check_count("num_worlds", num_worlds as u64)
-            .map_err(|e| value_error(e.to_string()))?;
+        let num_worlds = settings::count(&sim::base::ranges::WORLDS, "num_worlds", num_worlds)
+            .map_err(value_error)?;
         let autoreset = match autoreset.as_str() {
             "off" => Autoreset::Off,
             "next-step" => Autoreset::NextStep,
@@ -177,18 +180,10 @@ impl PyBatch {
         };
         let threads = match threads {
             None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-            Some(t) if t >= 1 => {
-                sim::base::ranges::THREADS
-                    .check_count("threads", t as u64)
-                    .map_err(|e| value_error(e.to_string()))?;
-                t as usize
-            }
-            Some(t) => {
-                return Err(value_error(format!(
-                    "threads = {t}: must be a whole number of at least 1"
-                )))
-            }
+            Some(t) => settings::count(&sim::base::ranges::THREADS, "threads", t)
+                .map_err(value_error)? as usize,
         };
+        settings::world_seeds(args.seed, num_worlds as usize).map_err(value_error)?;
         let batch = py
             .detach(|| {
                 let settings = args.settings().map_err(|e| e.to_string())?;
@@ -298,33 +293,30 @@ impl PyBatch {
     }
 
     /// Starts every world's next episode (the first reset of a world just
-    /// built keeps the episode its seed laid out); with `seeds`, one per
-    /// world, each world starts afresh from its seed. Returns the
+    /// built keeps the episode its seed laid out); with `seeds`, a list of
+    /// one per world, or one number, the first world's (world `i`: `seeds +
+    /// i`), each world starts afresh from its seed. Returns the
     /// observations.
     #[pyo3(signature = (seeds = None))]
-    fn reset<'py>(
-        &mut self,
-        py: Python<'py>,
-        seeds: Option<Vec<i64>>,
-    ) -> PyResult<Bound<'py, PyAny>> {
+    fn reset<'py>(&mut self, py: Python<'py>, seeds: Option<Seeds>) -> PyResult<Bound<'py, PyAny>> {
         let n = self.batch.worlds().len();
         let seeds = match seeds {
-            Some(s) if s.len() != n => {
+            None => None,
+            Some(Seeds::First(first)) => {
+                Some(settings::world_seeds(first, n).map_err(value_error)?)
+            }
+            Some(Seeds::Each(s)) if s.len() != n => {
                 return Err(value_error(format!(
                     "seed: got {} seeds for {n} worlds",
                     s.len()
                 )))
             }
-            Some(s) => Some(
+            Some(Seeds::Each(s)) => Some(
                 s.iter()
-                    .map(|&x| {
-                        u64::try_from(x).map_err(|_| {
-                            value_error(format!("seed = {x}: must be a whole number of at least 0"))
-                        })
-                    })
-                    .collect::<PyResult<Vec<u64>>>()?,
+                    .map(|&x| settings::world_seeds(x, 1).map(|one| one[0]))
+                    .collect::<Result<Vec<u64>, _>>()
+                    .map_err(value_error)?,
             ),
-            None => None,
         };
         let batch = &mut self.batch;
         let obs = py
@@ -673,6 +665,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         Reward::ALL.iter().map(|r| r.name()).collect::<Vec<_>>(),
     )?;
     m.add("SENSORS", SensorChoice::NAMES)?;
+    m.add("SEED_RANGE", settings::SEED_RANGE)?;
     m.add("DEFAULT_ANGULAR", ActionTable::DEFAULT_ANGULAR.to_vec())?;
     m.add("DEFAULT_FORWARD_SPEED", ActionTable::DEFAULT_FORWARD_SPEED)?;
     m.add(

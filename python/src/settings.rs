@@ -7,6 +7,7 @@
 //! `thresholds`, `reward`, the observation and action kinds).
 
 use shared::{ActionTable, StateHasher};
+use sim::base::ranges::{Range, RangeError, PUCKS, ROBOTS, STEPS};
 use sim::config::validate::ConfigError;
 use sim::config::{SimConfig, Thresholds};
 use sim::episodes::reward::Reward;
@@ -17,6 +18,10 @@ use sim::scenario::sensor_setup::SensorSetup;
 use sim::scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
 use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
+
+/// What a seed must be: the environments take 64-bit signed integers, as
+/// NumPy's seeds are, so the largest is `i64::MAX`.
+pub const SEED_RANGE: &str = "must be a whole number from 0 to 2**63 - 1";
 
 /// A keyword argument that cannot be used: `name = value: problem`.
 #[derive(Clone, Debug, PartialEq)]
@@ -181,15 +186,30 @@ pub struct EnvSettings {
     pub trained_for: shared::TrainedFor,
 }
 
-fn count(name: &str, value: i64, min: i64) -> Result<usize, ArgumentError> {
-    if value < min {
+/// A count or step number, inside its row of the ranges table: every
+/// refusal worded as the table words it (`pucks = 0: outside its plausible
+/// range [1, 100000] (...)`), whichever side of the range it falls.
+pub fn count(range: &'static Range, name: &str, value: i64) -> Result<u64, RangeError> {
+    range.check_as(name, value as f64)?;
+    // inside the range, so at least its minimum, which is not negative
+    Ok(value.unsigned_abs())
+}
+
+/// The seeds of `worlds` worlds numbered from `first` (world `i`: `first +
+/// i`), each a seed of [`SEED_RANGE`]; `first` is named `seed` in errors.
+pub fn world_seeds(first: i64, worlds: usize) -> Result<Vec<u64>, ArgumentError> {
+    let first = u64::try_from(first).map_err(|_| ArgumentError::new("seed", first, SEED_RANGE))?;
+    let last = first.saturating_add(worlds.saturating_sub(1) as u64);
+    if last > i64::MAX as u64 {
         return Err(ArgumentError::new(
-            name,
-            value,
-            format!("must be a whole number of at least {min}"),
+            "seed",
+            first,
+            format!(
+                "with {worlds} worlds (world i is seeded seed + i) must be a whole number from 0 to 2**63 - {worlds}"
+            ),
         ));
     }
-    usize::try_from(value).map_err(|_| ArgumentError::new(name, value, "is too large"))
+    Ok((first..=last).collect())
 }
 
 fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, ArgumentError> {
@@ -237,6 +257,8 @@ fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, Argume
 pub enum SettingsError {
     /// One argument is wrong on its own.
     Argument(ArgumentError),
+    /// A count outside its row of the ranges table.
+    Range(RangeError),
     /// The simulator refused the combination.
     Scenario(ScenarioError),
 }
@@ -245,12 +267,19 @@ impl fmt::Display for SettingsError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             SettingsError::Argument(e) => e.fmt(f),
+            SettingsError::Range(e) => e.fmt(f),
             SettingsError::Scenario(e) => e.fmt(f),
         }
     }
 }
 
 impl std::error::Error for SettingsError {}
+
+impl From<RangeError> for SettingsError {
+    fn from(e: RangeError) -> SettingsError {
+        SettingsError::Range(e)
+    }
+}
 
 impl From<ArgumentError> for SettingsError {
     fn from(e: ArgumentError) -> SettingsError {
@@ -265,14 +294,17 @@ impl EnvArgs {
         let field: FieldSource = self.field.parse().map_err(|e| {
             ArgumentError::new("field", format!("{:?}", self.field), format!("{e}"))
         })?;
-        let robots = self.robots.map(|r| count("robots", r, 1)).transpose()?;
-        let pucks = self.pucks.map(|p| count("pucks", p, 0)).transpose()?;
-        let seed = u64::try_from(self.seed).map_err(|_| {
-            ArgumentError::new("seed", self.seed, "must be a whole number of at least 0")
-        })?;
+        let robots = self
+            .robots
+            .map(|r| count(&ROBOTS, "robots", r))
+            .transpose()?;
+        let pucks = self.pucks.map(|p| count(&PUCKS, "pucks", p)).transpose()?;
+        // inside their ranges, so they fit
+        let (robots, pucks) = (robots.map(|r| r as usize), pucks.map(|p| p as usize));
+        let seed = world_seeds(self.seed, 1)?[0];
         let max_steps = self
             .max_steps
-            .map(|m| count("max_steps", m, 1).map(|m| m as u64))
+            .map(|m| count(&STEPS, "max_steps", m))
             .transpose()?;
         let reward: Reward = self
             .reward
@@ -283,28 +315,28 @@ impl EnvArgs {
                 ArgumentError::new("gamma", self.gamma, "must be a discount in [0, 1]").into(),
             );
         }
+        // The hasher is checked whatever the observation, so that a setting
+        // the environment would ignore is not taken silently.
+        let hasher = StateHasher::from_name(&self.hasher).ok_or_else(|| {
+            ArgumentError::new(
+                "hasher",
+                format!("{:?}", self.hasher),
+                format!("unknown hasher; expected {}", StateHasher::NAMES),
+            )
+        })?;
+        if hasher.has_role_bit() {
+            // The environments have no innies yet, so every state would be
+            // an outie's: refuse rather than mislead.
+            return Err(ArgumentError::new(
+                "hasher",
+                format!("{:?}", self.hasher),
+                "the role layout needs innies, which the Python environments do not have yet",
+            )
+            .into());
+        }
         let observation = match self.observation.as_str() {
             "reading" => ObservationKind::Reading,
-            "state" => {
-                let hasher = StateHasher::from_name(&self.hasher).ok_or_else(|| {
-                    ArgumentError::new(
-                        "hasher",
-                        format!("{:?}", self.hasher),
-                        format!("unknown hasher; expected {}", StateHasher::NAMES),
-                    )
-                })?;
-                if hasher.has_role_bit() {
-                    // The environments have no innies yet, so every state
-                    // would be an outie's: refuse rather than mislead.
-                    return Err(ArgumentError::new(
-                        "hasher",
-                        format!("{:?}", self.hasher),
-                        "the role layout needs innies, which the Python environments do not have yet",
-                    )
-                    .into());
-                }
-                ObservationKind::State(hasher)
-            }
+            "state" => ObservationKind::State(hasher),
             other => {
                 return Err(ArgumentError::new(
                     "observation",
@@ -462,17 +494,71 @@ mod tests {
     }
 
     #[test]
+    fn a_count_is_refused_in_the_ranges_tables_words_on_either_side_of_its_range() {
+        for pucks in [-3, 0, 100_001] {
+            let e = error_of(EnvArgs {
+                pucks: Some(pucks),
+                ..EnvArgs::default()
+            });
+            let expected = format!("pucks = {pucks}: outside its plausible range [1, 100000] (");
+            assert!(e.starts_with(&expected), "{e}");
+        }
+        let e = error_of(EnvArgs {
+            max_steps: Some(-1),
+            ..EnvArgs::default()
+        });
+        assert!(
+            e.starts_with("max_steps = -1: outside its plausible range [1, 1e10] steps"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn the_hasher_is_checked_whatever_the_observation() {
+        for observation in ["reading", "state"] {
+            let e = error_of(EnvArgs {
+                observation: observation.into(),
+                hasher: "original-role".into(),
+                ..EnvArgs::default()
+            });
+            assert!(
+                e.starts_with("hasher = \"original-role\": the role layout needs innies"),
+                "{e}"
+            );
+            let e = error_of(EnvArgs {
+                observation: observation.into(),
+                hasher: "md5".into(),
+                ..EnvArgs::default()
+            });
+            assert!(e.starts_with("hasher = \"md5\": unknown hasher"), "{e}");
+        }
+    }
+
+    #[test]
+    fn every_worlds_seed_is_at_most_2_to_the_63_minus_1() {
+        assert_eq!(world_seeds(5, 3).unwrap(), [5, 6, 7]);
+        assert_eq!(world_seeds(i64::MAX, 1).unwrap(), [i64::MAX as u64]);
+        assert_eq!(
+            world_seeds(-1, 1).unwrap_err().to_string(),
+            "seed = -1: must be a whole number from 0 to 2**63 - 1"
+        );
+        assert_eq!(
+            world_seeds(i64::MAX - 1, 3).unwrap_err().to_string(),
+            "seed = 9223372036854775806: with 3 worlds (world i is seeded seed + i) \
+             must be a whole number from 0 to 2**63 - 3"
+        );
+    }
+
+    #[test]
     fn each_bad_argument_is_named_with_its_value_and_problem() {
         let e = error_of(EnvArgs {
             robots: Some(0),
             ..EnvArgs::default()
         });
-        assert_eq!(e, "robots = 0: must be a whole number of at least 1");
-        let e = error_of(EnvArgs {
-            pucks: Some(-3),
-            ..EnvArgs::default()
-        });
-        assert!(e.starts_with("pucks = -3: "), "{e}");
+        assert!(
+            e.starts_with("robots = 0: outside its plausible range [1, 1000] ("),
+            "{e}"
+        );
         let e = error_of(EnvArgs {
             sensors: "pixy".into(),
             ..EnvArgs::default()

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from zumo_swarm._native import Batch
+from zumo_swarm._native import SEED_RANGE, Batch
 
 #: Render modes of every environment: the picture ``host render`` draws.
 RENDER_MODES = ["rgb_array"]
@@ -33,17 +33,32 @@ ONE_WORLD_RENDER_MODES = ["rgb_array", "human"]
 #: keyword arguments, less those the environments set themselves.
 SETTINGS = tuple(name for name in inspect.signature(Batch).parameters if name not in ("num_worlds", "autoreset", "threads"))
 
-#: Settings that are whole numbers (``None`` for the default).
-WHOLE_NUMBERS = ("robots", "pucks", "seed", "max_steps")
+#: Settings that are whole numbers (``None`` for the default); the seed is
+#: checked by :func:`check_seed`.
+WHOLE_NUMBERS = ("robots", "pucks", "max_steps")
+
+#: The largest seed: seeds are 64-bit signed integers, as NumPy's are.
+MAX_SEED = 2**63 - 1
 
 
-def check_whole(name: str, value: Any) -> None:
-    """``value`` a whole number of at most 64 bits; the simulator checks
-    its range."""
+def check_whole(name: str, value: Any) -> int:
+    """``value`` a whole number of 64 bits (signed); the simulator checks
+    its range, as its table of ranges words it."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
         raise TypeError(f"{name} = {value!r}: expected a whole number")
-    if not -(2**63) <= int(value) < 2**64:
-        raise ValueError(f"{name} = {value}: too large (at most 2**64 - 1)")
+    if not -(2**63) <= int(value) <= 2**63 - 1:
+        raise ValueError(f"{name} = {value}: not a 64-bit whole number (-2**63 to 2**63 - 1)")
+    return int(value)
+
+
+def check_seed(value: Any) -> int:
+    """``value`` a seed, 0 to :data:`MAX_SEED` (the simulator checks the
+    seeds of the other worlds of a vector env with the same words)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"seed = {value!r}: expected a whole number")
+    if not 0 <= int(value) <= MAX_SEED:
+        raise ValueError(f"seed = {value}: {SEED_RANGE}")
+    return int(value)
 
 
 def check_names(settings: Mapping[str, Any], own: tuple[str, ...]) -> None:
@@ -68,10 +83,12 @@ def make_batch(
     check_whole("num_worlds", num_worlds)
     if threads is not None:
         check_whole("threads", threads)
+    settings = dict(settings)
     for name in WHOLE_NUMBERS:
         if settings.get(name) is not None:
-            check_whole(name, settings[name])
-    settings = dict(settings)
+            settings[name] = check_whole(name, settings[name])
+    if "seed" in settings:
+        settings["seed"] = check_seed(settings["seed"])
     config = settings.get("robot_config")
     if isinstance(config, Mapping):
         settings["robot_config"] = json.dumps(config)
@@ -150,7 +167,31 @@ def world_info(info: dict[str, np.ndarray], world: int) -> dict[str, Any]:
     return {key: value[world].item() for key, value in info.items() if not key.startswith("_") and key != "final_obs"}
 
 
-class OneWorld:
+class Lifecycle:
+    """The order of calls Gymnasium and PettingZoo define, enforced:
+    ``reset()`` before the first ``step()``, and neither after ``close()``
+    (a closed environment has let its live view go)."""
+
+    _reset_done = False
+    _closed = False
+
+    def _check_open(self, call: str) -> None:
+        """Refuses ``call`` on a closed environment."""
+        if self._closed:
+            raise RuntimeError(f"{call}() after close(): the environment is closed; make a new one")
+
+    def _check_step(self) -> None:
+        """Refuses a step before the first reset or after close."""
+        self._check_open("step")
+        if not self._reset_done:
+            raise RuntimeError("step() before reset(): call reset() first, as Gymnasium and PettingZoo ask")
+
+    def _was_reset(self) -> None:
+        """Notes a reset: steps may follow."""
+        self._reset_done = True
+
+
+class OneWorld(Lifecycle):
     """What the environments of one world share: drawing it, its live view
     and its bodies (the class has ``_batch``, ``render_mode`` and
     ``render_size``)."""
@@ -175,9 +216,11 @@ class OneWorld:
         return self._batch.render(0, self.render_size)
 
     def close(self) -> None:
-        """Stops the live view, if one is served."""
+        """Stops the live view, if one is served; the environment takes no
+        more steps nor resets."""
         self._batch.close_view()
         self.view_url = None
+        self._closed = True
 
     def positions(self):
         """Bodies' positions (robots first, then pucks) and the robots' headings."""

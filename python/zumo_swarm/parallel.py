@@ -12,6 +12,7 @@ from zumo_swarm._settings import (
     ONE_WORLD_RENDER_MODES,
     OneWorld,
     check_render,
+    check_seed,
     flat_actions,
     make_batch,
     robot_action_space,
@@ -34,8 +35,10 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
     ``formations``, ``stuck_episodes``, ``total_steps``, ``mean_eval``,
     ``collisions_per_1000`` since the world was seeded.
 
-    ``reset(seed=s)`` starts afresh from seed ``s`` (``host run --seed s``
-    starts from the same world); ``reset()`` starts the next episode.
+    ``reset(seed=s)`` starts afresh from seed ``s`` (0 to 2**63 - 1; ``host
+    run --seed s`` starts from the same world); ``reset()`` starts the next
+    episode. ``step()`` before the first ``reset()``, or either after
+    ``close()``, raises ``RuntimeError``.
     Keyword arguments: see :func:`zumo_swarm.parallel_env`.
     """
 
@@ -65,13 +68,16 @@ class SwarmParallelEnv(OneWorld, ParallelEnv):
         return {agent: obs[i] for i, agent in enumerate(self.possible_agents)}
 
     def reset(self, seed: int | None = None, options: dict | None = None):
-        obs = self._batch.reset(None if seed is None else [seed])[0]
+        self._check_open("reset")
+        obs = self._batch.reset(None if seed is None else check_seed(seed))[0]
+        self._was_reset()
         self.agents = list(self.possible_agents)
         return self._observations(obs), {agent: {} for agent in self.agents}
 
     def step(self, actions: dict[str, Any]):
+        self._check_step()
         if not self.agents:
-            raise RuntimeError("step() without live agents: the episode has ended (or never began): call reset()")
+            raise RuntimeError("step() without live agents: the episode has ended: call reset()")
         missing = [agent for agent in self.possible_agents if agent not in actions]
         if missing:
             raise ValueError(f"actions: no action for {', '.join(missing)}")

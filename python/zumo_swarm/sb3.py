@@ -4,11 +4,18 @@ observation stacked, ``MultiDiscrete`` actions, the global reward), the
 worlds stepped in Rust threads. Needs ``stable-baselines3`` (not a
 dependency of this package)::
 
+    import torch
     from stable_baselines3 import PPO
     from zumo_swarm.sb3 import SB3VecEnv
 
+    torch.set_num_threads(1)  # the worlds' threads have the cores
     env = SB3VecEnv(16, max_steps=2_000)
     PPO("MlpPolicy", env).learn(1_000_000)
+
+``torch.set_num_threads(1)`` first: PyTorch's default, a thread per core,
+contends with the worlds' threads for every core, and a small network
+gains nothing from them (without it this example ran SLOWDOWN times
+slower on 2 cores, docs/python.md).
 
 SB3 resets an environment in the step that ends its episode and puts the
 last observation in ``infos[i]["terminal_observation"]``: the adapter runs

@@ -11,6 +11,7 @@ from zumo_swarm._settings import (
     ONE_WORLD_RENDER_MODES,
     OneWorld,
     check_render,
+    check_seed,
     flat_actions,
     make_batch,
     world_action_space,
@@ -27,9 +28,11 @@ class SwarmEnv(OneWorld, gym.Env):
     ``truncated`` at the stuck limit or ``max_steps``; ``info`` as in
     :class:`zumo_swarm.parallel.SwarmParallelEnv`.
 
-    ``reset(seed=s)`` starts afresh from seed ``s``, the world ``host run
-    --seed s`` starts from; ``reset()`` starts the next episode (the very
-    first one is the constructor's ``seed``'s).
+    ``reset(seed=s)`` starts afresh from seed ``s`` (0 to 2**63 - 1), the
+    world ``host run --seed s`` starts from; ``reset()`` starts the next
+    episode (the very first one is the constructor's ``seed``'s). ``step()``
+    before the first ``reset()``, or either after ``close()``, raises
+    ``RuntimeError``.
     """
 
     metadata = {"render_modes": ONE_WORLD_RENDER_MODES, "render_fps": 30}
@@ -48,11 +51,16 @@ class SwarmEnv(OneWorld, gym.Env):
         return self._batch
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        self._check_open("reset")
+        if seed is not None:
+            seed = check_seed(seed)
         super().reset(seed=seed)
-        obs = self._batch.reset(None if seed is None else [seed])
+        obs = self._batch.reset(seed)
+        self._was_reset()
         return obs[0], {}
 
     def step(self, action):
+        self._check_step()
         flat = flat_actions(self._batch, action, self.action_space.shape)
         obs, rewards, terminated, truncated, info, _ = self._batch.step(flat)
         return obs[0], float(rewards[0]), bool(terminated[0]), bool(truncated[0]), world_info(info, 0)

@@ -3,15 +3,18 @@ per-robot arrays, and its single-agent view."""
 
 from __future__ import annotations
 
+import sys
 from typing import Any, Sequence
 
 import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv, VectorWrapper
 from gymnasium.vector.utils import batch_space
-from gymnasium.wrappers.vector import RecordEpisodeStatistics
+from gymnasium.wrappers.vector import NormalizeReward, RecordEpisodeStatistics
 
 from zumo_swarm._settings import (
+    Lifecycle,
     check_render,
+    check_seed,
     flat_actions,
     make_batch,
     world_action_space,
@@ -20,8 +23,28 @@ from zumo_swarm._settings import (
 
 _AUTORESET = {AutoresetMode.NEXT_STEP: "next-step", AutoresetMode.SAME_STEP: "same-step"}
 
+#: Gymnasium's vector wrappers that keep one reward per world, which the
+#: per-robot rewards ``(worlds, robots)`` break: with them NumPy fails to
+#: broadcast, or, with as many robots as worlds, adds the wrong numbers.
+WORLD_REWARD_WRAPPERS = (RecordEpisodeStatistics, NormalizeReward)
 
-class SwarmVectorEnv(VectorEnv):
+
+def refuse_world_reward_wrapper() -> None:
+    """Raises ``TypeError`` when the caller of the :class:`SwarmVectorEnv`
+    method that calls this is one of :data:`WORLD_REWARD_WRAPPERS`, saying
+    what does work instead."""
+    caller = sys._getframe(2).f_locals.get("self")
+    if isinstance(caller, WORLD_REWARD_WRAPPERS):
+        wrapper = type(caller).__name__
+        raise TypeError(
+            f"gymnasium.wrappers.vector.{wrapper} cannot wrap zumo_swarm.vector_env: its rewards are per robot, "
+            f"shape (worlds, robots), and {wrapper} keeps one reward per world. Wrap env.single_agent_view() "
+            "(rewards (worlds,), the world's reward) instead"
+            + (", or use zumo_swarm.RecordRobotEpisodeStatistics(env)" if wrapper == "RecordEpisodeStatistics" else "")
+        )
+
+
+class SwarmVectorEnv(Lifecycle, VectorEnv):
     """``num_worlds`` worlds of one configuration, stepped together in Rust
     threads (``threads``, default one per core) with no Python per robot or
     per world: NumPy arrays in, NumPy arrays out.
@@ -48,14 +71,18 @@ class SwarmVectorEnv(VectorEnv):
       step instead and puts the last observation in ``infos["final_obs"]``
       (rows of the worlds marked in ``infos["_final_obs"]``).
     - ``reset(seed=s)`` starts world ``i`` afresh from seed ``s + i`` (a list
-      gives each world's seed); ``reset()`` starts every world's next
-      episode. Before any reset, world ``i`` holds seed ``seed + i``.
+      gives each world's seed; every seed from 0 to 2**63 - 1); ``reset()``
+      starts every world's next episode. Before any reset, world ``i``
+      holds seed ``seed + i``. ``step()`` before the first ``reset()``, or
+      either after ``close()``, raises ``RuntimeError``.
 
     :meth:`single_agent_view` gives the Gymnasium-convention view: one
     environment per world, rewards of shape ``(worlds,)``. Gymnasium's
-    reward wrappers expect that shape: on this per-robot env use
-    :class:`RecordRobotEpisodeStatistics` instead of
-    ``RecordEpisodeStatistics``.
+    wrappers that keep one reward per world (:data:`WORLD_REWARD_WRAPPERS`:
+    ``RecordEpisodeStatistics``, ``NormalizeReward``) expect that shape:
+    put directly on this per-robot env they are refused with a
+    ``TypeError`` at their first reset or step; use
+    :class:`RecordRobotEpisodeStatistics`, or wrap the single-agent view.
     Keyword arguments: see :func:`zumo_swarm.vector_env`.
     """
 
@@ -94,25 +121,35 @@ class SwarmVectorEnv(VectorEnv):
         return self._batch
 
     def reset(self, *, seed: int | Sequence[int] | None = None, options: dict | None = None):
+        self._check_open("reset")
+        refuse_world_reward_wrapper()
         if seed is None:
             seeds = None
         elif isinstance(seed, (int, np.integer)):
-            super().reset(seed=int(seed))
-            seeds = [int(seed) + i for i in range(self.num_envs)]
+            seeds = check_seed(seed)  # the native batch checks every world's, seeds + i
         else:
-            seeds = [int(s) for s in seed]
+            seeds = [check_seed(s) for s in seed]
             if len(seeds) != self.num_envs:
                 raise ValueError(f"seed: got {len(seeds)} seeds for {self.num_envs} worlds")
-            super().reset(seed=seeds[0])
-        return self._batch.reset(seeds), {}
+        obs = self._batch.reset(seeds)
+        if seeds is not None:
+            super().reset(seed=seeds if isinstance(seeds, int) else seeds[0])
+        self._was_reset()
+        return obs, {}
 
     def step(self, actions):
+        self._check_step()
+        refuse_world_reward_wrapper()
         flat = flat_actions(self._batch, actions, self._action_shape)
         obs, world_rewards, terminated, truncated, info, robot_rewards = self._batch.step(flat)
         info["world_reward"] = world_rewards
         for key in [k for k in info if not k.startswith("_") and k != "final_obs"]:
             info["_" + key] = self._every_world
         return obs, robot_rewards, terminated, truncated, info
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Marks the environment closed (``VectorEnv.close`` calls this once)."""
+        self._closed = True
 
     def render(self):
         """Every world as ``host render`` draws it (``render_mode="rgb_array"``)."""
