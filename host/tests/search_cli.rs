@@ -9,7 +9,8 @@ fn host() -> Command {
 
 /// Runs a one-generation search of two candidates on worlds of `steps`
 /// steps in `dir`, writing `s/NAME.policy`; `args` adds the world's flags.
-fn tiny_search(dir: &std::path::Path, args: &[&str], steps: &str, name: &str) {
+/// Returns what it printed.
+fn tiny_search(dir: &std::path::Path, args: &[&str], steps: &str, name: &str) -> String {
     let out = host()
         .current_dir(dir)
         .arg("search")
@@ -25,6 +26,25 @@ fn tiny_search(dir: &std::path::Path, args: &[&str], steps: &str, name: &str) {
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+#[test]
+fn a_search_ends_by_printing_its_steps_per_second_per_core_and_keeps_time_out_of_its_log() {
+    let dir = tempfile::tempdir().unwrap();
+    let printed = tiny_search(dir.path(), &["--threads", "1"], "300", "speed");
+    let line = printed
+        .lines()
+        .find(|l| l.starts_with("speed"))
+        .unwrap_or_else(|| panic!("no speed line in:\n{printed}"));
+    let rate: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(rate > 0.0, "{line}");
+    assert!(line.contains("steps/s per core (1 core,"), "{line}");
+    let log = std::fs::read_to_string(dir.path().join("s/speed.search.json")).unwrap();
+    assert!(
+        !log.contains("elapsed"),
+        "the log is the search's result, not its timing"
     );
 }
 

@@ -26,6 +26,7 @@ use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
 use sim::base::rng::SimRng;
 use sim::scenario::shape_pucks::tv_pucks;
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 /// Mixed into the seed for drawing candidates.
 const SAMPLE_STREAM: u64 = 0x5A3B_1E00_0000_0001;
@@ -100,6 +101,18 @@ pub struct SearchReport {
     pub policy: PathBuf,
     /// The JSON log written.
     pub log_file: PathBuf,
+    /// Wall time of the search (the start's distillation excluded).
+    pub elapsed: Duration,
+    /// Cores the worlds ran on: the search's threads, at most the machine's.
+    pub cores: usize,
+}
+
+impl SearchReport {
+    /// Steps simulated per second of wall time per core: the search's
+    /// speed on this machine (not part of the log, which is its result).
+    pub fn steps_per_core_second(&self) -> f64 {
+        self.log.steps as f64 / self.elapsed.as_secs_f64().max(1e-9) / self.cores.max(1) as f64
+    }
 }
 
 impl std::fmt::Display for SearchReport {
@@ -116,6 +129,14 @@ impl std::fmt::Display for SearchReport {
             l.result_validation.eval,
             l.validation_seeds.len(),
             l.search.validation_steps
+        )?;
+        writeln!(
+            f,
+            "speed                {:.0} steps/s per core ({} core{}, {:.1} s)",
+            self.steps_per_core_second(),
+            self.cores,
+            if self.cores == 1 { "" } else { "s" },
+            self.elapsed.as_secs_f64()
         )?;
         writeln!(f, "policy               {}", self.policy.display())?;
         write!(f, "log                  {}", self.log_file.display())
@@ -189,7 +210,11 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
         .context("the run's actions are not a valid action table")?;
     let scorer = Scorer::new(prepared, actions, settings.threads)?;
     let (start, distil_steps) = start_table(&config, &settings.start)?;
+    let started = Instant::now();
     let log = run(&config, settings, &scorer, start, distil_steps)?;
+    let elapsed = started.elapsed();
+    let machine = std::thread::available_parallelism().map_or(1, usize::from);
+    let cores = scorer.threads().min(machine);
     let name = config.name();
     let policy = config.output.dir.join(format!("{name}.policy"));
     let log_file = config.output.dir.join(format!("{name}.search.json"));
@@ -206,6 +231,8 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
         log,
         policy,
         log_file,
+        elapsed,
+        cores,
     })
 }
 

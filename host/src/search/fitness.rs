@@ -103,6 +103,11 @@ impl Scorer {
         })
     }
 
+    /// Threads the worlds are run on.
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
     /// Fields each table is scored on.
     pub fn fields(&self) -> usize {
         self.prepared.len()
