@@ -3,7 +3,7 @@
 //! ([`runner`], [`trial`]) or one at a time on the live view ([`watch`]), reusing other runs' identical trials ([`reuse`]), in shards over machines ([`shard`], [`merge`]),
 //! and reported ([`metric`], [`figures`], [`outputs`], [`pictures`]); the
 //! published trials ([`published`]) render `docs/reproduction.md`
-//! ([`report`], [`template`]).
+//! ([`report`], [`template`], with the learners side by side: [`side_by_side`]).
 
 pub mod figures;
 pub mod merge;
@@ -16,6 +16,7 @@ pub mod report;
 pub mod reuse;
 pub mod runner;
 pub mod shard;
+pub mod side_by_side;
 pub mod spec;
 pub mod template;
 pub mod trial;

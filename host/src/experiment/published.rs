@@ -1,13 +1,17 @@
 //! An experiment's published trials (`trials/<arm>/trial-<NN>.json` in its
 //! directory, of any result format), each checked against the plan of the
 //! experiment file as it is now: a trial of other settings is stale and left
-//! out, with a warning.
+//! out, with a warning. Also the figures of the trials published before the
+//! clamping border ([`wall_segments`]: `docs/reproduction/wall-segments/trials.tsv`,
+//! tab-separated with a header line, columns `experiment`, `arm`, `trial`,
+//! `commit`, `format`, `steps`, `formations`, `stuck`, `first_formation`
+//! (empty for none) and `collisions_per_1000`).
 
 use super::plan::plans_of_format;
 use super::runner::slug;
 use super::spec::ExperimentSpec;
 use super::trial::{stored_files, TrialResult};
-use anyhow::{Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -86,4 +90,129 @@ pub fn load(spec: &ExperimentSpec, dir: &Path, scale: f64, seed: u64) -> Result<
         out.results.extend(of_arm);
     }
     Ok(out)
+}
+
+/// The figures of one trial published with wall segments.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SegmentTrial {
+    /// Its arm.
+    pub arm: String,
+    /// Its index within the arm.
+    pub trial: usize,
+    /// Formations.
+    pub formations: u64,
+    /// Stuck episodes.
+    pub stuck: u64,
+    /// Step of the first formation, if any.
+    pub first_formation: Option<u64>,
+    /// Robot-robot collisions per 1000 steps.
+    pub collisions_per_1000: f64,
+}
+
+/// The wall-segment trials of `experiment` in the file at `path` (its
+/// format is in the module's doc); a missing file has none.
+pub fn wall_segments(path: &Path, experiment: &str) -> Result<Vec<SegmentTrial>> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+    };
+    let mut lines = text.lines().enumerate();
+    let header: Vec<&str> = lines
+        .next()
+        .map(|(_, l)| l.split('\t').collect())
+        .unwrap_or_default();
+    let column = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .ok_or_else(|| anyhow!("{}: no column {name:?}", path.display()))
+    };
+    let [exp, arm, trial, formations, stuck, first, collisions] = [
+        "experiment",
+        "arm",
+        "trial",
+        "formations",
+        "stuck",
+        "first_formation",
+        "collisions_per_1000",
+    ]
+    .map(column);
+    let (exp, arm, trial) = (exp?, arm?, trial?);
+    let (formations, stuck, first, collisions) = (formations?, stuck?, first?, collisions?);
+    let mut out = Vec::new();
+    for (n, line) in lines.filter(|(_, l)| !l.trim().is_empty()) {
+        let at = || format!("{} line {}", path.display(), n + 1);
+        let cells: Vec<&str> = line.split('\t').collect();
+        if cells.len() != header.len() {
+            bail!(
+                "{}: {} cells, the header has {}",
+                at(),
+                cells.len(),
+                header.len()
+            );
+        }
+        if cells[exp] != experiment {
+            continue;
+        }
+        fn number<T: std::str::FromStr>(cell: &str, name: &str) -> Result<T> {
+            cell.parse()
+                .map_err(|_| anyhow!("{name} {cell:?} is not a number"))
+        }
+        let row = || -> Result<SegmentTrial> {
+            Ok(SegmentTrial {
+                arm: cells[arm].to_string(),
+                trial: number(cells[trial], "trial")?,
+                formations: number(cells[formations], "formations")?,
+                stuck: number(cells[stuck], "stuck")?,
+                first_formation: match cells[first] {
+                    "" => None,
+                    cell => Some(number(cell, "first_formation")?),
+                },
+                collisions_per_1000: number(cells[collisions], "collisions_per_1000")?,
+            })
+        };
+        out.push(row().with_context(at)?);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wall_segment_trials_are_read_by_column_name_for_one_experiment() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("trials.tsv");
+        std::fs::write(
+            &path,
+            "experiment\tarm\ttrial\tcommit\tformat\tsteps\tformations\tstuck\tfirst_formation\tcollisions_per_1000\n\
+             annulus\tRL, author\t0\tabc\t2\t100\t7\t1\t\t3.5\n\
+             letters\tT RL\t0\tabc\t2\t100\t9\t0\t40\t1\n",
+        )
+        .unwrap();
+        let rows = wall_segments(&path, "annulus").unwrap();
+        assert_eq!(
+            rows,
+            [SegmentTrial {
+                arm: "RL, author".into(),
+                trial: 0,
+                formations: 7,
+                stuck: 1,
+                first_formation: None,
+                collisions_per_1000: 3.5,
+            }]
+        );
+        assert_eq!(
+            wall_segments(&dir.path().join("none"), "annulus").unwrap(),
+            []
+        );
+        std::fs::write(&path, "experiment\tarm\ttrial\tformations\tstuck\tfirst_formation\tcollisions_per_1000\nannulus\tRL\t0\tmany\t0\t\t1\n").unwrap();
+        let e = format!("{:#}", wall_segments(&path, "annulus").unwrap_err());
+        assert!(
+            e.contains("line 2") && e.contains("formations \"many\" is not a number"),
+            "{e}"
+        );
+    }
 }

@@ -26,24 +26,41 @@
 //!   `>`, `>=`, `=`), `thesis` (the thesis' figure from the experiment
 //!   file; for `A / B` A's formations ratio, or the ratio of the two arms'
 //!   figures), `over_thesis` (the mean over the thesis' figure), `verdict`
-//!   or `verdict X` (the thesis' figure, or X, against our trials: in our
-//!   95 % interval, within their range, or outside it), `author` (the mean
-//!   of the author's own trials, the arm's `author` values in the
-//!   experiment file), `over_author`, `author_p` (the two-sided p-value of
-//!   an exact permutation test of the difference of means, ours against
-//!   the author's trials), `p` (for `A / B`: the same test, A's trials
-//!   against B's);
-//! - a fifth part `OP X` checks the number: rendering fails when it does
+//!   (ours against the thesis' figure by the page's one rule, below),
+//!   `author` (the mean of the author's own trials, the arm's `author`
+//!   values in the experiment file), `over_author`, `author_verdict` (ours
+//!   against the author's trials by the same rule), `p` (for `A / B`: the
+//!   two-sided p-value of an exact permutation test of the difference of
+//!   means, A's trials against B's). `segments STAT` (STAT one of `mean`,
+//!   `median`, `min`, `max`, `n`, `verdict`, or for `A / B` `ratio`) is
+//!   the same over the trials published with wall segments, before the
+//!   clamping border ([`super::published::wall_segments`]: formations,
+//!   stuck, first_formation and collisions_per_1000 only);
+//! - `{{side-by-side table}}` and `{{side-by-side | ...}}`: the learned
+//!   tables of the author's program and ours ([`super::side_by_side`]);
+//! - a last part `OP X` checks the number: rendering fails when it does
 //!   not hold, since the prose around it says it does.
 //!
 //! An arm without trials renders `(not run)` and checks nothing.
+//!
+//! The verdict rule ([`crate::report::stats::Verdict`]), fixed before
+//! rendering: the 95 % interval of ours / theirs must lie inside 0.75 to
+//! 4/3 for `reproduced`; wholly outside it is `not reproduced`, and
+//! overlapping it without lying inside `inconclusive`. Theirs is the
+//! thesis' figure (a single number, taken as exact: the interval is our
+//! mean's, over it; for `A / B` our ratio of means with the delta method's
+//! interval, over the thesis' ratio) or the author's trials (their spread
+//! counts too). A verdict renders as `reproduced (L to H)`,
+//! `inconclusive (L to H)` or `not reproduced (ours higher: L to H)` /
+//! `(ours lower: L to H)`, L and H the interval's bounds with 2 decimals.
 
 use super::metric::Metric;
 use super::outputs;
-use super::published::Published;
+use super::published::{Published, SegmentTrial};
+use super::side_by_side::SideBySide;
 use super::spec::ExperimentSpec;
 use super::trial::{TrialResult, BLOCK_STEPS};
-use crate::report::stats::{median, permutation_p, Line, MeanCi};
+use crate::report::stats::{median, permutation_p, Line, MeanCi, RatioCi, Verdict};
 use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
@@ -56,13 +73,16 @@ pub struct Source {
     pub published: Published,
     /// Its published directory (`docs/reproduction/<name>`).
     pub dir: PathBuf,
+    /// Its trials published with wall segments, before the clamping border.
+    pub segments: Vec<SegmentTrial>,
 }
 
 /// What an arm without trials renders as.
 pub const NOT_RUN: &str = "(not run)";
 
-/// Renders a template; errors name the line and the expression.
-pub fn render(template: &str, sources: &[Source]) -> Result<String> {
+/// Renders a template with its experiments and side-by-side runs; errors
+/// name the line and the expression.
+pub fn render(template: &str, sources: &[Source], side: &SideBySide) -> Result<String> {
     let mut out = String::with_capacity(template.len() * 2);
     for (n, line) in template.split_inclusive('\n').enumerate() {
         let mut rest = line;
@@ -73,7 +93,7 @@ pub fn render(template: &str, sources: &[Source]) -> Result<String> {
                 .find("}}")
                 .ok_or_else(|| anyhow!("template line {}: `{{{{` is not closed", n + 1))?;
             let expr = &after[..close];
-            let value = expression(expr.trim(), sources)
+            let value = expression(expr.trim(), sources, side)
                 .with_context(|| format!("template line {}: {{{{{expr}}}}}", n + 1))?;
             out.push_str(&value);
             rest = &after[close + 2..];
@@ -83,8 +103,33 @@ pub fn render(template: &str, sources: &[Source]) -> Result<String> {
     Ok(out)
 }
 
-fn expression(expr: &str, sources: &[Source]) -> Result<String> {
+fn expression(expr: &str, sources: &[Source], side: &SideBySide) -> Result<String> {
     let parts: Vec<&str> = expr.split('|').map(str::trim).collect();
+    if expr == "side-by-side table" {
+        return Ok(side.table());
+    }
+    if parts[0] == "side-by-side" {
+        let (figure, check) = match parts.last().map(|p| comparison(p)) {
+            Some(Ok(check)) => (&parts[1..parts.len() - 1], Some(check)),
+            _ => (&parts[1..], None),
+        };
+        let v = side.figure(figure)?;
+        let text = match figure {
+            [_, "p"] => show_p(v),
+            ["runs"] => prose(v),
+            [.., f] if f.starts_with("action") => format!("{v:.3}"),
+            _ => format!("{v:.2}"),
+        };
+        if let Some((op, x)) = check {
+            if !op.holds(v, x) {
+                bail!(
+                    "the runs give {text}, which is not {}: the text around it needs rewriting",
+                    parts[parts.len() - 1]
+                );
+            }
+        }
+        return Ok(text);
+    }
     if parts.len() == 1 {
         let (names, what) = expr.rsplit_once(' ').ok_or_else(|| {
             anyhow!("expected `EXP table`, `EXP trials`, ... or `EXP | ARM | QUANTITY | STAT`")
@@ -295,6 +340,18 @@ impl Quantity {
         }
     }
 
+    /// The figure of a trial published with wall segments; an error for
+    /// the figures that file does not keep.
+    fn of_segment(self, r: &SegmentTrial) -> Result<Option<f64>> {
+        Ok(match self {
+            Quantity::Formations => Some(r.formations as f64),
+            Quantity::Stuck => Some(r.stuck as f64),
+            Quantity::FirstFormation => r.first_formation.map(|s| s as f64),
+            Quantity::Collisions => Some(r.collisions_per_1000),
+            _ => bail!("the trials with wall segments keep formations, stuck, first_formation and collisions_per_1000 only"),
+        })
+    }
+
     /// The experiment files' figure of this quantity.
     fn metric(self) -> Option<Metric> {
         match self {
@@ -387,6 +444,9 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
         let mean = values.iter().sum::<f64>() / values.len() as f64;
         return Ok(Stat::number(mean, prose(mean)));
     }
+    if let Some(stat) = stat.strip_prefix("segments ") {
+        return segments(source, a, b, q, stat.trim());
+    }
     let trials = of_arm(a);
     if trials.is_empty() {
         return Ok(Stat::text(NOT_RUN));
@@ -412,6 +472,12 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             let p = permutation_p(&values, &reference)
                 .ok_or_else(|| anyhow!("too many trials for an exact permutation test"))?;
             return Ok(Stat::number(p, show_p(p)));
+        }
+        if stat == "verdict" {
+            return Ok(Stat::text(&judge(
+                RatioCi::of(&values, &reference),
+                thesis(spec, a, Some(b), q)?,
+            )));
         }
         let mean = reference.iter().sum::<f64>() / reference.len() as f64;
         values.iter_mut().for_each(|v| *v /= mean);
@@ -451,7 +517,7 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             let v = ci.mean / thesis(spec, a, b, q)?;
             Ok(Stat::number(v, format!("{v:.2}")))
         }
-        "over_author" | "author_p" if b.is_some() => {
+        "over_author" | "author_verdict" if b.is_some() => {
             bail!("{stat} compares one arm with the author's trials, not a ratio")
         }
         "over_author" => {
@@ -460,27 +526,21 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             Ok(Stat::number(v, format!("{v:.2}")))
         }
         "p" => bail!("p compares two arms' trials: A / B"),
-        "author_p" => {
-            let p = permutation_p(&values, author(spec, a, q)?)
-                .ok_or_else(|| anyhow!("too many trials for an exact permutation test"))?;
-            Ok(Stat::number(p, show_p(p)))
-        }
+        "author_verdict" => Ok(Stat::text(&judge(
+            RatioCi::of(&values, author(spec, a, q)?),
+            1.0,
+        ))),
+        "verdict" => Ok(Stat::text(&judge(
+            RatioCi::of(&values, &[thesis(spec, a, b, q)?]),
+            1.0,
+        ))),
         _ => {
             if let Some(cond) = stat.strip_prefix("count") {
                 let (op, x) = comparison(cond.trim())?;
                 let n = values.iter().filter(|&&v| op.holds(v, x)).count() as f64;
                 return Ok(Stat::number(n, prose(n)));
             }
-            if let Some(given) = stat.strip_prefix("verdict") {
-                let figure = match given.trim() {
-                    "" => thesis(spec, a, b, q)?,
-                    x => x
-                        .parse()
-                        .map_err(|_| anyhow!("verdict {x:?}: expected a number"))?,
-                };
-                return Ok(Stat::text(&verdict(&values, figure)));
-            }
-            bail!("unknown statistic {stat:?}: expected mean, median, min, max, ci, mean±ci, n, ratio, percent, times, over_thesis, count OP X, thesis, verdict, author, over_author, author_p or p")
+            bail!("unknown statistic {stat:?}: expected mean, median, min, max, ci, mean±ci, n, ratio, percent, times, over_thesis, count OP X, thesis, verdict, author, over_author, author_verdict, p or segments STAT")
         }
     }
 }
@@ -494,24 +554,70 @@ fn show_p(p: f64) -> String {
     }
 }
 
-/// The thesis' figure against our trials' values: `reproduced` when it lies
-/// in the 95 % interval of our mean, `partly` within the range of our
-/// trials, `not reproduced` outside every trial (with the side ours is on).
-pub fn verdict(values: &[f64], thesis: f64) -> String {
-    let ci = MeanCi::of(values);
-    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
-    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let side = if ci.mean > thesis {
-        "ours higher"
-    } else {
-        "ours lower"
+/// The page's verdict on the interval of ours / theirs, divided by
+/// `figure` (the thesis' ratio for `A / B`, else 1), with the interval.
+fn judge(ci: Option<RatioCi>, figure: f64) -> String {
+    let Some(ci) = ci.filter(|_| figure > 0.0).map(|ci| ci.over(figure)) else {
+        return "– (no positive figure to compare with)".to_string();
     };
-    if values.len() > 1 && ci.low() <= thesis && thesis <= ci.high() {
-        "reproduced".to_string()
-    } else if min <= thesis && thesis <= max {
-        format!("partly ({side})")
-    } else {
-        format!("not reproduced ({side})")
+    let bounds = format!("{:.2} to {:.2}", ci.low, ci.high);
+    match Verdict::of(ci) {
+        Verdict::NotReproduced { higher } => format!(
+            "not reproduced (ours {}: {bounds})",
+            if higher { "higher" } else { "lower" }
+        ),
+        v => format!("{} ({bounds})", v.label()),
+    }
+}
+
+/// A statistic of the trials published with wall segments.
+fn segments(source: &Source, a: &str, b: Option<&str>, q: Quantity, stat: &str) -> Result<Stat> {
+    let of_arm = |name: &str| -> Result<Vec<f64>> {
+        let rows: Vec<&SegmentTrial> = source.segments.iter().filter(|r| r.arm == name).collect();
+        if rows.is_empty() {
+            bail!(
+                "{}: arm {name:?} has no trials with wall segments",
+                source.spec.name
+            );
+        }
+        rows.into_iter()
+            .map(|r| q.of_segment(r))
+            .filter_map(Result::transpose)
+            .collect()
+    };
+    let values = of_arm(a)?;
+    let show = |v: f64| {
+        Ok(Stat::number(
+            v,
+            if b.is_some() {
+                format!("{v:.2}")
+            } else {
+                prose(v)
+            },
+        ))
+    };
+    match (stat, b) {
+        ("verdict", None) => Ok(Stat::text(&judge(
+            RatioCi::of(&values, &[thesis(&source.spec, a, b, q)?]),
+            1.0,
+        ))),
+        ("verdict", Some(b)) => Ok(Stat::text(&judge(
+            RatioCi::of(&values, &of_arm(b)?),
+            thesis(&source.spec, a, Some(b), q)?,
+        ))),
+        ("ratio", Some(b)) => {
+            let ci = RatioCi::of(&values, &of_arm(b)?)
+                .ok_or_else(|| anyhow!("no ratio of {a:?} to {b:?}"))?;
+            show(ci.ratio)
+        }
+        (_, Some(_)) => bail!("segments of A / B: expected verdict or ratio"),
+        (_, None) if values.is_empty() => Ok(Stat::text("–")),
+        ("mean", None) => show(MeanCi::of(&values).mean),
+        ("median", None) => show(median(&values).unwrap_or(f64::NAN)),
+        ("min", None) => show(values.iter().copied().fold(f64::INFINITY, f64::min)),
+        ("max", None) => show(values.iter().copied().fold(f64::NEG_INFINITY, f64::max)),
+        ("n", None) => show(values.len() as f64),
+        _ => bail!("unknown statistic segments {stat:?}: expected mean, median, min, max, n, verdict or ratio"),
     }
 }
 
@@ -635,13 +741,25 @@ mod tests {
                 stale: vec![],
             },
             dir: PathBuf::from("/nonexistent"),
+            segments: [("A", 20), ("A", 22), ("B", 10), ("B", 12)]
+                .iter()
+                .enumerate()
+                .map(|(trial, &(arm, formations))| SegmentTrial {
+                    arm: arm.into(),
+                    trial,
+                    formations,
+                    stuck: 0,
+                    first_formation: None,
+                    collisions_per_1000: 0.0,
+                })
+                .collect(),
         }]
     }
 
     #[test]
     fn expressions_render_statistics_ratios_counts_and_checks() {
         let s = sources(&[8, 12, 13], &[4, 6]);
-        let r = |t: &str| render(t, &s);
+        let r = |t: &str| render(t, &s, &SideBySide::default());
         assert_eq!(
             r("{{x | A | formations | mean}} of {{x | A | formations | thesis}}").unwrap(),
             "11 of 10"
@@ -669,7 +787,12 @@ mod tests {
         );
         let none = sources(&[], &[]);
         assert_eq!(
-            render("{{x | A | formations | mean | > 5}}", &none).unwrap(),
+            render(
+                "{{x | A | formations | mean | > 5}}",
+                &none,
+                &SideBySide::default()
+            )
+            .unwrap(),
             NOT_RUN,
             "no trials: nothing to check"
         );
@@ -681,13 +804,17 @@ mod tests {
     #[test]
     fn arms_are_tested_against_each_other_and_against_the_authors_trials() {
         let s = sources(&[8, 12, 13], &[4, 6]);
-        let r = |t: &str| render(t, &s).unwrap();
+        let r = |t: &str| render(t, &s, &SideBySide::default()).unwrap();
         assert_eq!(r("{{x | A / B | formations | p}}"), "0.200");
         assert_eq!(r("{{x | A | formations | author}}"), "10");
         assert_eq!(r("{{x | A | formations | over_author}}"), "1.10");
-        // {8, 12, 13} against {9, 10, 11}: 14 of the 20 splits are as far apart
-        assert_eq!(r("{{x | A | formations | author_p}}"), "0.700");
-        let e = |t: &str| format!("{:#}", render(t, &s).unwrap_err());
+        // mean 11 against 10; relative variances 7/363 and 1/300, Welch's
+        // df 2.67 (t for 2 df: 4.303): 1.1 ± 4.303 x 1.1 x 0.1504
+        assert_eq!(
+            r("{{x | A | formations | author_verdict}}"),
+            "inconclusive (0.39 to 1.81)"
+        );
+        let e = |t: &str| format!("{:#}", render(t, &s, &SideBySide::default()).unwrap_err());
         assert!(e("{{x | A | formations | p}}").contains("A / B"));
         assert!(e("{{x | B | formations | author}}").contains("no author's trials"));
     }
@@ -698,17 +825,30 @@ mod tests {
     fn the_early_share_is_the_part_of_a_trials_formations_in_its_first_fifth() {
         let s = sources(&[30, 8], &[]);
         assert_eq!(
-            render("{{x | A | early_share | percent}}", &s).unwrap(),
+            render(
+                "{{x | A | early_share | percent}}",
+                &s,
+                &SideBySide::default()
+            )
+            .unwrap(),
             "82 %"
         );
-        assert_eq!(render("{{x | A | early_share | min}}", &s).unwrap(), "0.63");
-        assert!(render("{{x | A | early_share | percent | < 80}}", &s).is_err());
+        assert_eq!(
+            render("{{x | A | early_share | min}}", &s, &SideBySide::default()).unwrap(),
+            "0.63"
+        );
+        assert!(render(
+            "{{x | A | early_share | percent | < 80}}",
+            &s,
+            &SideBySide::default()
+        )
+        .is_err());
     }
 
     #[test]
     fn bad_expressions_are_named() {
         let s = sources(&[1], &[1]);
-        let e = |t: &str| format!("{:#}", render(t, &s).unwrap_err());
+        let e = |t: &str| format!("{:#}", render(t, &s, &SideBySide::default()).unwrap_err());
         assert!(e("{{x | C | formations | mean}}").contains("no arm \"C\""));
         assert!(e("{{y | A | formations | mean}}").contains("no experiment \"y\""));
         assert!(e("{{x | A | speed | mean}}").contains("unknown quantity \"speed\""));
@@ -718,11 +858,29 @@ mod tests {
         assert!(e("{{x | A | formations | mean | ~ 3}}").contains("expected OP X"));
     }
 
+    /// {8, 12, 13}: mean 11, half-width 4.303 x sqrt(7 / 3) = 6.57 over
+    /// the thesis' 10: a wide interval that holds 1 is inconclusive.
     #[test]
-    fn verdicts_place_the_thesis_figure_against_the_trials() {
-        let values = [10.0, 11.0, 12.0, 13.0, 30.0];
-        assert!(verdict(&values, 16.0).starts_with("reproduced"));
-        assert_eq!(verdict(&values, 29.0), "partly (ours lower)");
-        assert_eq!(verdict(&values, 4.0), "not reproduced (ours higher)");
+    fn verdicts_claim_reproduction_only_within_the_margin() {
+        let r = |a: &[u64], b: &[u64], t: &str| {
+            render(t, &sources(a, b), &SideBySide::default()).unwrap()
+        };
+        assert_eq!(
+            r(&[8, 12, 13], &[4, 6], "{{x | A | formations | verdict}}"),
+            "inconclusive (0.44 to 1.76)"
+        );
+        assert_eq!(
+            r(&[10, 11, 10, 11], &[1], "{{x | A | formations | verdict}}"),
+            "reproduced (0.96 to 1.14)"
+        );
+        assert_eq!(
+            r(&[20, 21, 20, 21], &[1], "{{x | A | formations | verdict}}"),
+            "not reproduced (ours higher: 1.96 to 2.14)"
+        );
+        // the trials with wall segments, by the same rule: 21 ± 12.71 x 1
+        assert_eq!(
+            r(&[1], &[1], "{{x | A | formations | segments mean}} {{x | A | formations | segments verdict}} {{x | A / B | formations | segments ratio}}"),
+            "21 inconclusive (0.83 to 3.37) 1.91"
+        );
     }
 }

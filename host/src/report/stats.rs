@@ -1,4 +1,5 @@
-//! Summary statistics for experiment reports.
+//! Summary statistics for experiment reports, and the one rule by which
+//! `docs/reproduction.md` judges a result reproduced ([`Verdict`]).
 
 /// Two-sided 95 % critical values of Student's t for 1..=30 degrees of freedom.
 const T95: [f64; 30] = [
@@ -34,11 +35,9 @@ impl MeanCi {
                 half_width: 0.0,
             };
         }
-        let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
-        let t = T95.get(n - 2).copied().unwrap_or(1.960);
         MeanCi {
             mean,
-            half_width: t * (var / n as f64).sqrt(),
+            half_width: t95((n - 1) as f64) * (variance(values) / n as f64).sqrt(),
         }
     }
 
@@ -50,6 +49,131 @@ impl MeanCi {
     /// Upper bound of the interval.
     pub fn high(&self) -> f64 {
         self.mean + self.half_width
+    }
+}
+
+/// The two-sided 95 % critical value of Student's t for `df` degrees of
+/// freedom, rounded down to a whole number (at least 1; 1.960 above 30).
+pub fn t95(df: f64) -> f64 {
+    let whole = (df.floor() as usize).max(1);
+    T95.get(whole - 1).copied().unwrap_or(1.960)
+}
+
+/// The sample variance (over n - 1); 0 for fewer than two values.
+fn variance(values: &[f64]) -> f64 {
+    let n = values.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let mean = values.iter().sum::<f64>() / n as f64;
+    values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64
+}
+
+/// A ratio of two means with its 95 % interval.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RatioCi {
+    /// The ratio of the means.
+    pub ratio: f64,
+    /// Lower bound of the interval.
+    pub low: f64,
+    /// Upper bound of the interval.
+    pub high: f64,
+}
+
+impl RatioCi {
+    /// The mean of `ours` over the mean of `theirs`, with the interval of
+    /// the delta method: `ratio ± t · ratio · √(s²ₐ/(nₐ mₐ²) + s²ᵦ/(nᵦ mᵦ²))`,
+    /// `t` for the Welch–Satterthwaite degrees of freedom of those two
+    /// terms. `theirs` of one value is a figure without spread: the interval
+    /// is then our mean's t interval (the tables' ±) over the figure.
+    /// `None` when a sample is empty or `theirs`' mean is not positive.
+    pub fn of(ours: &[f64], theirs: &[f64]) -> Option<RatioCi> {
+        let (na, nb) = (ours.len() as f64, theirs.len() as f64);
+        if ours.is_empty() || theirs.is_empty() {
+            return None;
+        }
+        let (ma, mb) = (
+            ours.iter().sum::<f64>() / na,
+            theirs.iter().sum::<f64>() / nb,
+        );
+        if mb <= 0.0 {
+            return None;
+        }
+        let ratio = ma / mb;
+        // the relative variances of the two means
+        let ua = variance(ours) / (na * ma * ma);
+        let ub = variance(theirs) / (nb * mb * mb);
+        let df = if ua + ub == 0.0 {
+            (na - 1.0).max(1.0)
+        } else {
+            let part = |u: f64, n: f64| if n > 1.0 { u * u / (n - 1.0) } else { 0.0 };
+            (ua + ub).powi(2) / (part(ua, na) + part(ub, nb))
+        };
+        let half = t95(df) * ratio.abs() * (ua + ub).sqrt();
+        Some(RatioCi {
+            ratio,
+            low: ratio - half,
+            high: ratio + half,
+        })
+    }
+
+    /// The interval divided by a figure (a ratio of ours against a ratio
+    /// the thesis gives).
+    pub fn over(self, figure: f64) -> RatioCi {
+        RatioCi {
+            ratio: self.ratio / figure,
+            low: self.low / figure,
+            high: self.high / figure,
+        }
+    }
+}
+
+/// The equivalence margin of [`Verdict`]: ours over theirs from 0.75 to
+/// 4/3 (1 / 0.75), symmetric on a log scale.
+pub const MARGIN: (f64, f64) = (0.75, 4.0 / 3.0);
+
+/// The one verdict rule of the reproduction page, fixed before rendering:
+/// the 95 % interval of the ratio ours / theirs ([`RatioCi`]) against the
+/// [`MARGIN`]. Inside it: reproduced (equivalent within the margin);
+/// wholly outside it: not reproduced, on the side ours lies; overlapping
+/// it without lying inside: inconclusive (the trials cannot tell).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// The interval lies inside the margin.
+    Reproduced,
+    /// The interval overlaps the margin without lying inside it.
+    Inconclusive,
+    /// The interval lies wholly outside the margin; `higher` when ours is
+    /// above it.
+    NotReproduced {
+        /// Ours above the margin (else below it).
+        higher: bool,
+    },
+}
+
+impl Verdict {
+    /// The verdict on an interval of ours / theirs.
+    pub fn of(ci: RatioCi) -> Verdict {
+        let (low, high) = MARGIN;
+        if ci.low >= low && ci.high <= high {
+            Verdict::Reproduced
+        } else if ci.high < low || ci.low > high {
+            Verdict::NotReproduced {
+                higher: ci.low > high,
+            }
+        } else {
+            Verdict::Inconclusive
+        }
+    }
+
+    /// As the page writes it.
+    pub fn label(self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::Inconclusive => "inconclusive",
+            Verdict::NotReproduced { higher: true } => "not reproduced (ours higher)",
+            Verdict::NotReproduced { higher: false } => "not reproduced (ours lower)",
+        }
     }
 }
 
@@ -157,6 +281,55 @@ mod tests {
         assert!((ci.half_width - expected).abs() < 1e-12);
         assert_eq!(MeanCi::of(&[3.0]).half_width, 0.0);
         assert_eq!(MeanCi::of(&[]).mean, 0.0);
+    }
+
+    /// Ten trials of mean 100 and standard deviation about 3.03: a t
+    /// half-width of 2.262 x 3.03 / sqrt(10) = 2.17.
+    #[test]
+    fn a_ratio_to_a_single_figure_is_the_means_interval_over_it() {
+        let ours: Vec<f64> = (0..10).map(|i| 95.5 + i as f64).collect();
+        let ci = RatioCi::of(&ours, &[50.0]).unwrap();
+        let half = 2.262 * variance(&ours).sqrt() / 10f64.sqrt();
+        assert!((ci.ratio - 2.0).abs() < 1e-12);
+        assert!((ci.low - (100.0 - half) / 50.0).abs() < 1e-12, "{ci:?}");
+        assert!((ci.high - (100.0 + half) / 50.0).abs() < 1e-12, "{ci:?}");
+        assert_eq!(RatioCi::of(&ours, &[0.0]), None);
+        assert_eq!(RatioCi::of(&[], &[1.0]), None);
+    }
+
+    /// Two samples of 4 whose means have relative variances 1/120 each:
+    /// the ratio 2, half-width t(6) x 2 x sqrt(1/60) (Welch's df:
+    /// (1/60)^2 / (2 (1/120)^2 / 3) = 6).
+    #[test]
+    fn a_ratio_of_two_means_takes_both_spreads() {
+        let ours = [16.0, 18.0, 22.0, 24.0]; // mean 20, variance 40/3
+        let theirs = [8.0, 9.0, 11.0, 12.0]; // mean 10, variance 10/3
+        let ci = RatioCi::of(&ours, &theirs).unwrap();
+        let half = 2.447 * 2.0 * (1.0f64 / 60.0).sqrt();
+        assert!((ci.high - 2.0 - half).abs() < 1e-9, "{ci:?} {half}");
+        assert_eq!(ci.over(2.0).ratio, 1.0);
+    }
+
+    #[test]
+    fn verdicts_claim_equality_only_inside_the_margin() {
+        let ci = |low, high| RatioCi {
+            ratio: (low + high) / 2.0,
+            low,
+            high,
+        };
+        assert_eq!(Verdict::of(ci(0.8, 1.3)), Verdict::Reproduced);
+        assert_eq!(Verdict::of(ci(0.75, 4.0 / 3.0)), Verdict::Reproduced);
+        // a wide interval that holds 1 is not equality
+        assert_eq!(Verdict::of(ci(-6.7, 47.0)), Verdict::Inconclusive);
+        assert_eq!(Verdict::of(ci(0.5, 0.9)), Verdict::Inconclusive);
+        assert_eq!(
+            Verdict::of(ci(0.3, 0.74)).label(),
+            "not reproduced (ours lower)"
+        );
+        assert_eq!(
+            Verdict::of(ci(1.4, 2.0)).label(),
+            "not reproduced (ours higher)"
+        );
     }
 
     #[test]
