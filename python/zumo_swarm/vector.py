@@ -29,11 +29,23 @@ _AUTORESET = {AutoresetMode.NEXT_STEP: "next-step", AutoresetMode.SAME_STEP: "sa
 WORLD_REWARD_WRAPPERS = (RecordEpisodeStatistics, NormalizeReward)
 
 
+#: The methods through which those wrappers call the env's ``reset`` and
+#: ``step``: only a call from one of them needs a look at who called.
+_WRAPPER_CALLS = {
+    method.__code__
+    for wrapper in (VectorWrapper, *WORLD_REWARD_WRAPPERS)
+    for method in (wrapper.reset, wrapper.step)
+}
+
+
 def refuse_world_reward_wrapper() -> None:
     """Raises ``TypeError`` when the caller of the :class:`SwarmVectorEnv`
     method that calls this is one of :data:`WORLD_REWARD_WRAPPERS`, saying
     what does work instead."""
-    caller = sys._getframe(2).f_locals.get("self")
+    frame = sys._getframe(2)
+    if frame.f_code not in _WRAPPER_CALLS:
+        return
+    caller = frame.f_locals.get("self")
     if isinstance(caller, WORLD_REWARD_WRAPPERS):
         wrapper = type(caller).__name__
         raise TypeError(
