@@ -11,6 +11,13 @@
 //! - `FIRMWARE_ROBOT_ID`: the robot's id, 0..=255 (default 0, none given),
 //!   stored with the policy's CRC in the image's identity record
 //!   (`shared::FirmwareIdentity`) and sent in every log frame.
+//!
+//! It also writes `source_hash.s`, an assembler section `.zumo.sources`
+//! (not loaded: the flash is unchanged) holding the marker of the
+//! sources' hash (`src/source_hash.rs`), which `src/main.rs` links in.
+
+#[path = "src/source_hash.rs"]
+mod source_hash;
 
 use shared::{FirmwareIdentity, PolicyBlob, RobotProfile, StateHasher};
 use std::fmt::Write as _;
@@ -160,6 +167,19 @@ fn main() {
         .unwrap();
     }
     writeln!(out, "    ],\n}};").unwrap();
-    let dest = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR")).join("policy.rs");
+    let out_dir = PathBuf::from(env::var("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let dest = out_dir.join("policy.rs");
     fs::write(&dest, out).unwrap_or_else(|e| fail(&format!("{}: {e}", dest.display())));
+
+    for source in source_hash::SOURCES {
+        println!("cargo:rerun-if-changed={}", root.join(source).display());
+    }
+    let hash = source_hash::of_workspace(&root)
+        .unwrap_or_else(|e| fail(&format!("hashing the sources: {e}")));
+    let asm = format!(
+        ".pushsection .zumo.sources,\"\",@progbits\n.asciz \"{}\"\n.popsection\n",
+        source_hash::marker(hash)
+    );
+    let dest = out_dir.join("source_hash.s");
+    fs::write(&dest, asm).unwrap_or_else(|e| fail(&format!("{}: {e}", dest.display())));
 }

@@ -20,5 +20,7 @@ pub mod pins;
 pub mod pixy;
 pub mod rc;
 pub mod screen_calibration;
+#[cfg(not(target_arch = "avr"))]
+pub mod source_hash;
 pub mod supervisor;
 pub mod usb;

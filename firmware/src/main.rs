@@ -16,6 +16,10 @@
 #[cfg(target_arch = "avr")]
 mod board;
 
+// The sources' hash, in a section that is not loaded (`build.rs`).
+#[cfg(target_arch = "avr")]
+core::arch::global_asm!(include_str!(concat!(env!("OUT_DIR"), "/source_hash.s")));
+
 #[cfg(target_arch = "avr")]
 #[avr_device::entry]
 fn main() -> ! {

@@ -221,6 +221,11 @@ pub enum Reply {
     /// A data stage from the host follows (SET_LINE_CODING): pass it to
     /// [`Control::line_coding_out`], then acknowledge.
     ReceiveLineCoding,
+    /// SET_FEATURE(ENDPOINT_HALT) (`true`) or CLEAR_FEATURE(ENDPOINT_HALT)
+    /// (`false`) on this endpoint number of the configuration: halt it
+    /// (every transaction on it stalls), or clear its halt and reset its
+    /// data toggle to DATA0 (USB 2.0 section 9.4.5); then acknowledge.
+    Halt(u8, bool),
     /// Not supported: stall endpoint 0 until the next setup packet.
     Stall,
 }
@@ -231,6 +236,8 @@ pub struct Control {
     configured: bool,
     line_coding: [u8; 7],
     dtr: bool,
+    /// The halted endpoints of the configuration, bit n for endpoint n.
+    halted: u8,
 }
 
 impl Default for Control {
@@ -249,7 +256,22 @@ impl Control {
             configured: false,
             line_coding: DEFAULT_LINE_CODING,
             dtr: false,
+            halted: 0,
         }
+    }
+
+    /// The number of the endpoint at `address` (wIndex of a request to an
+    /// endpoint: number and direction bit): endpoint 0 either way, the
+    /// configuration's three endpoints once configured, `None` otherwise
+    /// (a request error, USB 2.0 section 9.4).
+    fn endpoint(&self, address: u8) -> Option<u8> {
+        let number = address & 0x0F;
+        let valid = match address {
+            0x00 | 0x80 => true,
+            a if a == 0x80 | NOTIFY_EP || a == OUT_EP || a == 0x80 | IN_EP => self.configured,
+            _ => false,
+        };
+        valid.then_some(number)
     }
 
     /// The answer to a setup packet (standard requests of a device, the
@@ -274,22 +296,49 @@ impl Control {
                 _ => Reply::Stall,
             },
             (0x00, 0x05) => Reply::Address(v0 & 0x7F),
+            // SET_CONFIGURATION clears every halt (USB 2.0 section 9.4.7).
             (0x00, 0x09) => match value {
                 0 => {
                     self.configured = false;
                     self.dtr = false;
+                    self.halted = 0;
                     Reply::Ack
                 }
                 1 => {
                     self.configured = true;
+                    self.halted = 0;
                     Reply::Configure
                 }
                 _ => Reply::Stall,
             },
             (0x80, 0x08) => n(Payload::Short([u8::from(self.configured), 0], 1)),
-            (0x80..=0x82, 0x00) => n(Payload::Short([0, 0], 2)),
-            // CLEAR_FEATURE / SET_FEATURE (endpoint halt, remote wake-up): accepted.
-            (0x00..=0x02, 0x01 | 0x03) => Reply::Ack,
+            // GET_STATUS: the device (bus powered, no remote wake-up), an
+            // interface (nothing), an endpoint (its halt bit).
+            (0x80, 0x00) => n(Payload::Short([0, 0], 2)),
+            (0x81, 0x00) if i0 < 2 => n(Payload::Short([0, 0], 2)),
+            (0x82, 0x00) => match self.endpoint(i0) {
+                Some(e) => n(Payload::Short([(self.halted >> e) & 1, 0], 2)),
+                None => Reply::Stall,
+            },
+            // CLEAR_FEATURE / SET_FEATURE: ENDPOINT_HALT (feature 0) on an
+            // endpoint of the configuration; endpoint 0 has no halt (USB 2.0
+            // section 9.4.5 neither requires nor recommends one): accepted,
+            // no effect. The device's features stall: it has no remote
+            // wake-up (the configuration says so) and a full-speed device no
+            // test mode; interfaces have none.
+            (0x02, 0x01 | 0x03) if value == 0 => match self.endpoint(i0) {
+                Some(0) => Reply::Ack,
+                Some(e) => {
+                    let halt = request == 0x03;
+                    if halt {
+                        self.halted |= 1 << e;
+                    } else {
+                        self.halted &= !(1 << e);
+                    }
+                    Reply::Halt(e, halt)
+                }
+                None => Reply::Stall,
+            },
             (0x81, 0x0A) => n(Payload::Short([0, 0], 1)),
             (0x01, 0x0B) => Reply::Ack,
             // CDC class, interface 0.
@@ -326,6 +375,11 @@ impl Control {
     /// Whether the host holds the port open (DTR).
     pub fn dtr(&self) -> bool {
         self.dtr
+    }
+
+    /// Whether the host has halted endpoint `number` (SET_FEATURE).
+    pub fn halted(&self, number: u8) -> bool {
+        (self.halted >> (number & 7)) & 1 != 0
     }
 }
 
@@ -475,11 +529,22 @@ mod tests {
         let Reply::In(p, len) = c.setup(&request(0x80, 6, 0x0100, 0, 64), "robot-003") else {
             panic!("device descriptor not sent");
         };
-        assert_eq!(bytes(p, len), DEVICE_DESCRIPTOR);
+        // USB 2.0 table 9-8, written out: bcdUSB 2.00, class EF/02/01 (an
+        // interface association), 64-byte endpoint 0, 1FFB:2300, bcdDevice
+        // 1.00, strings 1, 2, 3, one configuration.
         assert_eq!(
-            c.setup(&request(0x80, 6, 0x0200, 0, 9), "robot-003"),
-            Reply::In(Payload::Bytes(&CONFIG_DESCRIPTOR), 9)
+            bytes(p, len),
+            [
+                18, 1, 0x00, 0x02, 0xEF, 0x02, 0x01, 64, 0xFB, 0x1F, 0x00, 0x23, 0x00, 0x01, 1, 2,
+                3, 1
+            ]
         );
+        let Reply::In(p, len) = c.setup(&request(0x80, 6, 0x0200, 0, 9), "robot-003") else {
+            panic!("configuration descriptor not sent");
+        };
+        // Its header only, as a host first asks: 75 bytes, 2 interfaces,
+        // value 1, bus powered (0x80), 100 mA (50 x 2 mA).
+        assert_eq!(bytes(p, len), [9, 2, 75, 0, 2, 1, 0, 0x80, 50]);
         let Reply::In(p, len) = c.setup(&request(0x80, 6, 0x0303, 0x0409, 255), "robot-003") else {
             panic!("serial number not sent");
         };
@@ -516,6 +581,62 @@ mod tests {
             })
             .collect();
         assert_eq!(endpoints, configured);
+    }
+
+    #[test]
+    fn endpoint_halts_are_set_cleared_and_reported_as_chapter_9_says() {
+        let mut c = Control::new();
+        let status = |c: &mut Control, ep: u16| match c.setup(&request(0x82, 0, 0, ep, 2), "") {
+            Reply::In(p, len) => Some(bytes(p, len)),
+            _ => None,
+        };
+        // Before SET_CONFIGURATION only endpoint 0 exists.
+        assert_eq!(c.setup(&request(0x02, 3, 0, 0x83, 0), ""), Reply::Stall);
+        assert_eq!(status(&mut c, 0x83), None);
+        assert_eq!(status(&mut c, 0x80), Some(std::vec![0, 0]));
+        c.setup(&request(0x00, 9, 1, 0, 0), "");
+        assert_eq!(
+            c.setup(&request(0x02, 3, 0, 0x83, 0), ""),
+            Reply::Halt(3, true)
+        );
+        assert!(c.halted(3) && !c.halted(2));
+        assert_eq!(status(&mut c, 0x83), Some(std::vec![1, 0]));
+        assert_eq!(
+            c.setup(&request(0x02, 3, 0, 0x02, 0), ""),
+            Reply::Halt(2, true)
+        );
+        // CLEAR_FEATURE clears the halt (and the board resets the toggle),
+        // also on an endpoint that was not halted.
+        assert_eq!(
+            c.setup(&request(0x02, 1, 0, 0x83, 0), ""),
+            Reply::Halt(3, false)
+        );
+        assert_eq!(status(&mut c, 0x83), Some(std::vec![0, 0]));
+        assert_eq!(
+            c.setup(&request(0x02, 1, 0, 0x81, 0), ""),
+            Reply::Halt(1, false)
+        );
+        // The wrong direction, an endpoint that does not exist, another feature.
+        for ep in [0x03, 0x82, 0x01, 0x04, 0x84] {
+            assert_eq!(
+                c.setup(&request(0x02, 3, 0, ep, 0), ""),
+                Reply::Stall,
+                "{ep:#x}"
+            );
+        }
+        assert_eq!(c.setup(&request(0x02, 3, 1, 0x83, 0), ""), Reply::Stall);
+        // Endpoint 0 has no halt: accepted, no effect.
+        assert_eq!(c.setup(&request(0x02, 3, 0, 0x80, 0), ""), Reply::Ack);
+        assert_eq!(status(&mut c, 0x00), Some(std::vec![0, 0]));
+        // No remote wake-up, no test mode, no interface features.
+        assert_eq!(c.setup(&request(0x00, 3, 1, 0, 0), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x00, 1, 1, 0, 0), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x00, 3, 2, 0x0100, 0), ""), Reply::Stall);
+        assert_eq!(c.setup(&request(0x01, 3, 0, 0, 0), ""), Reply::Stall);
+        // SET_CONFIGURATION clears the halts.
+        assert!(c.halted(2));
+        c.setup(&request(0x00, 9, 1, 0, 0), "");
+        assert!(!c.halted(2));
     }
 
     #[test]

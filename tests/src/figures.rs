@@ -8,15 +8,19 @@
 //! <!-- figures:NAME end -->
 //! ```
 //!
-//! [`Figures::check`] compares the section with what the test measured.
-//! Figures that do not depend on the compiler must always match. Figures
-//! that do (cycle counts, flash size, anything the poll loop's timing
-//! decides) are keyed on the compiler that built the firmware, which the
-//! section records (`built by rustc ...`): under another compiler they are
-//! not compared, and the check says so and names the command that
-//! regenerates them. With `UPDATE_FIGURES=1` in the environment the
-//! section is rewritten instead (atomically), which is what that command
-//! does.
+//! [`Figures::check`] compares the section with what the test measured,
+//! and fails when they differ, naming the command that regenerates them.
+//! Figures that depend on the compiler (cycle counts, flash size, anything
+//! the poll loop's timing decides) come after a line naming the compiler
+//! that built the firmware (`built by rustc ...`, from the ELF's
+//! `.comment`): firmware built by another compiler fails the check too,
+//! saying so, until the figures are regenerated with it. With
+//! `UPDATE_FIGURES=1` in the environment the section is rewritten instead
+//! (atomically), which is what that command does.
+//!
+//! The ELF measured is the one its sources build: [`check_sources`]
+//! refuses one whose source hash (`firmware::source_hash`) is not that of
+//! the sources in the tree.
 
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -45,9 +49,33 @@ pub enum Outcome {
     Current,
     /// The section was rewritten (`UPDATE_FIGURES=1`).
     Updated,
-    /// The fixed figures match; the compiler's figures were recorded with
-    /// another compiler and were not compared (the message says which).
-    OtherCompiler(String),
+}
+
+/// Refuses an ELF not built from the sources in the tree: its
+/// `firmware::source_hash` marker must be the sources' own. `build` is
+/// the command that rebuilds it.
+pub fn check_sources(elf: &Path, build: &str) -> Result<()> {
+    use firmware::source_hash::{marker, of_workspace, MARKER_PREFIX};
+    let bytes = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let now = marker(of_workspace(&workspace()).context("hashing the firmware's sources")?);
+    let prefix = MARKER_PREFIX.as_bytes();
+    let built = bytes
+        .windows(now.len())
+        .find(|w| w.starts_with(prefix))
+        .map(|w| String::from_utf8_lossy(w).into_owned());
+    match built {
+        Some(built) if built == now => Ok(()),
+        Some(built) => bail!(
+            "the firmware ELF {} is stale: it was built from other sources ({built}) than those in \
+             the tree ({now}); rebuild it with `{build}`",
+            elf.display()
+        ),
+        None => bail!(
+            "the firmware ELF {} carries no source hash (`{MARKER_PREFIX}...`): it is older than \
+             the sources; rebuild it with `{build}`",
+            elf.display()
+        ),
+    }
 }
 
 /// The compiler that built an ELF, from its `.comment` section
@@ -173,12 +201,12 @@ impl Figures {
             );
         }
         if compiler_doc != compiler_now {
-            return Ok(Outcome::OtherCompiler(format!(
-                "{doc} (section {name}) records compiler-dependent figures for another compiler ({}); this firmware \
-                 was built by {}: not compared. Regenerate them with `{command}`",
+            bail!(
+                "{doc} (section {name}) records compiler-dependent figures for another compiler ({}); this \
+                 firmware was built by {}: regenerate them with `{command}`",
                 compiler_doc.unwrap_or_else(|| "none".into()),
                 self.compiler
-            )));
+            );
         }
         bail!(
             "the compiler-dependent figures in {doc} (section {name}) are stale for {}.\n\
@@ -235,7 +263,7 @@ mod tests {
     }
 
     #[test]
-    fn stale_figures_fail_with_the_command_and_another_compiler_is_only_named() {
+    fn stale_figures_and_figures_of_another_compiler_fail_with_the_command() {
         let dir = tempfile::tempdir().unwrap();
         let mut f = Figures::new("rustc 1.95.0");
         f.fixed(&["states", "1,020"]);
@@ -254,12 +282,10 @@ mod tests {
         let mut other = Figures::new("rustc 1.99.0");
         other.fixed(&["states", "1,020"]);
         other.compiled(&["cycles", "950"]);
-        let Outcome::OtherCompiler(m) = other
+        let m = other
             .check(rel, "x", &["figure", "value"], "make it")
-            .unwrap()
-        else {
-            panic!()
-        };
+            .unwrap_err()
+            .to_string();
         assert!(
             m.contains("rustc 1.95.0") && m.contains("rustc 1.99.0") && m.contains("`make it`"),
             "{m}"
@@ -281,5 +307,24 @@ mod tests {
             .is_err());
         assert_eq!(thousands(1_234_567), "1,234,567");
         assert_eq!(thousands(12), "12");
+    }
+
+    #[test]
+    fn an_elf_built_from_other_sources_or_without_their_hash_is_refused() {
+        use firmware::source_hash::{marker, of_workspace};
+        let dir = tempfile::tempdir().unwrap();
+        let elf = dir.path().join("firmware.elf");
+        let now = marker(of_workspace(&workspace()).unwrap());
+        std::fs::write(&elf, format!("\x7fELF..{now}\0..")).unwrap();
+        check_sources(&elf, "rebuild").unwrap();
+        std::fs::write(&elf, format!("\x7fELF..{}\0..", marker(1))).unwrap();
+        let e = check_sources(&elf, "rebuild").unwrap_err().to_string();
+        assert!(e.contains("stale") && e.contains("`rebuild`"), "{e}");
+        std::fs::write(&elf, "\x7fELF....").unwrap();
+        let e = check_sources(&elf, "rebuild").unwrap_err().to_string();
+        assert!(
+            e.contains("no source hash") && e.contains("`rebuild`"),
+            "{e}"
+        );
     }
 }

@@ -10,7 +10,10 @@
 //! `usbV` ioctl is declared but not handled), no start-of-frame and no
 //! suspend: [`Zumo::plug_usb`] and [`Zumo::suspend_usb`] set the register
 //! bits the silicon would (USBSTA.VBUS, UDINT.SUSPI, UDINT.WAKEUPI) in the
-//! core's data memory. Between tries of a NAKed transaction the host lets
+//! core's data memory. Nor does it filter by address (a packet reaches the
+//! device whatever UDADDR holds: [`Zumo::usb_set_address`] reads UDADDR
+//! itself), model data toggles, or lock the PLL only when it is set right
+//! (any PLLE locks). Between tries of a NAKed transaction the host lets
 //! the firmware run 20 us (a full-speed host retries within a frame). The
 //! model does not NAK an OUT data stage while the setup packet before it
 //! is unread (it overwrites it), so the host waits 5 ms before one.
@@ -27,6 +30,13 @@ const UDINT: usize = 0xE1;
 const UDCON: usize = 0xE0;
 /// UDADDR (UADD, ADDEN bit 7) in data memory.
 const UDADDR: usize = 0xE3;
+/// USBCON (FRZCLK is bit 5) in data memory.
+const USBCON: usize = 0xD8;
+/// PLLCSR (PLLE is bit 1) in data memory.
+const PLLCSR: usize = 0x49;
+/// How long a host waits after SET_ADDRESS before it uses the address
+/// (Linux, `hub_port_init`); USB 2.0 gives the device 2 ms of it.
+const SET_ADDRESS_SETTLE_US: u64 = 10_000;
 const NAK: i32 = -2;
 const STALL: i32 = -3;
 /// How long the host waits between a setup packet and its OUT data stage.
@@ -39,6 +49,41 @@ const TIMEOUT_US: u64 = 50_000;
 /// A control transfer the device refused (STALL).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stalled;
+
+/// What [`Zumo::usb_enumerate`] read and measured.
+#[derive(Clone, Debug)]
+pub struct Enumeration {
+    /// The device descriptor.
+    pub device: Vec<u8>,
+    /// The configuration descriptor, all of it.
+    pub config: Vec<u8>,
+    /// From SET_ADDRESS's status stage to the address enabled (UDADDR.ADDEN),
+    /// in microseconds (the host looks every 10 us).
+    pub address_us: u64,
+}
+
+/// A configuration descriptor split into its descriptors (each
+/// `bLength` bytes); an error names the offset of one whose `bLength` is
+/// under 2 or runs past the end, so a malformed descriptor fails a test
+/// instead of looping it.
+pub fn split_descriptors(bytes: &[u8]) -> Result<Vec<&[u8]>, String> {
+    let mut out = Vec::new();
+    let mut rest = bytes;
+    while !rest.is_empty() {
+        let len = usize::from(rest[0]);
+        if len < 2 || len > rest.len() {
+            return Err(format!(
+                "descriptor at offset {}: bLength {len} with {} bytes left",
+                bytes.len() - rest.len(),
+                rest.len()
+            ));
+        }
+        let (d, tail) = rest.split_at(len);
+        out.push(d);
+        rest = tail;
+    }
+    Ok(out)
+}
 
 /// A setup packet: bmRequestType, bRequest, wValue, wIndex, wLength.
 pub fn setup(request_type: u8, request: u8, value: u16, index: u16, length: u16) -> [u8; 8] {
@@ -228,6 +273,17 @@ impl Zumo {
         self.data(UDCON) & 1 != 0
     }
 
+    /// Whether the firmware has frozen the USB controller's clock
+    /// (USBCON.FRZCLK).
+    pub fn usb_clock_frozen(&self) -> bool {
+        self.data(USBCON) & 1 << 5 != 0
+    }
+
+    /// Whether the firmware has the USB PLL on (PLLCSR.PLLE).
+    pub fn usb_pll_on(&self) -> bool {
+        self.data(PLLCSR) & 1 << 1 != 0
+    }
+
     /// The device address the firmware enabled (UDADDR with ADDEN), if any.
     pub fn usb_address(&self) -> Option<u8> {
         let a = self.data(UDADDR);
@@ -252,8 +308,9 @@ impl Zumo {
         self.usb_transaction(*b"usbr", ep, &[], zlp_ok)
     }
 
-    /// One OUT transaction on `ep`, retried while NAKed.
-    fn usb_out(&mut self, ep: u8, data: &[u8]) -> Result<(), Stalled> {
+    /// One OUT transaction on `ep` (at most 64 bytes of `data`), retried
+    /// while NAKed.
+    pub fn usb_out(&mut self, ep: u8, data: &[u8]) -> Result<(), Stalled> {
         self.usb_transaction(*b"usbw", ep, data, true).map(|_| ())
     }
 
@@ -324,18 +381,36 @@ impl Zumo {
         }
     }
 
+    /// SET_ADDRESS `address`, then the host looks every 10 us for the
+    /// address to be enabled, for as long as Linux waits before using it
+    /// (10 ms; it panics after that). Returns the microseconds from the
+    /// status stage to the address enabled (USB 2.0 section 9.2.6.3 allows
+    /// 2 ms).
+    pub fn usb_set_address(&mut self, address: u8) -> u64 {
+        self.usb_control(setup(0x00, 5, u16::from(address), 0, 0), &[])
+            .expect("SET_ADDRESS stalled");
+        let mut waited = 0;
+        while self.usb_address() != Some(address) {
+            assert!(
+                waited < SET_ADDRESS_SETTLE_US,
+                "address {address} not enabled {SET_ADDRESS_SETTLE_US} us after SET_ADDRESS"
+            );
+            self.run_us(10);
+            waited += 10;
+        }
+        waited
+    }
+
     /// What a host does when the device appears: bus reset, the device
-    /// descriptor, SET_ADDRESS `address` (2 ms to take effect), the
+    /// descriptor, SET_ADDRESS `address` ([`Zumo::usb_set_address`]), the
     /// configuration descriptor (its 9-byte header, then all of it),
-    /// SET_CONFIGURATION 1. Returns the device and configuration descriptors.
-    pub fn usb_enumerate(&mut self, address: u8) -> (Vec<u8>, Vec<u8>) {
+    /// SET_CONFIGURATION 1.
+    pub fn usb_enumerate(&mut self, address: u8) -> Enumeration {
         self.usb_reset();
         let device = self
             .usb_control(setup(0x80, 6, 0x0100, 0, 64), &[])
             .expect("GET_DESCRIPTOR(device) stalled");
-        self.usb_control(setup(0x00, 5, u16::from(address), 0, 0), &[])
-            .expect("SET_ADDRESS stalled");
-        self.run_us(2000);
+        let address_us = self.usb_set_address(address);
         let head = self
             .usb_control(setup(0x80, 6, 0x0200, 0, 9), &[])
             .expect("GET_DESCRIPTOR(configuration) stalled");
@@ -345,14 +420,22 @@ impl Zumo {
             .expect("GET_DESCRIPTOR(configuration) stalled");
         self.usb_control(setup(0x00, 9, 1, 0, 0), &[])
             .expect("SET_CONFIGURATION stalled");
-        (device, config)
+        Enumeration {
+            device,
+            config,
+            address_us,
+        }
+    }
+
+    /// A string descriptor as sent (English, 0x0409).
+    pub fn usb_string_descriptor(&mut self, index: u8) -> Vec<u8> {
+        self.usb_control(setup(0x80, 6, 0x0300 | u16::from(index), 0x0409, 255), &[])
+            .expect("GET_DESCRIPTOR(string) stalled")
     }
 
     /// A string descriptor, decoded (English, 0x0409).
     pub fn usb_string(&mut self, index: u8) -> String {
-        let d = self
-            .usb_control(setup(0x80, 6, 0x0300 | u16::from(index), 0x0409, 255), &[])
-            .expect("GET_DESCRIPTOR(string) stalled");
+        let d = self.usb_string_descriptor(index);
         let units: Vec<u16> = d[2..]
             .chunks(2)
             .map(|c| u16::from_le_bytes([c[0], c[1]]))
@@ -385,6 +468,19 @@ impl Zumo {
     pub fn usb_set_dtr(&mut self, dtr: bool) -> Result<(), Stalled> {
         self.usb_control(setup(0x21, 0x22, u16::from(dtr) | 2, 0, 0), &[])
             .map(|_| ())
+    }
+
+    /// One IN transaction on the bulk endpoint `ep`, not retried: the
+    /// bytes sent (none when NAKed, which simavr's model gives as an empty
+    /// packet), or [`Stalled`] when the endpoint is halted.
+    pub fn usb_bulk_in(&mut self, ep: u8) -> Result<Vec<u8>, Stalled> {
+        let mut buf = [0u8; 64];
+        match self.usb_ioctl(*b"usbr", ep, &mut buf, 64) {
+            (0, n) => Ok(buf[..n.min(64)].to_vec()),
+            (NAK, _) => Ok(Vec::new()),
+            (STALL, _) => Err(Stalled),
+            (r, _) => panic!("bulk IN on endpoint {ep}: simavr error {r}"),
+        }
     }
 
     /// Reads the bulk IN endpoint `ep` for `us` microseconds, as a host

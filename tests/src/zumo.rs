@@ -110,7 +110,8 @@ pub fn firmware_elf() -> PathBuf {
 }
 
 /// The ELF a build wrote to `target/avr-none/<dir>/firmware.elf`; panics
-/// saying to run `build` (the command that writes it) if it is missing.
+/// saying to run `build` (the command that writes it) if it is missing or
+/// stale (built from other sources, `crate::figures::check_sources`).
 pub fn firmware_elf_in(dir: &str, build: &str) -> PathBuf {
     let elf = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../target/avr-none")
@@ -122,6 +123,9 @@ pub fn firmware_elf_in(dir: &str, build: &str) -> PathBuf {
          component; `scripts/setup` installs them), or run everything with `./scripts/test`",
         elf.display()
     );
+    if let Err(e) = crate::figures::check_sources(&elf, build) {
+        panic!("{e:#}");
+    }
     elf
 }
 

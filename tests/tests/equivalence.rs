@@ -38,7 +38,7 @@ use tests::equivalence::{
     read_policy, sample_states, Decided, Expectation, Expected, Sample, Variant, EIGHT_BIT,
     GENERAL, ROLE, SEARCH_ANNULUS, SEARCH_T, TEN_BIT, TIED,
 };
-use tests::figures::{compiler_of, thousands, Figures, Outcome};
+use tests::figures::{compiler_of, thousands, Figures};
 use tests::playback::{driving_zumo, frames_since_boot, play, Observed, Stimulus};
 use tests::zumo::firmware_elf_in;
 
@@ -447,7 +447,6 @@ fn equivalence(v: &Variant) {
 
     let header = ["figure", &format!("{} ({})", v.policy, v.hasher.name())];
     match figures.check("docs/equivalence.md", v.elf_dir, &header, REGENERATE) {
-        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
         Ok(_) => {}
         Err(e) => panic!("{e:#}"),
     }

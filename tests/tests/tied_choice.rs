@@ -18,7 +18,7 @@ use std::sync::OnceLock;
 use tests::equivalence::{
     check_elf_embeds, cycles_of_ticks, follow_log, nudge, read_policy, Decided, Expectation, TIED,
 };
-use tests::figures::{compiler_of, thousands, Figures, Outcome};
+use tests::figures::{compiler_of, thousands, Figures};
 use tests::playback::{
     driving_zumo, frames_of_stream, frames_since_boot, play, Observed, Stimulus,
 };
@@ -276,7 +276,6 @@ fn the_firmwares_draws_are_uniform_among_tied_actions_within_the_stated_bound() 
         &["figure", "value", "bound"],
         REGENERATE,
     ) {
-        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
         Ok(_) => {}
         Err(e) => panic!("{e:#}"),
     }

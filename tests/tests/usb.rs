@@ -1,16 +1,89 @@
 //! The firmware's USB serial port in simavr, against the host written in
 //! `tests::zumo` (`usb_host`): enumeration and descriptors, the CDC-ACM
 //! requests, log frames over the bulk IN endpoint, the 1200-baud touch,
-//! a host that stops reading, the cable pulled and plugged back.
+//! a host that stops reading, the cable pulled and plugged back, suspend
+//! and endpoint halts. The identities and descriptors the robot must
+//! present are written here as literals from the specifications and
+//! `../shared/docs/hardware.md`, never imported from the firmware.
 
 use firmware::embedded;
-use firmware::usb::{BOOT_KEY, PID, VID};
 use shared::{LogFrame, PolicyBlob, RunMode};
-use tests::usb_host::setup;
+use tests::usb_host::{setup, split_descriptors, Stalled};
 use tests::zumo::Zumo;
 
-/// The bulk IN endpoint (`firmware::usb::IN_EP`; the configuration descriptor says so).
+/// The bulk IN endpoint (the configuration descriptor says so).
 const BULK_IN: u8 = 3;
+/// The bulk OUT endpoint.
+const BULK_OUT: u8 = 2;
+
+// What the robot must present, written here from the specifications and
+// the hardware facts, not taken from the firmware.
+
+/// Pololu's vendor id (`../shared/docs/hardware.md` section 6).
+const VID: u16 = 0x1FFB;
+/// The A-Star 32U4 application's product id (the same section; the
+/// bootloader's is 0x0101).
+const PID: u16 = 0x2300;
+/// The word at SRAM 0x0800 that sends the A-Star bootloader into itself
+/// after a watchdog reset (the same section).
+const BOOT_KEY: u16 = 0x7777;
+
+/// The device descriptor (USB 2.0 table 9-8).
+const DEVICE: [u8; 18] = [
+    18, 1, // bLength, DEVICE
+    0x00, 0x02, // bcdUSB 2.00
+    0xEF, 0x02, 0x01, // class: miscellaneous, common class, interface association
+    64,   // bMaxPacketSize0
+    0xFB, 0x1F, // idVendor 0x1FFB
+    0x00, 0x23, // idProduct 0x2300
+    0x00, 0x01, // bcdDevice 1.00
+    1, 2, 3, // iManufacturer, iProduct, iSerialNumber
+    1, // bNumConfigurations
+];
+
+/// The configuration descriptor, descriptor by descriptor: USB 2.0 tables
+/// 9-10, 9-12 and 9-13, the interface association descriptor of its ECN,
+/// and the CDC-ACM functional descriptors of CDC 1.2 (header, union) and
+/// its PSTN subclass document (call management, abstract control
+/// management).
+const CONFIGURATION: [&[u8]; 11] = [
+    // 75 bytes, 2 interfaces, value 1, no string, bus powered without
+    // remote wake-up, 100 mA (50 x 2 mA)
+    &[9, 2, 75, 0, 2, 1, 0, 0x80, 50],
+    // association: interfaces 0 and 1, CDC, ACM, no protocol, no string
+    &[8, 0x0B, 0, 2, 0x02, 0x02, 0x00, 0],
+    // interface 0, alternate 0, 1 endpoint, CDC communication, ACM, no protocol
+    &[9, 4, 0, 0, 1, 0x02, 0x02, 0x00, 0],
+    // CS_INTERFACE header: bcdCDC 1.10
+    &[5, 0x24, 0x00, 0x10, 0x01],
+    // call management: no capabilities, data interface 1
+    &[5, 0x24, 0x01, 0x00, 1],
+    // abstract control management: line coding and control line state
+    &[4, 0x24, 0x02, 0x02],
+    // union: interface 0 controls interface 1
+    &[5, 0x24, 0x06, 0, 1],
+    // endpoint 1 IN, interrupt, 8 bytes, every 255 ms
+    &[7, 5, 0x81, 0x03, 8, 0, 255],
+    // interface 1, alternate 0, 2 endpoints, CDC data
+    &[9, 4, 1, 0, 2, 0x0A, 0x00, 0x00, 0],
+    // endpoint 2 OUT, bulk, 64 bytes
+    &[7, 5, 0x02, 0x02, 64, 0, 0],
+    // endpoint 3 IN, bulk, 64 bytes
+    &[7, 5, 0x83, 0x02, 64, 0, 0],
+];
+
+/// A string descriptor (USB 2.0 table 9-16) of ASCII text: UTF-16LE.
+fn string_descriptor(text: &str) -> Vec<u8> {
+    let mut d = vec![2 + 2 * text.len() as u8, 3];
+    for c in text.bytes() {
+        d.extend_from_slice(&[c, 0]);
+    }
+    d
+}
+
+/// The sensors' times while driving, in Timer3 ticks: between the white
+/// (100 to 120) and black (400 to 420) of [`Zumo::calibrate`].
+const SENSOR_TICKS: [Option<u16>; 3] = [Some(300), Some(200), Some(150)];
 
 /// Splits a byte stream at the frames' delimiter (whole frames only).
 fn frames_of(bytes: &[u8]) -> Vec<&[u8]> {
@@ -34,50 +107,56 @@ fn open_port() -> Zumo {
 }
 
 #[test]
+fn a_malformed_descriptor_is_an_error_not_a_hang() {
+    assert_eq!(
+        split_descriptors(&[9, 2, 0, 0]),
+        Err("descriptor at offset 0: bLength 9 with 4 bytes left".to_string())
+    );
+    assert_eq!(
+        split_descriptors(&[2, 5, 0, 4]),
+        Err("descriptor at offset 2: bLength 0 with 2 bytes left".to_string())
+    );
+    assert_eq!(
+        split_descriptors(&[2, 5, 3, 4, 1]),
+        Ok(vec![&[2u8, 5][..], &[3, 4, 1][..]])
+    );
+}
+
+#[test]
 fn the_robot_enumerates_as_a_cdc_acm_serial_port_named_by_its_robot_id() {
     let mut z = plugged_zumo();
     assert!(!z.usb_detached(), "VBUS seen: the device attaches");
-    let (device, config) = z.usb_enumerate(5);
+    let e = z.usb_enumerate(5);
     assert_eq!(z.usb_address(), Some(5), "SET_ADDRESS took effect");
 
-    // Device descriptor: USB 2.0, IAD class triple, EP0 64 bytes, VID/PID.
-    assert_eq!(device.len(), 18);
-    assert_eq!(&device[..2], &[18, 1]);
-    assert_eq!(
-        (device[4], device[5], device[6], device[7]),
-        (0xEF, 0x02, 0x01, 64)
-    );
-    assert_eq!(u16::from_le_bytes([device[8], device[9]]), VID);
-    assert_eq!(u16::from_le_bytes([device[10], device[11]]), PID);
+    assert_eq!(u16::from_le_bytes([e.device[8], e.device[9]]), VID);
+    assert_eq!(u16::from_le_bytes([e.device[10], e.device[11]]), PID);
+    assert_eq!(e.device, DEVICE);
+    let sent = split_descriptors(&e.config).unwrap_or_else(|m| panic!("{m}: {:?}", e.config));
+    assert_eq!(sent, CONFIGURATION);
+    assert_eq!(e.config.len(), 75);
 
-    // Configuration: two interfaces; CDC communication (02/02) with an
-    // interrupt IN endpoint, CDC data (0A) with bulk OUT and bulk IN 64.
-    assert_eq!(config[1], 2);
     assert_eq!(
-        usize::from(u16::from_le_bytes([config[2], config[3]])),
-        config.len()
+        z.usb_string_descriptor(0),
+        [4, 3, 0x09, 0x04],
+        "English (US)"
     );
-    assert_eq!(config[4], 2, "interfaces");
-    let mut interfaces = Vec::new();
-    let mut endpoints = Vec::new();
-    let mut i = 0;
-    while i < config.len() {
-        let d = &config[i..i + usize::from(config[i])];
-        match d[1] {
-            4 => interfaces.push((d[5], d[6])),
-            5 => endpoints.push((d[2], d[3], u16::from_le_bytes([d[4], d[5]]))),
-            _ => {}
-        }
-        i += usize::from(config[i]);
-    }
-    assert_eq!(interfaces, [(0x02, 0x02), (0x0A, 0x00)]);
-    assert_eq!(endpoints, [(0x81, 3, 8), (0x02, 2, 64), (0x83, 2, 64)]);
-
-    assert_eq!(z.usb_string(device[16]), embedded::USB_SERIAL);
-    assert_eq!(embedded::USB_SERIAL, "robot-000");
-    assert_eq!(z.usb_string(device[15]), firmware::usb::PRODUCT);
-    let configuration = z.usb_control(setup(0x80, 8, 0, 0, 1), &[]).unwrap();
-    assert_eq!(configuration, [1]);
+    assert_eq!(z.usb_string_descriptor(1), string_descriptor("zumo-swarm"));
+    assert_eq!(
+        z.usb_string_descriptor(2),
+        string_descriptor("Zumo 32U4 robot")
+    );
+    assert_eq!(z.usb_string_descriptor(3), string_descriptor("robot-000"));
+    assert_eq!(z.usb_string(3), embedded::USB_SERIAL);
+    assert!(z
+        .usb_control(setup(0x80, 6, 0x0304, 0x0409, 255), &[])
+        .is_err());
+    assert_eq!(z.usb_control(setup(0x80, 8, 0, 0, 1), &[]), Ok(vec![1]));
+    assert_eq!(
+        z.usb_control(setup(0x80, 0, 0, 0, 2), &[]),
+        Ok(vec![0, 0]),
+        "GET_STATUS: bus powered, no remote wake-up"
+    );
 }
 
 /// A host resets the bus whenever it likes; the firmware spends most of a
@@ -85,6 +164,7 @@ fn the_robot_enumerates_as_a_cdc_acm_serial_port_named_by_its_robot_id() {
 /// its loop in turn (offsets 0 to 19 ms after a period starts, 1 ms apart).
 #[test]
 fn the_robot_enumerates_wherever_in_its_period_the_host_resets_the_bus() {
+    let mut slowest_address = 0;
     for offset_ms in 0..20 {
         let mut z = plugged_zumo();
         let periods = z.period_cycles().len();
@@ -92,10 +172,9 @@ fn the_robot_enumerates_wherever_in_its_period_the_host_resets_the_bus() {
             z.run_us(100);
         }
         z.run_ms(offset_ms);
-        let (device, _) = z.usb_enumerate(9);
+        let e = z.usb_enumerate(9);
         assert_eq!(
-            device.len(),
-            18,
+            e.device, DEVICE,
             "device descriptor after a reset {offset_ms} ms into a period"
         );
         assert_eq!(
@@ -103,7 +182,13 @@ fn the_robot_enumerates_wherever_in_its_period_the_host_resets_the_bus() {
             Some(9),
             "address after a reset {offset_ms} ms into a period"
         );
+        slowest_address = slowest_address.max(e.address_us);
     }
+    println!("the address enabled at most {slowest_address} us after SET_ADDRESS's status stage");
+    assert!(
+        slowest_address <= 2_000,
+        "the address took {slowest_address} us: USB 2.0 (9.2.6.3) allows 2 ms"
+    );
 }
 
 #[test]
@@ -189,21 +274,57 @@ fn a_host_that_stops_reading_never_blocks_the_control_period() {
     }
 }
 
+/// A robot calibrated by the real procedure and driving (A pressed), its
+/// port open on a host.
+fn driving_zumo_on_usb() -> Zumo {
+    let mut z = Zumo::boot();
+    z.usb_open(5);
+    z.calibrate();
+    z.set_sensor_ticks(SENSOR_TICKS);
+    z.press_a();
+    z.run_ms(100);
+    let frame = z
+        .frames()
+        .pop()
+        .expect("no log frame")
+        .expect("a frame that does not decode");
+    assert_eq!(
+        frame.mode,
+        RunMode::Driving,
+        "A pressed on a calibrated robot"
+    );
+    assert_ne!(z.duties(), (0, 0), "a driving robot's motors");
+    z
+}
+
 #[test]
 fn a_1200_baud_touch_stops_the_motors_stores_the_key_and_resets_by_the_watchdog() {
-    let mut z = open_port();
-    z.run_ms(40);
+    let mut z = driving_zumo_on_usb();
     assert!(z.watchdog_resets().is_empty());
+    assert_eq!(z.boot_key(), 0);
     z.usb_set_line_coding(1200).unwrap();
+    assert_ne!(
+        z.duties(),
+        (0, 0),
+        "1200 baud with DTR still high is no touch"
+    );
     z.usb_set_dtr(false).unwrap();
-    z.run_ms(2);
-    assert_eq!(z.duties(), (0, 0));
+    // Stopped in the USB service that acknowledged the request: by the time
+    // the host has the acknowledgement.
+    assert_eq!(z.duties(), (0, 0), "motors when the touch is acknowledged");
     assert_eq!(z.boot_key(), BOOT_KEY);
     // The watchdog (125 ms) resets the chip with the key in place: the
-    // bootloader would stay in itself.
-    let ms = z
-        .run_until_watchdog_reset(400)
-        .expect("no watchdog reset within 400 ms of the touch");
+    // bootloader would stay in itself. Until then the motors stay stopped.
+    // (`run_until_watchdog_reset`: the only stepping that crosses a reset)
+    let mut ms = 0;
+    loop {
+        assert_eq!(z.duties(), (0, 0), "motors {ms} ms after the touch");
+        assert!(ms < 400, "no watchdog reset within 400 ms of the touch");
+        ms += 1;
+        if z.run_until_watchdog_reset(1).is_some() {
+            break;
+        }
+    }
     println!("watchdog reset {ms} ms after the touch");
     assert!(
         (120..=140).contains(&ms),
@@ -243,21 +364,119 @@ fn pulling_the_cable_detaches_and_plugging_it_back_enumerates_again() {
     z.plug_usb(true);
     z.run_ms(25);
     assert!(!z.usb_detached());
-    let (device, _) = z.usb_enumerate(9);
-    assert_eq!(device.len(), 18);
+    assert_eq!(z.usb_enumerate(9).device, DEVICE);
     assert_eq!(z.usb_address(), Some(9));
     z.usb_set_dtr(true).unwrap();
     let usb = z.usb_read_bulk(BULK_IN, 100_000);
     assert!(frames_of(&usb).len() >= 3);
 }
 
+/// Suspend (USB 2.0 section 7.1.7.6: no bus activity for 3 ms): the
+/// firmware freezes the controller's clock and turns the PLL off; the
+/// robot drives and logs on TXD1 as before (`docs/firmware.md`, "USB
+/// serial port"); the host's resume wakes the port with its address and
+/// configuration, and frames come out whole again.
 #[test]
-fn a_suspended_bus_stops_nothing_and_wakes_up() {
-    let mut z = open_port();
+fn a_suspended_bus_freezes_the_usb_clock_while_the_robot_drives_on_and_wakes_up() {
+    let mut z = driving_zumo_on_usb();
+    assert!(!z.usb_clock_frozen() && z.usb_pll_on());
+    z.frames();
     z.suspend_usb(true);
-    z.run_ms(60);
-    assert!(z.frames().iter().all(|f| f.is_ok()));
+    z.run_ms(1);
+    assert!(z.usb_clock_frozen(), "suspended: the USB clock still runs");
+    assert!(!z.usb_pll_on(), "suspended: the PLL still on");
+    for ms in (0..100).step_by(10) {
+        assert_ne!(z.duties(), (0, 0), "motors {ms} ms into the suspend");
+        z.run_ms(10);
+    }
+    let frames: Vec<LogFrame> = z
+        .frames()
+        .into_iter()
+        .map(|f| f.expect("a frame that does not decode"))
+        .collect();
+    assert!(
+        frames.len() >= 4,
+        "{} frames in 100 ms suspended",
+        frames.len()
+    );
+    assert!(frames.windows(2).all(|w| w[1].tick == w[0].tick + 1));
+    assert!(frames.iter().all(|f| f.mode == RunMode::Driving));
+    assert!(z.usb_clock_frozen(), "still suspended");
+
     z.suspend_usb(false);
-    z.run_ms(5);
+    z.run_ms(1);
+    assert!(!z.usb_clock_frozen() && z.usb_pll_on(), "woken up");
+    assert_eq!(z.usb_address(), Some(5));
+    assert_eq!(z.usb_control(setup(0x80, 8, 0, 0, 1), &[]), Ok(vec![1]));
     assert_eq!(z.usb_line_coding().0, 115_200);
+    let usb = z.usb_read_bulk(BULK_IN, 100_000);
+    let frames = frames_of(&usb);
+    assert!(
+        frames.len() >= 3,
+        "{} frames after the wake-up",
+        frames.len()
+    );
+    for f in &frames[1..] {
+        LogFrame::decode(f).expect("a frame cut by the suspend");
+    }
+}
+
+/// SET_FEATURE(ENDPOINT_HALT) halts an endpoint: its transactions stall
+/// and GET_STATUS says so; CLEAR_FEATURE(ENDPOINT_HALT) clears it (and
+/// resets its data toggle, which simavr does not model) and the log flows
+/// again, in whole frames (USB 2.0 sections 9.4.1, 9.4.5, 9.4.9). Features
+/// the device does not have stall.
+#[test]
+fn a_halted_endpoint_stalls_until_the_host_clears_the_halt() {
+    let mut z = open_port();
+    z.run_ms(40);
+    let status = |z: &mut Zumo, ep: u16| z.usb_control(setup(0x82, 0, 0, ep, 2), &[]);
+    assert_eq!(status(&mut z, 0x83), Ok(vec![0, 0]));
+    z.usb_control(setup(0x02, 3, 0, 0x83, 0), &[])
+        .expect("SET_FEATURE(ENDPOINT_HALT) on 0x83");
+    assert_eq!(status(&mut z, 0x83), Ok(vec![1, 0]));
+    for _ in 0..5 {
+        assert_eq!(z.usb_bulk_in(BULK_IN), Err(Stalled), "a halted bulk IN");
+        z.run_ms(20);
+    }
+    z.usb_control(setup(0x02, 3, 0, 0x02, 0), &[])
+        .expect("SET_FEATURE(ENDPOINT_HALT) on 0x02");
+    assert_eq!(
+        z.usb_out(BULK_OUT, b"hello"),
+        Err(Stalled),
+        "a halted bulk OUT"
+    );
+    // TXD1 lost nothing meanwhile.
+    let ticks: Vec<u32> = z.frames().into_iter().map(|f| f.unwrap().tick).collect();
+    assert!(ticks.len() >= 5 && ticks.windows(2).all(|w| w[1] == w[0] + 1));
+
+    z.usb_control(setup(0x02, 1, 0, 0x83, 0), &[])
+        .expect("CLEAR_FEATURE(ENDPOINT_HALT) on 0x83");
+    z.usb_control(setup(0x02, 1, 0, 0x02, 0), &[])
+        .expect("CLEAR_FEATURE(ENDPOINT_HALT) on 0x02");
+    assert_eq!(status(&mut z, 0x83), Ok(vec![0, 0]));
+    assert_eq!(z.usb_out(BULK_OUT, b"hello"), Ok(()));
+    let usb = z.usb_read_bulk(BULK_IN, 100_000);
+    let frames = frames_of(&usb);
+    assert!(
+        frames.len() >= 3,
+        "{} frames after the halt was cleared",
+        frames.len()
+    );
+    for f in &frames[1..] {
+        LogFrame::decode(f).expect("a frame cut by the halt");
+    }
+
+    // An endpoint that does not exist, the wrong direction, remote wake-up
+    // (the configuration says the device has none) and test mode stall.
+    for request in [
+        setup(0x02, 3, 0, 0x84, 0),
+        setup(0x02, 3, 0, 0x03, 0),
+        setup(0x82, 0, 0, 0x84, 2),
+        setup(0x00, 3, 1, 0, 0),
+        setup(0x00, 3, 2, 0x0100, 0),
+    ] {
+        assert_eq!(z.usb_control(request, &[]), Err(Stalled), "{request:02x?}");
+    }
+    assert_eq!(z.usb_line_coding().0, 115_200, "the port still answers");
 }

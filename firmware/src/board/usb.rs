@@ -13,15 +13,20 @@
 //!    and do nothing more until it returns (the robot also runs on
 //!    batteries alone);
 //! 2. bus events (UDINT): reset -> endpoint 0 set up again, the port
-//!    unconfigured; suspend -> the controller's clock frozen; wake-up ->
-//!    unfrozen;
+//!    unconfigured; suspend -> the controller's clock frozen and the PLL
+//!    off; wake-up -> the PLL on, and the clock unfrozen once it has
+//!    locked (a later service if not at once); the robot drives on either way;
 //! 3. endpoint 0: a setup packet is read and answered (`Control::setup`);
 //!    an IN data stage goes out 64 bytes at a time, each packet when the
 //!    bank is free (TXINI); SET_ADDRESS's address is enabled once its
-//!    acknowledgement went out; the SET_LINE_CODING data stage is read;
+//!    acknowledgement went out (waited for, about 100 us at most, within
+//!    the service); the SET_LINE_CODING data stage is read; SET_FEATURE /
+//!    CLEAR_FEATURE(ENDPOINT_HALT) set STALLRQ / clear it with STALLRQC
+//!    and reset the data toggle (RSTDT);
 //! 4. once configured: bytes the host sent to the port (bulk OUT) are
 //!    dropped, and the next packet of the log queue goes into the bulk IN
-//!    endpoint if the host holds the port open (DTR) and its bank is free;
+//!    endpoint if the host holds the port open (DTR), has not halted it,
+//!    and its bank is free;
 //! 5. the touch: 1200 baud with DTR low -> [`TouchChange::Armed`].
 //!
 //! Registers (data space addresses, ATmega32U4 datasheet section 22): each
@@ -70,7 +75,16 @@ const RXSTPI: u8 = 1 << 3;
 const RXOUTI: u8 = 1 << 2;
 const TXINI: u8 = 1 << 0;
 const STALLRQ: u8 = 1 << 5;
+const STALLRQC: u8 = 1 << 4;
+const RSTDT: u8 = 1 << 3;
 const EPEN: u8 = 1 << 0;
+
+/// Polls of TXINI after SET_ADDRESS's status stage is armed (about 8
+/// cycles each: some 100 us): the host's IN token for it follows at once,
+/// so the address is enabled within the same service, well inside the
+/// 2 ms USB 2.0 allows (section 9.2.6.3); a host slower than that gets it
+/// at the next service.
+const ADDRESS_POLLS: u16 = 200;
 
 fn read(register: *mut u8) -> u8 {
     // SAFETY: `register` is one of the USB controller's registers above.
@@ -180,6 +194,8 @@ impl UsbPort {
         if vbus != self.vbus {
             self.vbus = vbus;
             write(UDCON, if vbus { 0 } else { DETACH });
+            // a cable pulled while suspended: the PLL back on for the next host
+            write(PLLCSR, PINDIV | PLLE);
             self.forget();
         }
         if vbus {
@@ -205,10 +221,15 @@ impl UsbPort {
         if events & SUSPI != 0 {
             clear(UDINT, SUSPI);
             write(USBCON, USBE | FRZCLK | OTGPADE);
+            write(PLLCSR, PINDIV);
         }
         if events & WAKEUPI != 0 {
-            write(USBCON, USBE | OTGPADE);
+            write(PLLCSR, PINDIV | PLLE);
             clear(UDINT, WAKEUPI);
+        }
+        // Unfrozen once the PLL has locked again after a wake-up.
+        if read(USBCON) & FRZCLK != 0 && read(PLLCSR) & PLOCK != 0 {
+            write(USBCON, USBE | OTGPADE);
         }
     }
 
@@ -238,9 +259,27 @@ impl UsbPort {
                     write(UDADDR, a);
                     self.address = Some(a);
                     clear(UEINTX, TXINI);
+                    for _ in 0..ADDRESS_POLLS {
+                        if read(UEINTX) & TXINI != 0 {
+                            break;
+                        }
+                    }
                 }
                 Reply::Configure => {
                     Self::configure(1, ENDPOINT_CONFIG.len());
+                    write(UENUM, 0);
+                    clear(UEINTX, TXINI);
+                }
+                Reply::Halt(ep, halt) => {
+                    write(UENUM, ep);
+                    write(
+                        UECONX,
+                        if halt {
+                            EPEN | STALLRQ
+                        } else {
+                            EPEN | STALLRQC | RSTDT
+                        },
+                    );
                     write(UENUM, 0);
                     clear(UEINTX, TXINI);
                 }
@@ -301,6 +340,9 @@ impl UsbPort {
         if !self.control.dtr() {
             self.queue.clear();
             return;
+        }
+        if self.control.halted(IN_EP) {
+            return; // the queue fills and drops whole frames until cleared
         }
         write(UENUM, IN_EP);
         if read(UEINTX) & TXINI == 0 {
