@@ -172,6 +172,7 @@ fn search(args: SearchArgs) -> Result<()> {
 
 fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
     use host::flashed::{measure_learner, measure_policy, GapReport};
+    ranges::STEPS.check_count("--window", args.window)?;
     let mut config = match &args.config {
         Some(path) => host::train::TrainConfig::from_file(path)?,
         None => host::train::TrainConfig::default(),
@@ -335,7 +336,7 @@ fn display(args: DisplayArgs) -> Result<()> {
     // The first line names the address (scripts and tests read it).
     println!("display: serving {url}");
     println!("  field: {url}   calibration: {url}?mode=calibrate   grey patches: {url}?mode=grey");
-    println!("  keys: c calibration, f field, g grey patches, Enter or click full-screen, h help; Ctrl-C stops");
+    println!("  on the page: c calibration, f field, g grey patches, Enter or click full-screen, h help; here: Ctrl-C stops");
     std::io::stdout()
         .flush()
         .context("cannot write to stdout")?;
@@ -353,7 +354,7 @@ fn view(args: ViewArgs) -> Result<()> {
     // The first line names the address (scripts and tests read it).
     println!("view: serving {url}");
     println!(
-        "  keys: space play/pause, s step, 1 2 3 speed, r reset, n next seed, h help; Ctrl-C stops"
+        "  on the page: space play/pause, s step, 1 2 3 speed, r reset, n next seed, h help; here: Ctrl-C stops"
     );
     std::io::stdout()
         .flush()
@@ -375,7 +376,7 @@ fn view_log(log: &Path, policy: &Path, args: &ViewArgs) -> Result<()> {
     // The first line names the address (scripts and tests read it).
     println!("view: serving {}", view.url());
     println!(
-        "  {} frames of {}, {} diverging from {}; keys: space play/pause, left/right step, d next divergence, h help; Ctrl-C stops",
+        "  {} frames of {}, {} diverging from {}; on the page: space play/pause, left/right step, d next divergence, h help; here: Ctrl-C stops",
         played.frames,
         log.display(),
         played.diverged,
@@ -428,6 +429,7 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             scale,
             documents,
         }) => {
+            ranges::SCALE.check(scale)?;
             let log = |line: &str| eprintln!("{line}");
             let documents = host::experiment::report::documents(&documents)?;
             if check {
@@ -472,6 +474,15 @@ fn monitor(args: MonitorArgs) -> Result<()> {
         anyhow::bail!("--port and --out are required");
     };
     ranges::BAUD.check_count("--baud", u64::from(args.baud))?;
+    if let Some(frames) = args.frames {
+        ranges::MONITOR_FRAMES.check_count("--frames", frames)?;
+    }
+    let mut opener = SerialOpener {
+        port: port.clone(),
+        baud: args.baud,
+    };
+    // before the log is created: a port that can never be read leaves no file
+    opener.check()?;
     let mut log = host::robot::log_file::LogWriter::create(&out, args.append)?;
     let stop = Arc::new(AtomicBool::new(false));
     let flag = stop.clone();
@@ -481,10 +492,6 @@ fn monitor(args: MonitorArgs) -> Result<()> {
     let options = MonitorOptions {
         max_frames: args.frames,
         ..MonitorOptions::default()
-    };
-    let mut opener = SerialOpener {
-        port,
-        baud: args.baud,
     };
     let status = monitor::run(&mut opener, &mut log, &options, &stop, &mut |e| {
         printer.show(&e)

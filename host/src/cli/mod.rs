@@ -2,6 +2,8 @@
 //! conversions from flags into the libraries' plain settings (`main.rs`
 //! gives each command its own function).
 
+#[cfg(test)]
+mod flag_ranges;
 pub mod learn;
 pub mod robot;
 pub mod scenario;
@@ -15,6 +17,7 @@ use robot::{FlashArgs, MonitorArgs, ReplayArgs};
 use screen::{DisplayArgs, FieldExportArgs, FieldGainArgs, ObserveArgs};
 use simulate::{BenchArgs, RenderArgs, RunArgs};
 use std::path::PathBuf;
+use std::process::ExitCode;
 use view::ViewArgs;
 
 /// Simulate, train and inspect policies for Zumo puck-construction swarms;
@@ -119,10 +122,20 @@ pub enum PolicyCommand {
     },
 }
 
-/// A positive, finite number (lengths, scales).
-pub(crate) fn parse_positive(s: &str) -> Result<f64, String> {
-    match s.parse::<f64>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        _ => Err(format!("{s:?} is not a positive number")),
+/// Shows the error of a command line `clap` did not accept and gives the
+/// exit code `docs/ranges.md` documents: 0 for `--help` and `--version`;
+/// 1 for a refused value (one that does not parse, or is not one of the
+/// choices), as for a value refused after parsing; 2 for a command line
+/// that cannot be read (an unknown flag, a missing argument).
+pub fn refused(e: &clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    // nothing more can be said if stderr is closed
+    let _ = e.print();
+    match e.kind() {
+        ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => ExitCode::SUCCESS,
+        ErrorKind::InvalidValue | ErrorKind::ValueValidation | ErrorKind::InvalidUtf8 => {
+            ExitCode::FAILURE
+        }
+        _ => ExitCode::from(2),
     }
 }

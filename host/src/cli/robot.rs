@@ -62,13 +62,13 @@ pub struct ReplayArgs {
 pub struct OdometryArgs {
     /// Millimetres per simulator unit (a tenth of the robot radius; 6.5 for
     /// the Zumo in its 65 mm skirt on the TV arena).
-    #[arg(long, default_value_t = 6.5, value_parser = super::parse_positive)]
+    #[arg(long, default_value_t = 6.5)]
     pub mm_per_unit: f64,
     /// Wheel encoder counts per millimetre of track travel (909.7 / 119 on 75:1 motors).
-    #[arg(long, default_value_t = 909.7 / 119.0, value_parser = super::parse_positive)]
+    #[arg(long, default_value_t = 909.7 / 119.0)]
     pub counts_per_mm: f64,
     /// Distance between the tracks' centre lines, mm.
-    #[arg(long, default_value_t = 85.0, value_parser = super::parse_positive)]
+    #[arg(long, default_value_t = 85.0)]
     pub track_mm: f64,
 }
 

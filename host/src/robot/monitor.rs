@@ -13,6 +13,7 @@ use anyhow::{Context, Result};
 use shared::{Faults, LogFrame, RunMode};
 use std::fmt;
 use std::io::{ErrorKind, IsTerminal, Read, Write};
+use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
@@ -35,29 +36,100 @@ pub struct SerialOpener {
     pub baud: u32,
 }
 
-impl PortOpener for SerialOpener {
-    fn open(&mut self) -> Result<Box<dyn Read + Send>> {
+/// Why a port can never be monitored, however long the monitor waits (a
+/// path that is not a serial device, a baud rate that resets the robot):
+/// [`run`] gives up with it instead of retrying.
+#[derive(Debug)]
+pub struct Unusable(pub String);
+
+impl fmt::Display for Unusable {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Unusable {}
+
+impl SerialOpener {
+    /// Fails with [`Unusable`] when the port can never be monitored: the
+    /// 1200-baud touch, or a path that exists and is no serial device (a
+    /// regular file, a directory, `/dev/zero`). A path that does not exist
+    /// passes: the adapter may not be plugged in yet.
+    pub fn check(&self) -> Result<(), Unusable> {
+        self.check_baud()?;
+        match not_a_serial_device(Path::new(&self.port)) {
+            Some(what) => Err(Unusable(format!(
+                "port {} is {what}, not a serial device: give the robot's port (host monitor --list lists them)",
+                self.port
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    fn check_baud(&self) -> Result<(), Unusable> {
         if self.baud == shared::identity::USB_TOUCH_BAUD {
-            anyhow::bail!(
+            return Err(Unusable(format!(
                 "{} baud on a robot's USB port is the touch that resets it into its bootloader when the port \
                  closes: monitor at another rate (any rate works on USB)",
                 self.baud
-            );
+            )));
         }
+        Ok(())
+    }
+}
+
+/// What the file at `path` is, if it exists and is no terminal (serial
+/// ports are terminals): "a regular file", "a directory", "a character
+/// device that is not a terminal".
+#[cfg(unix)]
+fn not_a_serial_device(path: &Path) -> Option<&'static str> {
+    use std::io::IsTerminal;
+    use std::os::unix::fs::{FileTypeExt, OpenOptionsExt};
+    let kind = std::fs::metadata(path).ok()?.file_type();
+    if kind.is_file() {
+        Some("a regular file")
+    } else if kind.is_dir() {
+        Some("a directory")
+    } else if kind.is_char_device() {
+        // without blocking on a modem line, without becoming its controller
+        let file = std::fs::OpenOptions::new()
+            .read(true)
+            .custom_flags(libc::O_NONBLOCK | libc::O_NOCTTY)
+            .open(path)
+            .ok()?;
+        (!file.is_terminal()).then_some("a character device that is not a terminal")
+    } else {
+        Some("neither a file nor a device (a pipe or a socket)")
+    }
+}
+
+/// Elsewhere the serial library's error says what is wrong.
+#[cfg(not(unix))]
+fn not_a_serial_device(_path: &Path) -> Option<&'static str> {
+    None
+}
+
+impl PortOpener for SerialOpener {
+    fn open(&mut self) -> Result<Box<dyn Read + Send>> {
+        self.check_baud()?;
         let port = serialport::new(&self.port, self.baud)
             .data_bits(serialport::DataBits::Eight)
             .parity(serialport::Parity::None)
             .stop_bits(serialport::StopBits::One)
             .flow_control(serialport::FlowControl::None)
             .timeout(READ_TIMEOUT)
-            .open()
-            .with_context(|| {
-                format!(
+            .open();
+        match port {
+            Ok(port) => Ok(Box::new(port)),
+            // the device is there and is no port: waiting will not help
+            Err(e) => Err(match self.check() {
+                Err(unusable) => anyhow::Error::new(unusable),
+                Ok(()) => anyhow::Error::new(e).context(format!(
                     "cannot open serial port {} at {} baud",
                     self.port, self.baud
-                )
-            })?;
-        Ok(Box::new(port))
+                )),
+            }),
+        }
     }
 }
 
@@ -204,8 +276,8 @@ pub enum MonitorEvent<'a> {
 
 /// Reads frames from the port until `stop` is set or `options.max_frames`
 /// are recorded, appending each to `log` as received; reopens the port
-/// whenever it is lost. Returns the final status. Fails only when the log
-/// file cannot be written.
+/// whenever it is lost. Returns the final status. Fails when the log file
+/// cannot be written or the port can never be monitored ([`Unusable`]).
 pub fn run(
     opener: &mut dyn PortOpener,
     log: &mut LogWriter,
@@ -219,6 +291,7 @@ pub fn run(
     while !stop.load(Ordering::SeqCst) && !done(&status) {
         let mut port = match opener.open() {
             Ok(port) => port,
+            Err(e) if e.is::<Unusable>() => return Err(e),
             Err(e) => {
                 observer(MonitorEvent::OpenFailed(&e));
                 pause(options.reopen_interval, stop);
@@ -557,6 +630,81 @@ mod tests {
             .map(|e| LogFrame::decode(e.frame.as_ref().unwrap()).unwrap().tick)
             .collect();
         assert_eq!(ticks, [1, 2, 3]);
+    }
+
+    /// Fails every open, as no serial device or as a missing port, counting the attempts.
+    struct Failing {
+        unusable: bool,
+        opens: usize,
+    }
+
+    impl PortOpener for Failing {
+        fn open(&mut self) -> Result<Box<dyn Read + Send>> {
+            self.opens += 1;
+            if self.unusable {
+                Err(Unusable("port /dev/zero is not a serial device".into()).into())
+            } else {
+                anyhow::bail!("no such port")
+            }
+        }
+    }
+
+    #[test]
+    fn the_loop_gives_up_on_a_port_that_can_never_be_monitored_and_retries_a_missing_one() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut log = LogWriter::create(&dir.path().join("x.log"), false).unwrap();
+        let options = MonitorOptions {
+            max_frames: None,
+            reopen_interval: Duration::ZERO,
+        };
+        let mut unusable = Failing {
+            unusable: true,
+            opens: 0,
+        };
+        let stop = AtomicBool::new(false);
+        let e = run(&mut unusable, &mut log, &options, &stop, &mut |_| {}).unwrap_err();
+        assert!(e.to_string().contains("not a serial device"), "{e}");
+        assert_eq!(unusable.opens, 1);
+        // a port that is not there (yet) is retried until stopped
+        let mut missing = Failing {
+            unusable: false,
+            opens: 0,
+        };
+        let mut failures = 0;
+        run(&mut missing, &mut log, &options, &stop, &mut |e| {
+            if matches!(e, MonitorEvent::OpenFailed(_)) {
+                failures += 1;
+                if failures == 3 {
+                    stop.store(true, Ordering::SeqCst);
+                }
+            }
+        })
+        .unwrap();
+        assert_eq!(missing.opens, 3);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn files_directories_and_devices_that_are_no_terminal_are_no_serial_ports() {
+        let dir = tempfile::tempdir().unwrap();
+        let file = dir.path().join("capture.bin");
+        std::fs::write(&file, [0u8; 4]).unwrap();
+        let opener = |port: &Path| SerialOpener {
+            port: port.display().to_string(),
+            baud: DEFAULT_BAUD,
+        };
+        for (port, what) in [
+            (file.as_path(), "a regular file"),
+            (dir.path(), "a directory"),
+            (
+                Path::new("/dev/zero"),
+                "a character device that is not a terminal",
+            ),
+        ] {
+            let e = opener(port).check().unwrap_err().to_string();
+            assert!(e.contains(what) && e.contains("not a serial device"), "{e}");
+        }
+        assert!(opener(&dir.path().join("ttyACM7")).check().is_ok());
     }
 
     #[test]

@@ -113,19 +113,37 @@ pub struct SearchConfig {
 impl SearchConfig {
     /// Checks the settings; errors name the setting.
     pub fn validate(&self, actions: usize) -> Result<()> {
-        let positive = [
-            ("generations", self.generations),
-            ("population", self.population as u64),
-            ("elites", self.elites as u64),
-            ("fitness-seeds", self.fitness_seeds as u64),
-            ("fitness-steps", self.fitness_steps),
-            ("validation-seeds", self.validation_seeds as u64),
-            ("validation-steps", self.validation_steps),
+        use sim::base::ranges;
+        let counts = [
+            (&ranges::GENERATIONS, "--generations", self.generations),
+            (&ranges::CANDIDATES, "--population", self.population as u64),
+            (&ranges::CANDIDATES, "--elites", self.elites as u64),
+            (
+                &ranges::SEARCH_WORLDS,
+                "--fitness-seeds",
+                self.fitness_seeds as u64,
+            ),
+            (&ranges::STEPS, "--fitness-steps", self.fitness_steps),
+            (
+                &ranges::SEARCH_WORLDS,
+                "--validation-seeds",
+                self.validation_seeds as u64,
+            ),
+            (&ranges::STEPS, "--validation-steps", self.validation_steps),
         ];
-        for (name, value) in positive {
-            if value == 0 {
-                bail!("--{name} = 0: must be at least 1");
-            }
+        for (range, flag, value) in counts {
+            range.check_count(flag, value)?;
+        }
+        // 0: one per core
+        if self.threads != 0 {
+            ranges::THREADS.check_count("--threads", self.threads as u64)?;
+        }
+        for (flag, value) in [
+            ("--keep", self.keep),
+            ("--rate", self.rate),
+            ("--floor", self.floor),
+        ] {
+            ranges::SEARCH_PROBABILITY.check_as(flag, value)?;
         }
         if self.population < 2 {
             bail!(
@@ -139,11 +157,6 @@ impl SearchConfig {
                 self.elites,
                 self.population
             );
-        }
-        for (name, value) in [("keep", self.keep), ("rate", self.rate)] {
-            if !(0.0..=1.0).contains(&value) {
-                bail!("--{name} = {value}: must be in [0, 1]");
-            }
         }
         let most = 1.0 / actions as f64;
         if !(0.0..=most).contains(&self.floor) {

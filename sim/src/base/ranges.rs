@@ -487,7 +487,7 @@ pub const WHEEL_SPEED_FACTOR: Range = Range::closed(
 
 /// The noise multiplier.
 pub const NOISE: Range = Range::closed(
-    &["noise"],
+    &["noise", "--also-noise"],
     0.0,
     5.0,
     "times the default noise",
@@ -525,6 +525,10 @@ pub const STEPS: Range = Range::closed(
         "select.steps",
         "distil_oc",
         "max_steps",
+        "epsilon_decay",
+        "--fitness-steps",
+        "--validation-steps",
+        "--window",
     ],
     1.0,
     1e10,
@@ -599,8 +603,76 @@ pub const SCALE: Range = Range::closed(
 pub const TRIALS: Range = Range::closed(&["--trials"], 1.0, 1000.0, "", "the thesis runs 10");
 
 /// Worker threads.
-pub const THREADS: Range =
-    Range::closed(&["--threads", "threads"], 1.0, 1024.0, "", "one per core");
+pub const THREADS: Range = Range::closed(
+    &["--threads", "threads"],
+    1.0,
+    1024.0,
+    "",
+    "one per core (none, or `host search`'s 0, for one per core)",
+);
+
+/// Generations of the policy search (`host search`).
+pub const GENERATIONS: Range = Range::closed(
+    &["--generations"],
+    1.0,
+    100_000.0,
+    "",
+    "20 by default; each scores every candidate on every fitness world",
+);
+
+/// Candidates per generation and elites of the policy search.
+pub const CANDIDATES: Range = Range::closed(
+    &["--population", "--elites"],
+    1.0,
+    1024.0,
+    "",
+    "16 and 4 by default; the population is at least 2 and holds the elites",
+);
+
+/// Worlds each candidate of the policy search is scored on.
+pub const SEARCH_WORLDS: Range = Range::closed(
+    &["--fitness-seeds", "--validation-seeds"],
+    1.0,
+    1000.0,
+    "",
+    "2 and 4 by default; the thesis' experiments run 10 trials",
+);
+
+/// The policy search's probabilities.
+pub const SEARCH_PROBABILITY: Range = Range::closed(
+    &["--keep", "--rate", "--floor"],
+    0.0,
+    1.0,
+    "",
+    "0.9, 0.5 and 0.01 by default; --floor at most 1 / actions",
+);
+
+/// Rewards an n-step update sums.
+pub const N_STEP: Range = Range::closed(
+    &["n_step"],
+    1.0,
+    64.0,
+    "rewards per update",
+    "1, the thesis' one-step Q-learning, by default",
+);
+
+/// Innies among the robots.
+pub const INNIES: Range = Range::closed(
+    &["innies"],
+    0.0,
+    1000.0,
+    "",
+    "at most the robots; half of them on the annulus",
+);
+
+/// `host`'s seeds: every 64-bit unsigned integer is one.
+pub const SEED: Range = Range::closed(
+    &["--seed", "--seeds"],
+    0.0,
+    u64::MAX as f64,
+    "",
+    "any unsigned 64-bit integer, 0 to 2^64 - 1",
+);
 
 /// Worlds of a Python vector environment.
 pub const WORLDS: Range = Range::closed(
@@ -826,6 +898,27 @@ pub const COUNTS_PER_MM: Range = Range::closed(
 /// Track width (`host replay`).
 pub const TRACK_MM: Range = Range::closed(&["--track-mm"], 10.0, 1000.0, "mm", "85 mm on the Zumo");
 
+/// Frames `host monitor --frames` records before it stops.
+pub const MONITOR_FRAMES: Range = Range::closed(
+    &["--frames"],
+    1.0,
+    1e10,
+    "frames",
+    "a day at 50 frames a second is 4,320,000",
+);
+
+/// The robot's id (`host flash`).
+pub const ROBOT_ID: Range = Range::closed(
+    &["--robot-id"],
+    0.0,
+    255.0,
+    "",
+    "one byte in every log frame; 0 for none",
+);
+
+/// TCP ports of the servers (`host view`, `host display`).
+pub const PORT: Range = Range::closed(&["--port"], 0.0, 65535.0, "", "0 for any free port");
+
 /// Serial baud rates (`host monitor`).
 pub const BAUD: Range = Range::closed(
     &["--baud"],
@@ -918,9 +1011,26 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &TRIALS,
             &THREADS,
             &WORLDS,
+            &SEED,
+            &N_STEP,
+            &INNIES,
+            &GENERATIONS,
+            &CANDIDATES,
+            &SEARCH_WORLDS,
+            &SEARCH_PROBABILITY,
         ],
     ),
-    ("Robots", &[&COUNTS_PER_MM, &TRACK_MM, &BAUD]),
+    (
+        "Robots and servers",
+        &[
+            &COUNTS_PER_MM,
+            &TRACK_MM,
+            &BAUD,
+            &MONITOR_FRAMES,
+            &ROBOT_ID,
+            &PORT,
+        ],
+    ),
     (
         "Files, read no further than these sizes",
         &[
