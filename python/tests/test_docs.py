@@ -106,3 +106,12 @@ def test_a_bad_exploration_setting_of_the_learning_benchmark_is_named(repo):
     for text, words in [("1", "INITIAL_Q,EPSILON"), ("a,b", "INITIAL_Q,EPSILON"), ("1,1.5", "epsilon 1.5")]:
         with pytest.raises(argparse.ArgumentTypeError, match=words):
             learning.exploration(text)
+
+
+def test_the_install_section_says_what_installing_builds_how_long_and_how_to_get_a_cpu_only_torch(repo):
+    doc = (repo / "docs" / "python.md").read_text()
+    install = doc[doc.index("## Install\n"):doc.index("## Settings\n")]
+    assert "pip install -v ./python" in install, "-v: cargo's progress, not only 'still running'"
+    for words in ("What `pip install ./python` builds", "in release", "Measured", "2 cores",
+                  "pip install torch --index-url https://download.pytorch.org/whl/cpu"):
+        assert words in install, words

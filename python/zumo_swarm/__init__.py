@@ -25,8 +25,8 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   ``"disc-thesis"`` or ``"robot"`` (the Zumo's photo-transistors and Pixy
   camera through the firmware's arithmetic); ``robot_config``: the robot
   model's settings as a dict or a JSON file (docs/robot-sensors.md);
-- ``seed=1``: the first world's seed (world ``i`` of a vector env gets
-  ``seed + i``);
+- ``seed=1``: the first world's seed, 0 to 2**63 - 1 (world ``i`` of a
+  vector env gets ``seed + i``, which must not pass 2**63 - 1 either);
 - ``max_steps=None``: truncate episodes after this many steps (they are
   always truncated at the stuck limit: 150,000 steps on the annulus,
   50,000 on letters and images);
@@ -42,7 +42,8 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   left, mid, right, then puck left/right and obstacle left/right as 0/1)
   or ``"state"`` (the reading hashed by ``hasher``, a discrete state);
 - ``hasher="original"``: ``"original"``, ``"original-obstacle"``,
-  ``"bits7"``, ``"bits9"``;
+  ``"bits7"``, ``"bits9"`` (checked whatever the observation;
+  ``"original-role"`` is refused: the environments have no innies);
 - ``action="discrete"``: ``"discrete"`` (an index into ``actions``) or
   ``"continuous"`` (an angular speed, radians per step, clipped to the
   largest of ``actions``);
@@ -54,8 +55,11 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   printed and in ``env.view_url``; docs/python.md), ``render_size=800``
   pixels.
 
-A bad argument raises ``ValueError`` or ``TypeError`` naming it; an
+A bad argument raises ``ValueError`` or ``TypeError`` naming it (a count
+out of range in the words of the ranges table, docs/ranges.md); an
 unknown keyword is refused with the closest valid name and the list.
+``step()`` before the first ``reset()``, and ``step()`` or ``reset()``
+after ``close()``, raise ``RuntimeError``.
 """
 
 from __future__ import annotations
