@@ -6,9 +6,9 @@
 //! Served: `/` (the page), `/recording.json` (the document), `/field.png`;
 //! nothing else, GET only, loopback unless the caller binds elsewhere.
 
-use crate::http;
-use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicBool, AtomicUsize};
+use crate::http::{self, Connection, Connections};
+use std::net::{SocketAddr, TcpListener};
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 /// The page, built in.
@@ -27,7 +27,7 @@ pub struct RecordingView {
     listener: TcpListener,
     address: SocketAddr,
     served: Arc<Served>,
-    open: Arc<AtomicUsize>,
+    open: Arc<Connections>,
 }
 
 impl RecordingView {
@@ -38,8 +38,7 @@ impl RecordingView {
         document: Vec<u8>,
         field_png: Vec<u8>,
     ) -> Result<RecordingView, String> {
-        let listener =
-            TcpListener::bind(bind).map_err(|e| format!("cannot listen on {bind}: {e}"))?;
+        let listener = http::bind_listener(bind)?;
         let address = listener
             .local_addr()
             .map_err(|e| format!("cannot read the address of {bind}: {e}"))?;
@@ -50,7 +49,7 @@ impl RecordingView {
                 document,
                 field_png,
             }),
-            open: Arc::new(AtomicUsize::new(0)),
+            open: Arc::new(Connections::new(address)),
         })
     }
 
@@ -66,7 +65,7 @@ impl RecordingView {
             &self.listener,
             &self.open,
             &AtomicBool::new(false),
-            move |stream| served.connection(stream),
+            move |connection| served.connection(connection),
         );
     }
 
@@ -80,10 +79,11 @@ impl RecordingView {
 
 impl Served {
     /// One connection: one request, answered.
-    fn connection(&self, mut stream: TcpStream) {
-        let Some(request) = http::accept_request(&mut stream, 0) else {
+    fn connection(&self, mut connection: Connection) {
+        let Some(request) = http::accept_request(&mut connection, 0) else {
             return;
         };
+        let stream = &mut connection.stream;
         let get = matches!(request.method.as_str(), "GET" | "HEAD");
         let (status, kind, body): (u16, &str, &[u8]) = match (request.path.as_str(), get) {
             ("/" | "/index.html", true) => (200, "text/html; charset=utf-8", PAGE.as_bytes()),
@@ -91,15 +91,15 @@ impl Served {
             ("/field.png", true) => (200, "image/png", &self.field_png),
             ("/" | "/index.html" | "/recording.json" | "/field.png", false) => {
                 let message = format!("{} is not served at {}", request.method, request.path);
-                return http::respond(&mut stream, 405, JSON, &http::error_json(&message));
+                return http::respond(stream, 405, JSON, &http::error_json(&message));
             }
             (path, _) => {
                 let message = format!(
                     "not found: {path} (this server has /, /recording.json and /field.png)"
                 );
-                return http::respond(&mut stream, 404, JSON, &http::error_json(&message));
+                return http::respond(stream, 404, JSON, &http::error_json(&message));
             }
         };
-        http::respond(&mut stream, status, kind, body);
+        http::reply(stream, &request, status, kind, body);
     }
 }

@@ -10,7 +10,7 @@
 //! `POST /policy?name=NAME` (a policy blob as the body). Refused settings
 //! answer 400 with the reason and change nothing.
 
-use crate::http::{self, error_json, Request};
+use crate::http::{self, error_json, Connection, Connections, Request};
 use crate::hub::Hub;
 use crate::session::{self, Companion, Frame, Hello, History, Learning, Policy, Session};
 use crate::settings::{self, valid_name, Allowed, ViewController, ViewSettings};
@@ -44,6 +44,15 @@ pub const REAL_TIME: f64 = 50.0;
 /// Steps one `step` control may ask for.
 pub const MAX_STEPS_PER_CONTROL: u64 = 1_000_000;
 
+/// Longest the simulation's thread steps while holding the control lock:
+/// it then lets waiting requests in, so every request is answered while
+/// steps run (a step of the largest world takes about 10 ms).
+pub const SLICE: Duration = Duration::from_millis(10);
+
+/// Behind by more than this, paced stepping drops its backlog and goes on
+/// from the present (a stall, a world too slow for the speed).
+pub const CATCH_UP: Duration = Duration::from_millis(100);
+
 /// How fast the simulation runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Speed {
@@ -71,6 +80,13 @@ impl Speed {
             Speed::Max => "max",
         }
     }
+}
+
+/// A `speed=` parameter; errors name it.
+fn speed_param(value: &str) -> Result<Speed, String> {
+    value
+        .parse()
+        .map_err(|_| format!("speed={value}: expected real, 10x or max"))
 }
 
 impl std::str::FromStr for Speed {
@@ -112,9 +128,12 @@ pub struct View {
 
 struct Shared {
     control: Mutex<Control>,
+    /// Threads waiting for `control`: the simulation's thread lets them in
+    /// between slices of steps.
+    waiting: AtomicUsize,
     wake: Condvar,
     hub: Hub,
-    connections: Arc<AtomicUsize>,
+    connections: Arc<Connections>,
     policies: Option<PathBuf>,
     allowed: Allowed,
     /// Set when a [`Follower`] is dropped: the server ends.
@@ -192,12 +211,51 @@ struct Control {
     /// Single steps asked for and not yet run.
     pending: u64,
     /// Paced runs count steps from here.
-    anchor: (Instant, u64),
+    pace: Pace,
     last_publish: Option<Instant>,
     /// Steps a second, measured over the last second.
     meter: Vec<(Instant, u64)>,
     uploads: BTreeMap<String, (u64, Vec<u8>)>,
     uploads_made: u64,
+}
+
+/// Paced stepping at a rate: the steps due since an anchor, less those
+/// run.
+#[derive(Clone, Copy, Debug)]
+struct Pace {
+    from: Instant,
+    done: u64,
+}
+
+impl Pace {
+    /// Pacing from `now`, the first step due one period later.
+    fn new(now: Instant) -> Pace {
+        Pace { from: now, done: 0 }
+    }
+
+    /// Steps due at `now` at `rate` a second and not yet run. Behind by
+    /// more than [`CATCH_UP`], the backlog is dropped: pacing goes on from
+    /// `now`, one step due.
+    fn due(&mut self, now: Instant, rate: f64) -> u64 {
+        let due = (now.saturating_duration_since(self.from).as_secs_f64() * rate) as u64;
+        let behind = due.saturating_sub(self.done);
+        if behind as f64 > rate * CATCH_UP.as_secs_f64() {
+            let period = Duration::from_secs_f64(1.0 / rate);
+            *self = Pace::new(now.checked_sub(period).unwrap_or(now));
+            return 1;
+        }
+        behind
+    }
+
+    /// `n` steps were run.
+    fn ran(&mut self, n: u64) {
+        self.done += n;
+    }
+
+    /// When the next step is due at `rate`.
+    fn next(&self, rate: f64) -> Instant {
+        self.from + Duration::from_secs_f64((self.done + 1) as f64 / rate)
+    }
 }
 
 impl Control {
@@ -329,8 +387,7 @@ impl View {
         paused: bool,
         speed: Speed,
     ) -> Result<View, String> {
-        let listener =
-            TcpListener::bind(bind).map_err(|e| format!("cannot listen on {bind}: {e}"))?;
+        let listener = http::bind_listener(bind)?;
         let address = listener
             .local_addr()
             .map_err(|e| format!("cannot read the address of {bind}: {e}"))?;
@@ -344,15 +401,16 @@ impl View {
                 paused,
                 speed,
                 pending: 0,
-                anchor: (Instant::now(), 0),
+                pace: Pace::new(Instant::now()),
                 last_publish: None,
                 meter: Vec::new(),
                 uploads: BTreeMap::new(),
                 uploads_made: 0,
             }),
+            waiting: AtomicUsize::new(0),
             wake: Condvar::new(),
             hub: Hub::default(),
-            connections: Arc::new(AtomicUsize::new(0)),
+            connections: Arc::new(Connections::new(address)),
             policies,
             allowed,
             stopped: AtomicBool::new(false),
@@ -387,7 +445,7 @@ impl View {
             &self.listener,
             &self.shared.connections,
             &self.shared.stopped,
-            move |stream| shared.connection(stream),
+            move |connection| shared.connection(connection),
         );
     }
 
@@ -447,11 +505,29 @@ fn json<T: Serialize>(value: &T) -> Utf8Bytes {
 
 impl Shared {
     fn lock(&self) -> MutexGuard<'_, Control> {
+        self.waiting.fetch_add(1, Ordering::SeqCst);
         // the control is consistent between statements: a panic in a step
         // leaves a world a reset replaces
-        self.control
+        let c = self
+            .control
             .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        self.waiting.fetch_sub(1, Ordering::SeqCst);
+        c
+    }
+
+    /// Lets the threads waiting for the control lock have it (for at most
+    /// a few milliseconds, so a flood of requests cannot stop the
+    /// simulation), then takes it again.
+    fn let_others_in<'a>(&'a self, c: MutexGuard<'a, Control>) -> MutexGuard<'a, Control> {
+        drop(c);
+        for _ in 0..50 {
+            if self.waiting.load(Ordering::SeqCst) == 0 {
+                break;
+            }
+            std::thread::sleep(Duration::from_micros(100));
+        }
+        self.lock()
     }
 
     fn hello_message(&self, c: &Control) -> Utf8Bytes {
@@ -506,13 +582,13 @@ impl Shared {
         self.hub.publish(&message);
     }
 
-    /// Replaces the simulation (a reset, new settings) and tells every viewer.
-    fn replace(&self, c: &mut Control, session: Session) -> Result<(), String> {
-        let png = session.field_png()?;
+    /// Replaces the simulation (a reset, new settings; `png` its field
+    /// image), cancels pending steps and tells every viewer.
+    fn replace(&self, c: &mut Control, session: Session, png: Vec<u8>) {
         c.source = Source::Own(session);
+        c.pending = 0;
         self.restart(c, png);
         self.publish(c);
-        Ok(())
     }
 
     /// A new generation: its field image, an empty plot, a hello to every viewer.
@@ -520,7 +596,7 @@ impl Shared {
         c.field_png = Arc::new(png);
         c.history = History::default();
         c.generation += 1;
-        c.anchor = (Instant::now(), 0);
+        c.pace = Pace::new(Instant::now());
         c.meter.clear();
         c.hello = self.hello_message(c);
         self.hub.publish(&c.hello);
@@ -549,7 +625,9 @@ impl Shared {
         }
     }
 
-    /// The simulation's thread: steps at the chosen speed, publishes.
+    /// The simulation's thread: steps at the chosen speed, publishes. It
+    /// holds the control lock for at most [`SLICE`] of steps at a time,
+    /// then lets waiting requests in.
     fn run(&self) {
         let frame_gap = Duration::from_secs_f64(1.0 / FRAMES_PER_SECOND);
         let mut c = self.lock();
@@ -559,85 +637,69 @@ impl Shared {
                     .wake
                     .wait(c)
                     .unwrap_or_else(std::sync::PoisonError::into_inner);
-                c.anchor = (Instant::now(), 0);
+                c.pace = Pace::new(Instant::now());
             }
             let now = Instant::now();
-            let mut single = false;
-            let stepped;
-            if c.pending > 0 {
-                // single steps run in chunks, so controls stay answered
-                let n = c.pending.min(10_000);
-                for _ in 0..n {
-                    c.source.step();
-                }
-                c.pending -= n;
-                stepped = true;
-                single = c.pending == 0;
-            } else {
-                match c.speed.rate() {
-                    Some(rate) => {
-                        let (from, done) = c.anchor;
-                        let due = (now.duration_since(from).as_secs_f64() * rate) as u64;
-                        let mut n = due.saturating_sub(done);
-                        if n as f64 > rate / 10.0 {
-                            // behind by more than 0.1 s: start again from now
-                            n = 1;
-                            c.anchor = (now, due.saturating_sub(1));
-                        }
-                        for _ in 0..n {
-                            c.source.step();
-                        }
-                        c.anchor.1 += n;
-                        stepped = n > 0;
-                    }
-                    None => {
-                        let until = now + Duration::from_millis(8);
-                        while Instant::now() < until {
-                            c.source.step();
-                        }
-                        stepped = true;
-                    }
+            let rate = c.speed.rate();
+            let want = match (c.pending, rate) {
+                (0, Some(rate)) => c.pace.due(now, rate),
+                (0, None) => u64::MAX,
+                (pending, _) => pending,
+            };
+            let mut ran = 0;
+            while ran < want {
+                c.source.step();
+                ran += 1;
+                if now.elapsed() >= SLICE {
+                    break;
                 }
             }
-            if stepped {
+            let single = c.pending > 0 && c.pending == ran;
+            if c.pending > 0 {
+                c.pending -= ran;
+            } else {
+                c.pace.ran(ran);
+            }
+            if ran > 0 {
                 c.measure();
             }
             let due = c.last_publish.is_none_or(|t| t.elapsed() >= frame_gap);
-            if stepped && (due || single) {
+            if ran > 0 && (due || single) {
                 self.publish(&mut c);
             }
             // wait for the next step or frame, or a control
-            let wait = match (c.paused, c.pending, c.speed.rate()) {
+            let wait = match (c.paused, c.pending, rate) {
                 (_, p, _) if p > 0 => Duration::ZERO,
                 (true, _, _) => Duration::ZERO,
-                (false, _, Some(rate)) => {
-                    let next = c.anchor.0 + Duration::from_secs_f64((c.anchor.1 + 1) as f64 / rate);
-                    next.saturating_duration_since(Instant::now())
-                        .min(frame_gap)
-                }
-                (false, _, None) => Duration::from_micros(200),
+                (false, _, Some(rate)) => c
+                    .pace
+                    .next(rate)
+                    .saturating_duration_since(Instant::now())
+                    .min(frame_gap),
+                (false, _, None) => Duration::ZERO,
             };
-            if !wait.is_zero() {
-                c = self
-                    .wake
+            c = if wait.is_zero() {
+                self.let_others_in(c)
+            } else {
+                self.wake
                     .wait_timeout(c, wait)
                     .unwrap_or_else(std::sync::PoisonError::into_inner)
-                    .0;
-            }
+                    .0
+            };
         }
     }
 
     /// One connection: one request, or a WebSocket's life.
-    fn connection(&self, mut stream: TcpStream) {
+    fn connection(&self, mut connection: Connection) {
         let limit = ranges::POLICY_FILE.max as usize;
-        let Some(request) = http::accept_request(&mut stream, limit) else {
+        let Some(request) = http::accept_request(&mut connection, limit) else {
             return;
         };
         if request.path == "/stream" && request.is_websocket() {
-            return self.stream(stream, &request);
+            return self.stream(connection, &request);
         }
         let (status, kind, body) = self.answer(&request);
-        http::respond(&mut stream, status, kind, &body);
+        http::reply(&mut connection.stream, &request, status, kind, &body);
     }
 
     fn answer(&self, request: &Request) -> (u16, &'static str, Vec<u8>) {
@@ -684,56 +746,45 @@ impl Shared {
 
     fn control(&self, query: &str) -> Result<(), String> {
         let pairs = settings::query_pairs(query);
+        if let Some((key, _)) = pairs
+            .iter()
+            .find(|(k, _)| !["action", "speed", "steps", "seed"].contains(&k.as_str()))
+        {
+            return Err(format!(
+                "unknown control {key:?}: expected action, speed, steps or seed"
+            ));
+        }
         let get = |key: &str| {
             pairs
                 .iter()
                 .find(|(k, _)| k == key)
                 .map(|(_, v)| v.as_str())
         };
-        let mut c = self.lock();
-        c.source.own()?;
-        if let Some(speed) = get("speed") {
-            c.speed = speed.parse()?;
-            c.anchor = (Instant::now(), 0);
+        let action = get("action");
+        let speed = get("speed").map(speed_param).transpose()?;
+        for (key, with) in [("steps", "step"), ("seed", "reset")] {
+            if get(key).is_some() && action != Some(with) {
+                return Err(format!("{key}= goes with action={with}"));
+            }
         }
-        match get("action") {
-            None if get("speed").is_some() => {}
-            Some("play") => {
-                c.paused = false;
-                c.pending = 0;
-                c.anchor = (Instant::now(), 0);
-            }
-            Some("pause") => {
-                c.paused = true;
-                c.pending = 0;
-                self.publish(&mut c);
-            }
-            Some("step") => {
-                let steps = match get("steps") {
-                    None => 1,
-                    Some(s) => {
-                        let n = s
-                            .parse::<u64>()
-                            .map_err(|_| format!("steps={s}: not a whole number"))?;
-                        ranges::RUN_STEPS
-                            .check_count("steps", n)
-                            .map_err(|e| e.to_string())?;
-                        n.min(MAX_STEPS_PER_CONTROL)
-                    }
-                };
-                c.paused = true;
-                c.pending += steps;
-            }
+        let mut rebuilt = None;
+        match action {
+            None if speed.is_some() => {}
+            Some("play" | "pause" | "step") => {}
             Some("reset") => {
-                let mut next = c.source.own()?.settings().clone();
-                if let Some(seed) = get("seed") {
-                    next.seed = seed.parse().map_err(|_| {
-                        format!("seed={seed}: not a whole number from 0 to 2^64 - 1")
-                    })?;
-                }
-                let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
-                let session = Session::build(next, policy)?;
-                self.replace(&mut c, session)?;
+                let seed = get("seed")
+                    .map(|seed| {
+                        seed.parse().map_err(|_| {
+                            format!("seed={seed}: not a whole number from 0 to 2^64 - 1")
+                        })
+                    })
+                    .transpose()?;
+                rebuilt = Some(self.rebuild(|now| {
+                    Ok(ViewSettings {
+                        seed: seed.unwrap_or(now.seed),
+                        ..now.clone()
+                    })
+                })?);
             }
             Some(other) => {
                 return Err(format!(
@@ -742,20 +793,106 @@ impl Shared {
             }
             None => return Err("no action= or speed= given".into()),
         }
+        let steps = match get("steps") {
+            None => 1,
+            Some(s) => {
+                let n = s
+                    .parse::<u64>()
+                    .map_err(|_| format!("steps={s}: not a whole number"))?;
+                ranges::RUN_STEPS
+                    .check_count("steps", n)
+                    .map_err(|e| e.to_string())?;
+                n.min(MAX_STEPS_PER_CONTROL)
+            }
+        };
+        let mut c = self.lock();
+        c.source.own()?;
+        if let Some(speed) = speed {
+            c.speed = speed;
+            c.pace = Pace::new(Instant::now());
+        }
+        match action {
+            Some("play") => {
+                c.paused = false;
+                c.pending = 0;
+                c.pace = Pace::new(Instant::now());
+            }
+            Some("pause") => {
+                c.paused = true;
+                c.pending = 0;
+                self.publish(&mut c);
+            }
+            Some("step") => {
+                c.paused = true;
+                c.pending = c.pending.saturating_add(steps).min(MAX_STEPS_PER_CONTROL);
+            }
+            _ => {}
+        }
+        if let Some((session, png)) = rebuilt {
+            self.replace(&mut c, session, png);
+        }
         self.wake.notify_all();
         Ok(())
     }
 
-    fn settings(&self, query: &str) -> Result<(), String> {
-        let mut c = self.lock();
-        let next =
-            c.source
-                .own()?
-                .settings()
-                .with_query(query, &self.allowed, &["speed", "paused"])?;
-        let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
+    /// A new session of the settings `change` makes of the running ones,
+    /// and its field image, built outside the control lock (a large world
+    /// takes a while) so requests and steps go on meanwhile.
+    fn rebuild(
+        &self,
+        change: impl FnOnce(&ViewSettings) -> Result<ViewSettings, String>,
+    ) -> Result<(Session, Vec<u8>), String> {
+        let (next, policy) = {
+            let mut c = self.lock();
+            let next = change(c.source.own()?.settings())?;
+            let policy = policy_for(&next, self.policies.as_deref(), &c.uploads)?;
+            (next, policy)
+        };
         let session = Session::build(next, policy)?;
-        self.replace(&mut c, session)?;
+        let png = session.field_png()?;
+        Ok((session, png))
+    }
+
+    /// New settings: the world's (a new simulation, pending steps
+    /// cancelled) when any of [`settings::KEYS`] is given, and `speed` and
+    /// `paused`; refused as a whole, naming the key, if any is bad.
+    fn settings(&self, query: &str) -> Result<(), String> {
+        let pairs = settings::query_pairs(query);
+        let mut speed = None;
+        let mut paused = None;
+        for (key, value) in &pairs {
+            match key.as_str() {
+                "speed" => speed = Some(speed_param(value)?),
+                "paused" => {
+                    paused = Some(match value.as_str() {
+                        "true" => true,
+                        "false" => false,
+                        _ => return Err(format!("paused={value}: expected true or false")),
+                    })
+                }
+                _ => {}
+            }
+        }
+        let world = pairs.is_empty() || pairs.iter().any(|(k, _)| k != "speed" && k != "paused");
+        let rebuilt = if world {
+            Some(self.rebuild(|now| now.with_query(query, &self.allowed, &["speed", "paused"]))?)
+        } else {
+            None
+        };
+        let mut c = self.lock();
+        c.source.own()?;
+        if let Some((session, png)) = rebuilt {
+            self.replace(&mut c, session, png);
+        }
+        if let Some(speed) = speed {
+            c.speed = speed;
+        }
+        if let Some(paused) = paused {
+            c.paused = paused;
+            c.pending = 0;
+        }
+        c.pace = Pace::new(Instant::now());
+        self.publish(&mut c);
         self.wake.notify_all();
         Ok(())
     }
@@ -795,8 +932,12 @@ impl Shared {
 
     /// A viewer's WebSocket: the hello and then every frame, until the
     /// viewer goes away or is dropped for not keeping up.
-    fn stream(&self, mut stream: TcpStream, request: &Request) {
-        if http::accept_websocket(&mut stream, request).is_err() {
+    fn stream(&self, connection: Connection, request: &Request) {
+        // `connection` stays open, and counted, for the viewer's life
+        let Ok(mut stream) = connection.stream.try_clone() else {
+            return;
+        };
+        if !http::accept_websocket(&mut stream, request) {
             return;
         }
         let queue = {
@@ -921,5 +1062,39 @@ impl Drop for Follower {
             let _ = accept.join();
         }
         self.shared.hub.close();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Steps `pace` runs at `rate`, asked every 5 ms from `from` to `to`
+    /// (seconds after `start`).
+    fn run(pace: &mut Pace, start: Instant, from: f64, to: f64) -> u64 {
+        let mut ran = 0;
+        let mut t = from;
+        while t < to {
+            let n = pace.due(start + Duration::from_secs_f64(t), REAL_TIME);
+            pace.ran(n);
+            ran += n;
+            t += 0.005;
+        }
+        ran
+    }
+
+    #[test]
+    fn after_a_stall_paced_steps_go_on_from_the_present() {
+        let start = Instant::now();
+        let mut pace = Pace::new(start);
+        let before = run(&mut pace, start, 0.0, 30.0);
+        assert!(before.abs_diff(1500) <= 2, "{before} steps in 30 s");
+        // stalled from 30 s to 35 s (SIGSTOP, a loaded machine): the second
+        // after it runs at the rate, neither frozen nor catching up
+        let after = run(&mut pace, start, 35.0, 36.0);
+        assert!(
+            (45..=55).contains(&after),
+            "{after} steps in the second after a stall"
+        );
     }
 }

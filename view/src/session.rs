@@ -14,6 +14,7 @@ use sim::episodes::eval::pucks_in_band;
 use sim::physics::outline::Outline;
 use sim::render::{self, RenderOptions};
 use sim::scenario::sensor_setup::SelectedSensors;
+use sim::scenario::trained_for;
 use sim::sensors::{FootprintKind, SensorModel};
 use sim::simulation::Simulation;
 use std::path::PathBuf;
@@ -29,6 +30,9 @@ pub struct Session {
     settings: ViewSettings,
     sim: Simulation<SelectedSensors>,
     controller: Box<dyn Controller + Send>,
+    /// Why the policy may act poorly here: it was trained for another
+    /// sensor model or arena (`host run`'s warning).
+    warning: Option<String>,
 }
 
 /// The plot's points (step, Eval, formations), at most [`HISTORY_POINTS`].
@@ -96,6 +100,10 @@ pub struct Hello {
     /// experiment, arm and trial).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub caption: Option<String>,
+    /// A policy trained for another sensor model or arena than the world's:
+    /// `host run`'s warning, shown on the page.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub warning: Option<String>,
 }
 
 /// A sensor's footprint in a robot's frame, for drawing.
@@ -166,10 +174,13 @@ impl Session {
     /// controller is a policy. Errors name the setting.
     pub fn build(settings: ViewSettings, policy: Option<Policy>) -> Result<Session, String> {
         let path = policy.as_ref().map(|p| p.path.clone());
-        let scenario = settings
-            .choices(path)
-            .scenario()
-            .map_err(|e| e.to_string())?;
+        let choices = settings.choices(path);
+        let warning = policy.as_ref().and_then(|p| {
+            let here = trained_for::trained_for(&choices.sensors, &choices.arena_choice());
+            trained_for::mismatch(p.blob.trained_for(), &here)
+                .map(|why| format!("policy {}: {why}", p.path.display()))
+        });
+        let scenario = choices.scenario().map_err(|e| e.to_string())?;
         let built = match policy {
             Some(p) => scenario.build_with_policy(p.blob),
             None => scenario.build(),
@@ -179,6 +190,7 @@ impl Session {
             settings,
             sim,
             controller,
+            warning,
         })
     }
 
@@ -199,7 +211,10 @@ impl Session {
 
     /// What stays until the next reset.
     pub fn hello(&self) -> Hello {
-        Hello::of(&self.sim, self.settings.pairs())
+        Hello {
+            warning: self.warning.clone(),
+            ..Hello::of(&self.sim, self.settings.pairs())
+        }
     }
 
     /// The field as grey with the target band outlined, as a PNG
@@ -235,6 +250,7 @@ impl Hello {
             check_interval: sim.config().episode.check_interval,
             companion: None,
             caption: None,
+            warning: None,
         }
     }
 }

@@ -74,3 +74,16 @@ pub fn wait_for_step(address: SocketAddr, step: u64) -> serde_json::Value {
         std::thread::sleep(std::time::Duration::from_millis(20));
     }
 }
+
+/// Sends `bytes` as they are and reads the answer until the server closes
+/// (at most 20 s); empty when none came.
+pub fn raw(address: SocketAddr, bytes: &[u8]) -> String {
+    let mut stream = TcpStream::connect(address).unwrap();
+    stream
+        .set_read_timeout(Some(std::time::Duration::from_secs(20)))
+        .unwrap();
+    let _ = stream.write_all(bytes);
+    let mut reply = Vec::new();
+    let _ = stream.read_to_end(&mut reply);
+    String::from_utf8_lossy(&reply).to_string()
+}
