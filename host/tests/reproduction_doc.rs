@@ -1,9 +1,23 @@
 //! docs/reproduction.md and docs/robot-sensors.md are what `host
 //! experiment report` renders from their templates and the committed
 //! trials: every figure they state comes from the trial files, and every
-//! claim their templates check still holds.
+//! claim their templates check still holds. The reproduction page's
+//! verdicts follow its one rule (recomputed here), and the author's
+//! per-trial figures in the experiment files are those of the checked-in
+//! copy of the author's result files.
 
-use std::path::Path;
+use host::experiment::metric::Metric;
+use host::experiment::published::SegmentTrial;
+use host::experiment::report::DOCUMENTS;
+use host::experiment::side_by_side::SideBySide;
+use host::experiment::spec::ExperimentSpec;
+use host::experiment::template::{self, Source};
+use host::report::stats::t95;
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
 
 #[test]
 fn the_rendered_pages_are_what_the_committed_trials_give() {
@@ -92,141 +106,262 @@ fn the_collisions_table_says_where_its_text_column_follows_the_code() {
     );
 }
 
-/// One training run's table at a glance, as the author's instrumented
-/// program or `host train` printed it.
-#[derive(Debug, Default)]
-struct TableAtEnd {
-    formations: f64,
-    stuck: f64,
-    states: f64,
-    shares: Vec<f64>,
-    median: f64,
-    p90: f64,
-    tied: f64,
-}
-
-/// The number `skip` + 1 tokens after `key` among whitespace-separated
-/// tokens.
-fn after_skipping(tokens: &[&str], key: &str, skip: usize) -> f64 {
-    let at = tokens
-        .iter()
-        .position(|t| *t == key)
-        .unwrap_or_else(|| panic!("no {key} in {tokens:?}"));
-    tokens[at + 1 + skip].trim_end_matches(',').parse().unwrap()
-}
-
-/// The number after `key` among whitespace-separated tokens.
-fn after(tokens: &[&str], key: &str) -> f64 {
-    after_skipping(tokens, key, 0)
-}
-
-/// The author's program's last lines (`END`, `ACTIONS_TOTAL`, `QSTATS`).
-fn author_run(text: &str) -> TableAtEnd {
-    let mut run = TableAtEnd::default();
-    for line in text.lines() {
-        let t: Vec<&str> = line.split_whitespace().collect();
-        match t.first() {
-            Some(&"END") => {
-                run.formations = after(&t, "formations");
-                run.stuck = after(&t, "stuck");
-            }
-            Some(&"ACTIONS_TOTAL") => {
-                run.shares = t[1..].iter().map(|v| v.parse().unwrap()).collect()
-            }
-            Some(&"QSTATS") => {
-                run.states = after(&t, "visited_states");
-                run.tied = after(&t, "states_with_tied_max");
-                run.median = after(&t, "q50");
-                run.p90 = after(&t, "q90");
-            }
-            _ => {}
-        }
-    }
-    run
-}
-
-/// `host train`'s report.
-fn our_run(text: &str) -> TableAtEnd {
-    let mut run = TableAtEnd::default();
-    for line in text.lines() {
-        let t: Vec<&str> = line.split_whitespace().collect();
-        match t.first() {
-            Some(&"formations") => run.formations = t[1].parse().unwrap(),
-            Some(&"stuck") => run.stuck = t[2].parse().unwrap(),
-            Some(&"states") => run.states = t[2].parse().unwrap(),
-            Some(&"actions") => run.shares = t[2..].iter().map_while(|v| v.parse().ok()).collect(),
-            Some(&"values,") => {
-                run.median = after(&t, "median");
-                run.p90 = after_skipping(&t, "90", 1); // "90 % -5.629,"
-            }
-            Some(&"tied") => run.tied = after(&t, "in"),
-            _ => {}
-        }
-    }
-    run
-}
-
-/// The side-by-side table of the learners' insides is what the runs under
-/// docs/reproduction/side-by-side/ printed: the author's program and ours,
-/// the same letters, length and number of runs.
+/// The experiment files' `author` lists are, trial by trial, the last
+/// counts of the author's result files (the checked-in copy under
+/// docs/reproduction/author/), and their means are Table 5's figures.
 #[test]
-fn the_side_by_side_of_the_learned_tables_is_what_the_runs_printed() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/reproduction");
-    // one space between words, as the rows and claims are written
-    let template = std::fs::read_to_string(root.join("template.md"))
-        .unwrap()
-        .split_whitespace()
-        .collect::<Vec<_>>()
-        .join(" ");
-    let mean = |runs: &[TableAtEnd], f: &dyn Fn(&TableAtEnd) -> f64| {
-        runs.iter().map(f).sum::<f64>() / runs.len() as f64
-    };
-    let mut missing = Vec::new();
-    for letter in ["T", "V"] {
-        let mut formations = Vec::new();
-        for (program, dir, read) in [
-            (
-                "the author's",
-                "author",
-                author_run as fn(&str) -> TableAtEnd,
-            ),
-            ("ours", "ours", our_run),
-        ] {
-            let runs: Vec<TableAtEnd> = (1..=4)
-                .map(|k| {
-                    let path = root.join(format!("side-by-side/{dir}/{letter}-{k}.txt"));
-                    read(&std::fs::read_to_string(&path).unwrap())
-                })
-                .collect();
-            assert!(runs.iter().all(|r| r.shares.len() == 4), "{runs:?}");
-            formations.push(runs.iter().map(|r| r.formations).collect::<Vec<f64>>());
-            let shares: Vec<String> = (0..4)
-                .map(|a| format!("{:.3}", mean(&runs, &|r| r.shares[a])))
-                .collect();
-            let row = format!(
-                "| {letter} | {program} | {} | {:.1} | {:.1} | {:.1} | {} | {:.2} | {:.2} | {:.0} |",
-                runs.len(),
-                mean(&runs, &|r| r.formations),
-                mean(&runs, &|r| r.stuck),
-                mean(&runs, &|r| r.states),
-                shares.join(", "),
-                mean(&runs, &|r| r.median),
-                mean(&runs, &|r| r.p90),
-                runs.iter().map(|r| r.tied).sum::<f64>(),
+fn the_authors_lists_are_the_counts_of_the_authors_result_files() {
+    let text =
+        std::fs::read_to_string(root().join("docs/reproduction/author/letters.tsv")).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split('\t').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let mut files: std::collections::BTreeMap<String, Vec<(usize, f64, f64)>> = Default::default();
+    for line in lines {
+        let c: Vec<&str> = line.split('\t').collect();
+        let formations: f64 = c[col("formations")].parse().unwrap();
+        // the copy keeps every rise of the count: as many as the last count
+        let rises = c[col("formation_steps")].split_whitespace().count();
+        assert_eq!(rises as f64, formations, "{line}");
+        files
+            .entry(format!("{} {}", c[col("letter")], c[col("system")]))
+            .or_default()
+            .push((
+                c[col("trial")].parse().unwrap(),
+                formations,
+                c[col("stuck")].parse().unwrap(),
+            ));
+    }
+    let spec = ExperimentSpec::load("letters").unwrap();
+    for arm in &spec.arms {
+        let listed = arm.author.get(&Metric::Formations);
+        let Some(trials) = files.get_mut(&arm.name) else {
+            assert!(
+                listed.is_none(),
+                "{}: an author list without files",
+                arm.name
             );
-            if !template.contains(&row) {
-                missing.push(row);
-            }
-        }
-        let p = host::report::stats::permutation_p(&formations[0], &formations[1]).unwrap();
-        let claim = format!("p {p:.2} on {letter}");
-        if !template.contains(&claim) {
-            missing.push(claim);
+            continue;
+        };
+        trials.sort_by_key(|t| t.0);
+        let counts: Vec<f64> = trials.iter().map(|t| t.1).collect();
+        assert_eq!(listed, Some(&counts), "{}", arm.name);
+        for (metric, i) in [(Metric::Formations, 1), (Metric::Stuck, 2)] {
+            let mean = trials.iter().map(|t| [t.1, t.2][i - 1]).sum::<f64>() / trials.len() as f64;
+            assert_eq!(
+                format!("{mean:.1}"),
+                format!("{:.1}", arm.thesis[&metric]),
+                "{}: Table 5's {metric:?}",
+                arm.name
+            );
         }
     }
+    assert_eq!(files.len(), 8, "T, V, X and Z, RL and OC");
+}
+
+/// The verdict rule, recomputed: ours over theirs with its 95 % interval
+/// (a mean's t interval over a single figure, or a ratio of two means
+/// with the delta method's interval and Welch's degrees of freedom), inside
+/// 0.75 to 4/3 reproduced, outside it not reproduced, else inconclusive.
+fn expected_verdict(ours: &[f64], theirs: &[f64], figure: f64) -> String {
+    let stats = |v: &[f64]| {
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let var = if v.len() > 1 {
+            v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)
+        } else {
+            0.0
+        };
+        (n, m, var)
+    };
+    let (na, ma, va) = stats(ours);
+    let (nb, mb, vb) = stats(theirs);
+    let r = ma / mb;
+    let (ua, ub) = (va / (na * ma * ma), vb / (nb * mb * mb));
+    let df = if nb == 1.0 {
+        na - 1.0
+    } else {
+        (ua + ub).powi(2) / (ua * ua / (na - 1.0) + ub * ub / (nb - 1.0))
+    };
+    let half = t95(df) * r * (ua + ub).sqrt();
+    let (low, high) = ((r - half) / figure, (r + half) / figure);
+    let show = |v: f64| format!("{:.2}", if v.abs() < 0.005 { 0.0 } else { v });
+    let bounds = format!("{} to {}", show(low), show(high));
+    if low >= 0.75 && high <= 4.0 / 3.0 {
+        format!("reproduced ({bounds})")
+    } else if low > 4.0 / 3.0 {
+        format!("not reproduced (ours higher: {bounds})")
+    } else if high < 0.75 {
+        format!("not reproduced (ours lower: {bounds})")
+    } else {
+        format!("inconclusive ({bounds})")
+    }
+}
+
+/// An arm's per-trial values of a quantity the summary judges.
+fn arm_values(source: &Source, arm: &str, quantity: &str, segments: bool) -> Vec<f64> {
+    if segments {
+        let of = |r: &SegmentTrial| match quantity {
+            "formations" => Some(r.formations as f64),
+            "first_formation" => r.first_formation.map(|s| s as f64),
+            "collisions_per_1000" => Some(r.collisions_per_1000),
+            q => panic!("no verdict on {q}"),
+        };
+        return source
+            .segments
+            .iter()
+            .filter(|r| r.arm == arm)
+            .filter_map(of)
+            .collect();
+    }
+    source
+        .published
+        .results
+        .iter()
+        .filter(|r| r.arm == arm)
+        .filter_map(|r| match quantity {
+            "formations" => Some(r.formations as f64),
+            "first_formation" => r.formation_steps.first().map(|&s| s as f64),
+            "collisions_per_1000" => Some(r.collisions_per_1000),
+            q => panic!("no verdict on {q}"),
+        })
+        .collect()
+}
+
+/// A verdict expression's verdict, recomputed from the trials; `None` for
+/// an expression that is not a verdict.
+fn recompute(expr: &str, sources: &[Source]) -> Option<String> {
+    let parts: Vec<&str> = expr.split('|').map(str::trim).collect();
+    let [experiment, arms, quantity, stat] = parts[..] else {
+        return None;
+    };
+    let (segments, stat) = match stat.strip_prefix("segments ") {
+        Some(stat) => (true, stat),
+        None => (false, stat),
+    };
+    if !(stat.starts_with("verdict") || stat == "author_verdict") {
+        return None;
+    }
+    let source = sources.iter().find(|s| s.spec.name == experiment).unwrap();
+    let metric = match quantity {
+        "formations" => Metric::Formations,
+        "first_formation" => Metric::FirstFormation,
+        "collisions_per_1000" => Metric::CollisionsPer1000,
+        q => panic!("no verdict on {q}"),
+    };
+    let figure = |arm: &str, m: Metric| source.spec.arm(arm).unwrap().thesis[&m];
+    Some(match arms.split_once(" / ") {
+        None if stat == "author_verdict" => {
+            let author = &source.spec.arm(arms).unwrap().author[&metric];
+            expected_verdict(&arm_values(source, arms, quantity, segments), author, 1.0)
+        }
+        None => expected_verdict(
+            &arm_values(source, arms, quantity, segments),
+            &[figure(arms, metric)],
+            1.0,
+        ),
+        Some((a, b)) => {
+            let thesis_ratio = || match source
+                .spec
+                .arm(a)
+                .unwrap()
+                .thesis
+                .get(&Metric::FormationsRatio)
+            {
+                Some(&r) if metric == Metric::Formations => r,
+                _ => figure(a, metric) / figure(b, metric),
+            };
+            let against = match stat.strip_prefix("verdict").unwrap().trim() {
+                "" => thesis_ratio(),
+                x => x.parse().unwrap(),
+            };
+            expected_verdict(
+                &arm_values(source, a, quantity, segments),
+                &arm_values(source, b, quantity, segments),
+                against,
+            )
+        }
+    })
+}
+
+/// Every verdict on docs/reproduction.md is the one rule's, recomputed
+/// here from the published trials (and the wall-segment trials and the
+/// author's trials) without the renderer's code for it: each template line
+/// with a verdict, its verdicts recomputed and its other expressions
+/// rendered, is a line of the page.
+#[test]
+fn every_verdict_on_the_page_follows_the_one_rule() {
+    std::env::set_current_dir(root()).unwrap();
+    let docs = Path::new("docs");
+    let document = DOCUMENTS[0];
+    let sources = document.sources(docs, 1.0, &|_| {}).unwrap();
+    let side = SideBySide::load(&docs.join("reproduction/side-by-side")).unwrap();
+    let template_text = std::fs::read_to_string(docs.join("reproduction/template.md")).unwrap();
+    let page = std::fs::read_to_string(docs.join("reproduction.md")).unwrap();
+    let page_lines: std::collections::HashSet<&str> = page.lines().collect();
+    let (mut verdicts, mut missing) = (0, Vec::new());
+    for line in template_text.lines() {
+        let mut expected = String::new();
+        let mut rest = line;
+        let mut judged = false;
+        while let Some(open) = rest.find("{{") {
+            expected.push_str(&rest[..open]);
+            let close = rest[open..].find("}}").unwrap() + open;
+            let expr = rest[open + 2..close].trim();
+            match recompute(expr, &sources) {
+                Some(v) => {
+                    expected.push_str(&v);
+                    judged = true;
+                    verdicts += 1;
+                }
+                None => expected.push_str(
+                    &template::render(&format!("{{{{{expr}}}}}"), &sources, &side).unwrap(),
+                ),
+            }
+            rest = &rest[close + 2..];
+        }
+        expected.push_str(rest);
+        if judged && !page_lines.contains(expected.as_str()) {
+            missing.push(expected);
+        }
+    }
+    assert!(verdicts > 100, "only {verdicts} verdicts found");
     assert!(
         missing.is_empty(),
-        "rows the template should hold:\n{}",
+        "lines whose verdicts are not the rule's:\n{}",
         missing.join("\n")
+    );
+}
+
+/// The page types none of the figures the trials or the runs give: the
+/// learners' side-by-side table and its comparisons, and the figures with
+/// wall segments, are rendered.
+#[test]
+fn the_template_types_no_figure_of_the_runs() {
+    let template = std::fs::read_to_string(root().join("docs/reproduction/template.md")).unwrap();
+    let mut prose = String::new();
+    let mut rest = template.as_str();
+    while let Some(open) = rest.find("{{") {
+        prose.push_str(&rest[..open]);
+        rest = &rest[open + rest[open..].find("}}").unwrap() + 2..];
+    }
+    prose.push_str(rest);
+    let prose = prose.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(template.contains("{{side-by-side table}}"));
+    for typed in [
+        "254",
+        "442",
+        "0.02",
+        "p 0.09",
+        "p 0.69",
+        "within 1.1",
+        "a tenth",
+        "| 31.0 |",
+    ] {
+        assert!(!prose.contains(typed), "typed into the template: {typed:?}");
+    }
+    assert!(
+        !prose.contains("forms as many shapes as the author"),
+        "equality read from a test that found no difference"
     );
 }

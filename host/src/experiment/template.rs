@@ -27,8 +27,9 @@
 //!   file; for `A / B` A's formations ratio, or the ratio of the two arms'
 //!   figures), `over_thesis` (the mean over the thesis' figure), `verdict`
 //!   (ours against the thesis' figure by the page's one rule, below),
-//!   `author` (the mean of the author's own trials, the arm's `author`
-//!   values in the experiment file), `over_author`, `author_verdict` (ours
+//!   and for `A / B` `verdict X` (our ratio against X, e.g. 1 for
+//!   the same), `author` (the mean of the author's own trials, the arm's `author`
+//!   values in the experiment file), `author_min`, `author_max`, `over_author`, `author_verdict` (ours
 //!   against the author's trials by the same rule), `p` (for `A / B`: the
 //!   two-sided p-value of an exact permutation test of the difference of
 //!   means, A's trials against B's). `segments STAT` (STAT one of `mean`,
@@ -439,10 +440,17 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
             },
         ));
     }
-    if stat == "author" {
+    if let Some(which) = stat.strip_prefix("author") {
         let values = author(spec, a, q)?;
-        let mean = values.iter().sum::<f64>() / values.len() as f64;
-        return Ok(Stat::number(mean, prose(mean)));
+        let v = match which {
+            "" => Some(values.iter().sum::<f64>() / values.len() as f64),
+            "_min" => values.iter().copied().reduce(f64::min),
+            "_max" => values.iter().copied().reduce(f64::max),
+            _ => None,
+        };
+        if let Some(v) = v {
+            return Ok(Stat::number(v, prose(v)));
+        }
     }
     if let Some(stat) = stat.strip_prefix("segments ") {
         return segments(source, a, b, q, stat.trim());
@@ -473,11 +481,14 @@ fn statistic(source: &Source, arms: &str, quantity: &str, stat: &str) -> Result<
                 .ok_or_else(|| anyhow!("too many trials for an exact permutation test"))?;
             return Ok(Stat::number(p, show_p(p)));
         }
-        if stat == "verdict" {
-            return Ok(Stat::text(&judge(
-                RatioCi::of(&values, &reference),
-                thesis(spec, a, Some(b), q)?,
-            )));
+        if let Some(figure) = stat.strip_prefix("verdict") {
+            let figure = match figure.trim() {
+                "" => thesis(spec, a, Some(b), q)?,
+                x => x
+                    .parse()
+                    .map_err(|_| anyhow!("verdict {x:?}: expected a number"))?,
+            };
+            return Ok(Stat::text(&judge(RatioCi::of(&values, &reference), figure)));
         }
         let mean = reference.iter().sum::<f64>() / reference.len() as f64;
         values.iter_mut().for_each(|v| *v /= mean);
@@ -560,7 +571,9 @@ fn judge(ci: Option<RatioCi>, figure: f64) -> String {
     let Some(ci) = ci.filter(|_| figure > 0.0).map(|ci| ci.over(figure)) else {
         return "– (no positive figure to compare with)".to_string();
     };
-    let bounds = format!("{:.2} to {:.2}", ci.low, ci.high);
+    // 2 decimals, without the sign of a bound that rounds to zero
+    let show = |v: f64| format!("{:.2}", if v.abs() < 0.005 { 0.0 } else { v });
+    let bounds = format!("{} to {}", show(ci.low), show(ci.high));
     match Verdict::of(ci) {
         Verdict::NotReproduced { higher } => format!(
             "not reproduced (ours {}: {bounds})",
@@ -806,7 +819,12 @@ mod tests {
         let s = sources(&[8, 12, 13], &[4, 6]);
         let r = |t: &str| render(t, &s, &SideBySide::default()).unwrap();
         assert_eq!(r("{{x | A / B | formations | p}}"), "0.200");
+        assert!(r("{{x | A / B | formations | verdict 1}}").starts_with("inconclusive"));
         assert_eq!(r("{{x | A | formations | author}}"), "10");
+        assert_eq!(
+            r("{{x | A | formations | author_min}} {{x | A | formations | author_max}}"),
+            "9 11"
+        );
         assert_eq!(r("{{x | A | formations | over_author}}"), "1.10");
         // mean 11 against 10; relative variances 7/363 and 1/300, Welch's
         // df 2.67 (t for 2 df: 4.303): 1.1 ± 4.303 x 1.1 x 0.1504
