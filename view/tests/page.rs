@@ -245,3 +245,26 @@ fn a_learning_world_shows_its_progress_and_its_companion_beside_it() {
         "{boxes}"
     );
 }
+
+#[test]
+fn a_policy_trained_for_other_sensors_chosen_on_the_page_shows_the_warning() {
+    let address = serve(small(7), true, Speed::Real);
+    // the page's own POST (its Origin is the server's): obeyed
+    let mut page = Browser::open(
+        &format!("http://{address}/?controller=policy:robot-annulus-8bit.policy&sensors=disc"),
+        SIZE,
+    );
+    page.wait_for("document.documentElement.dataset.generation === '1'", 60);
+    page.wait_for("document.documentElement.dataset.warning !== ''", 30);
+    let warning = page.data("warning");
+    assert!(
+        warning.contains("sensor model robot (this run: disc)"),
+        "{warning}"
+    );
+    assert_eq!(
+        page.eval("document.getElementById('warning').textContent")
+            .as_str()
+            .unwrap(),
+        warning
+    );
+}

@@ -76,14 +76,22 @@ pub fn wait_for_step(address: SocketAddr, step: u64) -> serde_json::Value {
 }
 
 /// Sends `bytes` as they are and reads the answer until the server closes
-/// (at most 20 s); empty when none came.
+/// or 20 s have passed; empty when none came.
 pub fn raw(address: SocketAddr, bytes: &[u8]) -> String {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
     let mut stream = TcpStream::connect(address).unwrap();
-    stream
-        .set_read_timeout(Some(std::time::Duration::from_secs(20)))
-        .unwrap();
     let _ = stream.write_all(bytes);
     let mut reply = Vec::new();
-    let _ = stream.read_to_end(&mut reply);
+    let mut chunk = [0u8; 4096];
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        if left.is_zero() || stream.set_read_timeout(Some(left)).is_err() {
+            break;
+        }
+        match stream.read(&mut chunk) {
+            Ok(0) | Err(_) => break,
+            Ok(n) => reply.extend_from_slice(&chunk[..n]),
+        }
+    }
     String::from_utf8_lossy(&reply).to_string()
 }
