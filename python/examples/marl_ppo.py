@@ -17,7 +17,7 @@ afresh at every step (--redraw 0) no setting we tried formed an annulus
 
 It prints a line every update, logs as CleanRL does (each ended episode's
 return, length and last Eval, the losses and steps per second, to
-runs/RUN/scalars.csv and to TensorBoard when it is installed: run_log.py),
+out/runs/RUN/scalars.csv and to TensorBoard when it is installed: run_log.py),
 and ends with a summary that holds the held-out evaluation: the exported
 table run greedily on the evaluation seeds, none of them trained on.
 """
@@ -50,7 +50,7 @@ def parse(argv=None):
     p.add_argument("--redraw", type=int, default=5, help="updates between draws of each world's exploration noise (0: sample every step)")
     p.add_argument("--out", default="out/marl-annulus.policy")
     p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each evaluation seed")
-    p.add_argument("--run-dir", help="the log's directory (default runs/marl_ppo__SEED__TIME)")
+    p.add_argument("--run-dir", help="the log's directory (default out/runs/marl_ppo__SEED__TIME)")
     args = p.parse_args(argv)
     if args.redraw < 0:
         p.error(f"--redraw {args.redraw}: expected a number of updates, 0 or more")

@@ -22,7 +22,7 @@ exports the Q-table: each state's best actions, among which the robot
 picks as the learner did.
 
 It logs as CleanRL does (each ended episode's return, length and last
-Eval, each evaluation, to runs/RUN/scalars.csv and to TensorBoard when it
+Eval, each evaluation, to out/runs/RUN/scalars.csv and to TensorBoard when it
 is installed: run_log.py) and ends with a summary that holds the held-out
 evaluation: the exported table run greedily on the evaluation seeds, none
 of them trained on (nor the world it selects on).
@@ -51,7 +51,7 @@ def parse(argv=None):
     p.add_argument("--max-steps", type=int, help="episode truncation (default none: an episode ends when it forms or is stuck)")
     p.add_argument("--out", default="out/marl-q-annulus.policy")
     p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each evaluation seed")
-    p.add_argument("--run-dir", help="the log's directory (default runs/marl_q__SEED__TIME)")
+    p.add_argument("--run-dir", help="the log's directory (default out/runs/marl_q__SEED__TIME)")
     return p.parse_args(argv)
 
 

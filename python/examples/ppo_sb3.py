@@ -7,7 +7,7 @@ is a table over hashed states, exactly what a robot looks up; the critic sees ev
 on its own draw of the policy (Gumbel noise fixed per world, robot and state), redrawn every few
 rollouts; SB3 would sample every discrete action afresh, which learns nothing here (docs/python.md).
 VecMonitor measures each episode's return and last Eval; they are logged as CleanRL logs them, with
-each evaluation, to runs/RUN/scalars.csv and to TensorBoard when it is installed (run_log.py), and SB3
+each evaluation, to out/runs/RUN/scalars.csv and to TensorBoard when it is installed (run_log.py), and SB3
 prints its table every rollout. Every 100,000 steps the greedy table runs on one evaluation world, and
 the table that formed most there is the one exported as a policy blob (as marl_q.py and `host train
 --select-every` keep their best). The run ends with a summary that holds the held-out evaluation: the
@@ -183,7 +183,7 @@ def main(argv=None):
     p.add_argument("steps", nargs="?", type=int, default=1_000_000, help="world-steps, all worlds together")
     p.add_argument("--out", default="out/ppo-annulus.policy")
     p.add_argument("--eval-steps", type=int, default=20_000, help="steps of the held-out evaluation on each seed")
-    p.add_argument("--run-dir", help="the log's directory (default runs/ppo_sb3__1__TIME)")
+    p.add_argument("--run-dir", help="the log's directory (default out/runs/ppo_sb3__1__TIME)")
     args = p.parse_args(argv)
     log = RunLog("ppo_sb3", {**vars(args), "seed": 1}, args.run_dir)
     model, env, table = train(args.steps, log=log)

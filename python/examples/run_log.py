@@ -1,7 +1,7 @@
 """What the neural examples log, as CleanRL logs it, and the held-out
 evaluation each of them ends with.
 
-A run's directory (``runs/EXAMPLE__SEED__TIME`` by default, CleanRL's
+A run's directory (``out/runs/EXAMPLE__SEED__TIME`` by default, CleanRL's
 naming) holds:
 
 - ``scalars.csv``: a header line ``global_step,tag,value,wall_time``, then
@@ -12,7 +12,7 @@ naming) holds:
   ``eval/formations``), the value, and the seconds since the run began;
 - TensorBoard's event files with the same scalars, when TensorBoard is
   installed (``pip install tensorboard``; then ``tensorboard --logdir
-  runs``); without it the CSV alone, and the run says so once;
+  out/runs``); without it the CSV alone, and the run says so once;
 - ``config.json``: the run's settings; ``summary.json``: its summary
   (both written whole, atomically).
 
@@ -73,7 +73,7 @@ class RunLog:
 
     def __init__(self, example: str, config: dict, run_dir: str | None = None) -> None:
         seed = config.get("seed", 0)
-        self.dir = Path(run_dir or f"runs/{example}__{seed}__{int(time.time())}")
+        self.dir = Path(run_dir or f"out/runs/{example}__{seed}__{int(time.time())}")
         self.dir.mkdir(parents=True, exist_ok=True)
         self.example, self.start = example, time.perf_counter()
         write_json(self.dir / "config.json", config)
