@@ -119,7 +119,8 @@ fn expression(expr: &str, sources: &[Source], side: &SideBySide) -> Result<Strin
             [_, "p"] => show_p(v),
             ["runs"] => prose(v),
             [.., f] if f.starts_with("action") => format!("{v:.3}"),
-            _ => format!("{v:.2}"),
+            [.., "median" | "p90"] => format!("{v:.2}"),
+            _ => prose(v),
         };
         if let Some((op, x)) = check {
             if !op.holds(v, x) {
