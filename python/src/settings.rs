@@ -515,22 +515,22 @@ mod tests {
 
     #[test]
     fn the_hasher_is_checked_whatever_the_observation() {
+        let refusals = [
+            ("original-role", "the role layout needs innies"),
+            ("md5", "unknown hasher"),
+        ];
         for observation in ["reading", "state"] {
-            let e = error_of(EnvArgs {
-                observation: observation.into(),
-                hasher: "original-role".into(),
-                ..EnvArgs::default()
-            });
-            assert!(
-                e.starts_with("hasher = \"original-role\": the role layout needs innies"),
-                "{e}"
-            );
-            let e = error_of(EnvArgs {
-                observation: observation.into(),
-                hasher: "md5".into(),
-                ..EnvArgs::default()
-            });
-            assert!(e.starts_with("hasher = \"md5\": unknown hasher"), "{e}");
+            for (hasher, problem) in refusals {
+                let e = error_of(EnvArgs {
+                    observation: observation.into(),
+                    hasher: hasher.into(),
+                    ..EnvArgs::default()
+                });
+                assert!(
+                    e.starts_with(&format!("hasher = {hasher:?}: {problem}")),
+                    "{e}"
+                );
+            }
         }
     }
 
