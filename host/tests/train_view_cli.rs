@@ -1,7 +1,7 @@
 //! `host train --view`: the page's stream carries the world the learner
 //! learns in with its progress, names the exported policy's world beside
-//! it, which acts while someone watches; and a run with the view trains
-//! exactly as one without.
+//! it, which acts while someone watches; a run with the view trains
+//! exactly as one without, and keeps serving its final state until Ctrl-C.
 
 use std::io::{BufRead, BufReader};
 use std::net::TcpStream;
@@ -133,15 +133,32 @@ fn the_page_shows_the_learning_world_with_its_progress_and_the_exported_policy_a
 }
 
 #[test]
-fn training_with_the_view_gives_the_policy_and_figures_of_training_without_it() {
+fn training_with_the_view_gives_the_policy_and_figures_of_training_without_it_and_serves_until_ctrl_c(
+) {
     let base = std::env::temp_dir().join(format!("train-view-same-{}", std::process::id()));
     let (with, without) = (base.join("with"), base.join("without"));
     let mut training = train_with_view(&with, "300000");
     // a viewer, so the greedy world runs too
     let mut socket = viewer(&training.learning);
     let _ = next_json(&mut socket);
+    // the summary, then the line saying the page stays until Ctrl-C
     let mut rest = String::new();
-    std::io::Read::read_to_string(&mut training._stdout, &mut rest).unwrap();
+    loop {
+        let mut line = String::new();
+        let read = training._stdout.read_line(&mut line).unwrap();
+        assert!(read > 0, "host train --view ended before Ctrl-C: {rest}");
+        rest.push_str(&line);
+        if line.starts_with("view: training ended") {
+            break;
+        }
+    }
+    assert!(rest.contains("until Ctrl-C"), "{rest}");
+    // still serving its final state after training ended
+    let mut late = viewer(&training.learning);
+    assert!(next_json(&mut late).is_object());
+    let pid = training.child.id().to_string();
+    let sent = Command::new("kill").args(["-INT", &pid]).status().unwrap();
+    assert!(sent.success());
     assert!(training.child.wait().unwrap().success());
     let plain = Command::new(HOST)
         .args(["train", "--steps", "300000", "--seed", "4", "--out"])

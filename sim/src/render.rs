@@ -21,7 +21,8 @@ use image::{Rgb, RgbImage};
 /// A puck's colour.
 pub const PUCK: Rgb<u8> = Rgb([200, 44, 44]);
 /// A puck's colour in the target band, when the band is drawn.
-pub const PUCK_IN_BAND: Rgb<u8> = Rgb([40, 190, 60]);
+/// The live view's page (`view/src/page.html`) draws them the same.
+pub const PUCK_IN_BAND: Rgb<u8> = Rgb([40, 180, 80]);
 const ROBOT: Rgb<u8> = Rgb([0, 100, 200]);
 const HEADING: Rgb<u8> = Rgb([255, 255, 255]);
 const PUCK_SENSOR: Rgb<u8> = Rgb([250, 200, 0]);

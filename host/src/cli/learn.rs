@@ -1,11 +1,13 @@
 //! Learning: `host train` and `host experiment`.
 
 use super::screen::{parse_bind, Bind};
-use clap::{Args, Subcommand};
+use clap::{ArgMatches, Args, FromArgMatches, Subcommand};
 use host::experiment::shard::Shard;
 use host::experiment::RunOptions;
 use host::search::{SearchConfig, SearchRequest};
 use host::train::{TrainFlags, TrainRequest};
+use std::marker::PhantomData;
+use std::ops::Deref;
 use std::path::PathBuf;
 
 /// `host train`'s options.
@@ -57,11 +59,11 @@ pub struct SearchArgs {
     /// flags override it.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// The world's settings: every field of a training config (the learner's
-    /// hasher and actions, the field, sensors, arena, counts, noise, seed,
-    /// --out and --name).
+    /// The world's settings: a training config's fields but those only
+    /// training uses (the learner's hasher and actions, the field,
+    /// sensors, arena, counts, noise, seed, --out and --name).
     #[command(flatten)]
-    pub flags: TrainFlags,
+    pub flags: FlagsOf<Search>,
     /// The search's settings.
     #[command(flatten)]
     pub search: SearchConfig,
@@ -72,7 +74,7 @@ impl SearchArgs {
     pub fn request(self) -> SearchRequest {
         SearchRequest {
             config: self.config,
-            flags: self.flags,
+            flags: self.flags.0,
             search: self.search,
         }
     }
@@ -86,8 +88,8 @@ pub struct GapArgs {
     #[arg(long)]
     pub label: String,
     /// Steps of the final window of training, and of each frozen and
-    /// flashed run.
-    #[arg(long, default_value_t = 1_000_000)]
+    /// flashed run [default: 1,000,000].
+    #[arg(long, default_value_t = 1_000_000, hide_default_value = true)]
     pub window: u64,
     /// The seeds, one training run each (comma-separated).
     #[arg(long, value_delimiter = ',', required = true)]
@@ -101,12 +103,92 @@ pub struct GapArgs {
     /// TOML file with any of the training settings; flags override it.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// The training settings flags.
+    /// The training settings flags (but the output's and --seed: --seeds).
     #[command(flatten)]
-    pub flags: TrainFlags,
+    pub flags: FlagsOf<Gap>,
     /// The default real-world noise (the same as --noise 1).
     #[arg(long, conflicts_with = "noise")]
     pub randomise: bool,
+}
+
+/// Which of a training config's flags a command other than `host train`
+/// does not use, and the helps that say what others mean there.
+pub trait FlagUse {
+    /// The command, for the error on a flag it does not use.
+    const COMMAND: &'static str;
+    /// The ids of the flags it does not use: hidden from its help and
+    /// refused when given.
+    const UNUSED: &'static [&'static str];
+    /// Helps replaced, by id.
+    const HELPS: &'static [(&'static str, &'static str)];
+}
+
+/// `host search`: no training steps, checkpoints or policy selection.
+#[derive(Clone, Debug)]
+pub enum Search {}
+
+impl FlagUse for Search {
+    const COMMAND: &'static str = "host search";
+    const UNUSED: &'static [&'static str] =
+        &["steps", "checkpoint_every", "select_every", "select_steps"];
+    const HELPS: &'static [(&'static str, &'static str)] = &[(
+        "out",
+        "Directory of <name>.policy and <name>.search.json [default: out]",
+    )];
+}
+
+/// `host policy gap`: writes no files, one run per --seeds.
+#[derive(Clone, Debug)]
+pub enum Gap {}
+
+impl FlagUse for Gap {
+    const COMMAND: &'static str = "host policy gap";
+    const UNUSED: &'static [&'static str] = &["out", "name", "checkpoint_every", "seed"];
+    const HELPS: &'static [(&'static str, &'static str)] = &[(
+        "steps",
+        "Steps of each training run, its last --window of them the learner's window [default: 2,000,000]",
+    )];
+}
+
+/// A training config's flags as command `U` takes them ([`FlagUse`]).
+#[derive(Clone, Debug)]
+pub struct FlagsOf<U>(pub TrainFlags, PhantomData<U>);
+
+impl<U> Deref for FlagsOf<U> {
+    type Target = TrainFlags;
+
+    fn deref(&self) -> &TrainFlags {
+        &self.0
+    }
+}
+
+impl<U: FlagUse> Args for FlagsOf<U> {
+    fn augment_args(command: clap::Command) -> clap::Command {
+        let mut command = TrainFlags::augment_args(command);
+        for &id in U::UNUSED {
+            let message = format!("{} does not use --{}", U::COMMAND, id.replace('_', "-"));
+            let refuse = move |_: &str| Err::<String, String>(message.clone());
+            command = command.mut_arg(id, |a| a.hide(true).value_parser(refuse));
+        }
+        for &(id, help) in U::HELPS {
+            command = command.mut_arg(id, |a| a.help(help));
+        }
+        command
+    }
+
+    fn augment_args_for_update(command: clap::Command) -> clap::Command {
+        FlagsOf::<U>::augment_args(command)
+    }
+}
+
+impl<U> FromArgMatches for FlagsOf<U> {
+    fn from_arg_matches(matches: &ArgMatches) -> Result<Self, clap::Error> {
+        Ok(FlagsOf(TrainFlags::from_arg_matches(matches)?, PhantomData))
+    }
+
+    fn update_from_arg_matches(&mut self, matches: &ArgMatches) -> Result<(), clap::Error> {
+        self.0.update_from_arg_matches(matches)
+    }
 }
 
 /// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.

@@ -72,8 +72,8 @@ pub struct RunArgs {
     /// The scenario.
     #[command(flatten)]
     pub scenario: ScenarioArgs,
-    /// Steps to run.
-    #[arg(long, default_value_t = 200_000)]
+    /// Steps to run [default: 200,000].
+    #[arg(long, default_value_t = 200_000, hide_default_value = true)]
     pub steps: u64,
     /// Print one JSON object instead of text.
     #[arg(long)]
@@ -87,8 +87,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub scenario: ScenarioArgs,
     /// Steps to run before drawing (or to animate, with --gif; with
-    /// --until-formed, at most).
-    #[arg(long, default_value_t = 200_000)]
+    /// --until-formed, at most) [default: 200,000].
+    #[arg(long, default_value_t = 200_000, hide_default_value = true)]
     pub steps: u64,
     /// PNG file to write.
     #[arg(long, required_unless_present = "gif")]
@@ -103,7 +103,7 @@ pub struct RenderArgs {
     /// Steps between GIF frames [default: --steps / 100, at least 1].
     #[arg(long)]
     pub every: Option<u64>,
-    /// Image side in pixels.
+    /// Image width in pixels (the height follows the arena's shape).
     #[arg(long, default_value_t = 800)]
     pub size: u32,
     /// Draw each robot's sensor discs and field points.

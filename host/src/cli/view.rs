@@ -46,7 +46,8 @@ pub struct ViewArgs {
     /// drove on (default the annulus on tv75).
     #[arg(long, requires = "policy")]
     pub log: Option<PathBuf>,
-    /// The policy blob the robot of --log was flashed with.
+    /// With --log only: the policy blob the robot was flashed with (a
+    /// simulation's policy is --controller policy:FILE).
     #[arg(long, requires = "log")]
     pub policy: Option<PathBuf>,
     /// How --log's wheel encoder counts become the robot's track.

@@ -69,15 +69,15 @@ pub struct TrainConfig {
     /// robot senses' readings [default: 0].
     #[arg(long, required = false)]
     pub noise: f64,
-    /// Steps to run [default: 2000000; when resuming, the checkpoint's run
-    /// length].
+    /// Steps to run [default: 2,000,000; when resuming, the checkpoint's
+    /// run length].
     #[arg(long, required = false)]
     pub steps: u64,
     /// Seed of every random choice [default: 1].
     #[arg(long, required = false)]
     pub seed: u64,
     /// Steps before an unformed episode counts as stuck [default: the
-    /// field's: 150000 on the annulus, 50000 otherwise].
+    /// field's: 150,000 on the annulus, 50,000 otherwise].
     #[arg(long)]
     pub stuck_limit: Option<u64>,
     /// The learner.
@@ -186,7 +186,7 @@ pub struct OutputConfig {
     /// path separators) [default: <field>-<hasher>, e.g. annulus-original].
     #[arg(long)]
     pub name: Option<String>,
-    /// Steps between checkpoints, 0 for only at the end [default: 1000000].
+    /// Steps between checkpoints, 0 for only at the end [default: 1,000,000].
     #[arg(long, required = false)]
     pub checkpoint_every: u64,
 }
