@@ -46,14 +46,14 @@ pub const EVICT_AFTER: Duration = Duration::from_secs(1);
 /// view); errors name the address.
 pub fn bind_listener(bind: SocketAddr) -> Result<TcpListener, String> {
     let listener = TcpListener::bind(bind).map_err(|e| format!("cannot listen on {bind}: {e}"))?;
-    if let Some(warning) = exposure_warning(bind) {
+    if let Some(warning) = exposure_warning(listener.local_addr().unwrap_or(bind)) {
         eprintln!("warning: {warning}");
     }
     Ok(listener)
 }
 
 /// The warning for serving on `bind`, or `None` on a loopback address.
-pub fn exposure_warning(bind: SocketAddr) -> Option<String> {
+fn exposure_warning(bind: SocketAddr) -> Option<String> {
     (!bind.ip().is_loopback()).then(|| {
         format!(
             "serving on {bind}, not loopback: every machine that can reach this one can open the page and drive it"
@@ -91,11 +91,6 @@ impl Connections {
             bound: bound.ip(),
             open: Mutex::new(Open::default()),
         }
-    }
-
-    /// Connections open now.
-    pub fn count(&self) -> usize {
-        self.lock().entries.len()
     }
 
     fn lock(&self) -> MutexGuard<'_, Open> {

@@ -6,9 +6,12 @@
 //! current hello and frame, for scripts), `GET /stream` (WebSocket:
 //! `hello`, then `frame`s), `POST /control?action=play|pause|step|reset`
 //! (`&seed=N` with reset, `&steps=N` with step), `POST /control?speed=real|10x|max`,
-//! `POST /settings?KEY=VALUE...` (the settings of [`crate::settings::KEYS`]),
-//! `POST /policy?name=NAME` (a policy blob as the body). Refused settings
-//! answer 400 with the reason and change nothing.
+//! `POST /settings?KEY=VALUE...` (the settings of [`crate::settings::KEYS`],
+//! `speed` and `paused`), `POST /policy?name=NAME` (a policy blob as the
+//! body). Refused settings answer 400 naming the key and change nothing.
+//! The simulation's thread steps in slices of at most [`SLICE`], letting
+//! waiting requests in between, so a long step request never keeps a
+//! request waiting; a pause, play, reset or new settings cancel its steps.
 
 use crate::http::{self, error_json, Connection, Connections, Request};
 use crate::hub::Hub;
