@@ -148,12 +148,14 @@ impl LogWriter {
     }
 }
 
-fn read_up_to(f: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+fn read_up_to(f: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut n = 0;
     while n < buf.len() {
-        match f.read(&mut buf[n..])? {
-            0 => break,
-            k => n += k,
+        match f.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
         }
     }
     Ok(n)
@@ -271,34 +273,71 @@ fn check_header(bytes: &[u8]) -> Result<()> {
 /// be read (truncated, another format version); damaged records become
 /// entries with an error.
 pub fn parse(bytes: &[u8]) -> Result<Recording> {
-    let starts_like_header =
-        !bytes.is_empty() && MAGIC.starts_with(&bytes[..bytes.len().min(MAGIC.len())]);
-    if !starts_like_header {
-        let mut splitter = FrameSplitter::new();
-        let mut chunks = splitter.push(bytes);
-        chunks.extend(splitter.finish());
-        let entries = chunks
+    let mut entries = Vec::new();
+    let kind = split(bytes, None, &mut |e| entries.push(e))?;
+    Ok(Recording { kind, entries })
+}
+
+/// Bytes read from the file at a time.
+const READ_BLOCK: usize = 64 * 1024;
+
+/// Splits what `reader` gives into entries, handing each to `visit` as it
+/// is read (memory does not grow with the file), and refuses more than
+/// `limit` bytes; returns what kind of file it is. Errors as [`parse`]'s,
+/// and the reader's.
+fn split(
+    mut reader: impl Read,
+    limit: Option<&'static ranges::Range>,
+    visit: &mut dyn FnMut(Entry),
+) -> Result<SourceKind> {
+    let mut first = [0u8; HEADER_LEN];
+    let n = read_up_to(&mut reader, &mut first)?;
+    let first = &first[..n];
+    let starts_like_header = n > 0 && MAGIC.starts_with(&first[..n.min(MAGIC.len())]);
+    let (kind, mut splitter) = if starts_like_header {
+        check_header(first)?;
+        let splitter = FrameSplitter::with_limit(HEADER_LEN as u64, MAX_RECORD_LEN);
+        (SourceKind::Recorded, splitter)
+    } else {
+        (SourceKind::RawCapture, FrameSplitter::new())
+    };
+    let entry = |chunk: Chunk| match kind {
+        SourceKind::Recorded => decode_record(&chunk),
+        SourceKind::RawCapture => Entry {
+            offset: chunk.offset,
+            len: chunk.bytes.len(),
+            host_time_us: None,
+            frame: Ok(chunk.bytes),
+        },
+    };
+    if kind == SourceKind::RawCapture {
+        splitter
+            .push(first)
             .into_iter()
-            .map(|c| Entry {
-                offset: c.offset,
-                len: c.bytes.len(),
-                host_time_us: None,
-                frame: Ok(c.bytes),
-            })
-            .collect();
-        return Ok(Recording {
-            kind: SourceKind::RawCapture,
-            entries,
-        });
+            .map(entry)
+            .for_each(&mut *visit);
     }
-    check_header(bytes)?;
-    let mut splitter = FrameSplitter::with_limit(HEADER_LEN as u64, MAX_RECORD_LEN);
-    let mut chunks = splitter.push(&bytes[HEADER_LEN..]);
-    chunks.extend(splitter.finish());
-    Ok(Recording {
-        kind: SourceKind::Recorded,
-        entries: chunks.iter().map(decode_record).collect(),
-    })
+    let mut total = n as u64;
+    let mut block = vec![0u8; READ_BLOCK];
+    loop {
+        let n = match reader.read(&mut block) {
+            Ok(0) => break,
+            Ok(n) => n,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => continue,
+            Err(e) => return Err(e.into()),
+        };
+        total += n as u64;
+        if let Some(limit) = limit.filter(|l| total as f64 > l.max) {
+            return Err(ranges::too_large(limit).into());
+        }
+        splitter
+            .push(&block[..n])
+            .into_iter()
+            .map(entry)
+            .for_each(&mut *visit);
+    }
+    splitter.finish().into_iter().map(entry).for_each(visit);
+    Ok(kind)
 }
 
 fn decode_record(chunk: &Chunk) -> Entry {
@@ -340,9 +379,22 @@ fn decode_record(chunk: &Chunk) -> Entry {
 
 /// Reads and splits a recorded log or raw capture; errors name the file.
 pub fn read(path: &Path) -> Result<Recording> {
-    let bytes = ranges::read_file(path, &ranges::LOG_FILE)
-        .with_context(|| format!("cannot read log file {}", path.display()))?;
-    parse(&bytes).with_context(|| format!("log file {}", path.display()))
+    let mut entries = Vec::new();
+    let kind = read_each(path, &ranges::LOG_FILE, &mut |e| entries.push(e))?;
+    Ok(Recording { kind, entries })
+}
+
+/// Reads a recorded log or raw capture of at most `limit` bytes entry by
+/// entry, handing each to `visit` as it is read: memory does not grow
+/// with the file. Returns what kind of file it is; errors name the file.
+pub fn read_each(
+    path: &Path,
+    limit: &'static ranges::Range,
+    visit: &mut dyn FnMut(Entry),
+) -> Result<SourceKind> {
+    let file =
+        File::open(path).with_context(|| format!("cannot read log file {}", path.display()))?;
+    split(file, Some(limit), visit).with_context(|| format!("log file {}", path.display()))
 }
 
 #[cfg(test)]

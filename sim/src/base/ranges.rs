@@ -231,6 +231,16 @@ pub const LOG_FILE: Range = Range::closed(
     "about a day of one robot's log at 50 frames a second",
 );
 
+/// Longest log `host view --log` plays: the page's document holds every
+/// frame, some 8 bytes of it per byte of the log.
+pub const VIEW_LOG_FILE: Range = Range::closed(
+    &["viewed log file size"],
+    0.0,
+    64.0 * 1024.0 * 1024.0,
+    "bytes",
+    "about 6 hours of one robot's log; the page's document takes about 8 times the log (`host replay` reads any log up to the log file size)",
+);
+
 /// Longest checkpoint file.
 pub const CHECKPOINT_FILE: Range = Range::closed(
     &["checkpoint file size"],
@@ -542,7 +552,7 @@ pub const RUN_STEPS: Range = Range::closed(
     0.0,
     1e10,
     "steps",
-    "as a training run's; 0 draws the first step",
+    "200,000 by default, as a training run's range; 0 draws the first step",
 );
 
 /// Steps between the frames of an animation (`host render --gif`).
@@ -551,7 +561,7 @@ pub const FRAME_EVERY: Range = Range::closed(
     1.0,
     1e6,
     "steps",
-    "100 by default",
+    "--steps / 100 by default (100 frames), at least 1",
 );
 
 /// Steps between checkpoints.
@@ -1038,6 +1048,7 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &POLICY_FILE,
             &IMAGE_FILE,
             &LOG_FILE,
+            &VIEW_LOG_FILE,
             &CHECKPOINT_FILE,
         ],
     ),
@@ -1069,17 +1080,23 @@ pub fn read_file(path: &Path, limit: &'static Range) -> std::io::Result<Vec<u8>>
     let mut bytes = Vec::new();
     file.take(max + 1).read_to_end(&mut bytes)?;
     if bytes.len() as u64 > max {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!(
-                "larger than {} bytes, the most a {} is ({})",
-                number(limit.max),
-                limit.key().trim_end_matches(" size"),
-                limit.why
-            ),
-        ));
+        return Err(too_large(limit));
     }
     Ok(bytes)
+}
+
+/// The error of a file larger than `limit` allows (a reader that streams
+/// a file reads no further than `limit.max + 1` bytes, then refuses it so).
+pub fn too_large(limit: &'static Range) -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::InvalidData,
+        format!(
+            "larger than {} bytes, the most a {} is ({})",
+            number(limit.max),
+            limit.key().trim_end_matches(" size"),
+            limit.why
+        ),
+    )
 }
 
 /// [`read_file`] as text.

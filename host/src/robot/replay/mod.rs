@@ -35,13 +35,14 @@ pub use report::{
     StageCounts, LISTED,
 };
 
-use super::log_file::{Recording, SourceKind};
+use super::log_file::{self, Entry, Recording, SourceKind};
 use super::visits::TrainingVisits;
 use anyhow::{bail, Result};
 use decisions::DecisionCheck;
 use faults::FaultTracker;
 use odometry::{OdometrySettings, OdometryTracker};
 use shared::{LogFrame, PolicyBlob, State};
+use sim::base::ranges;
 use std::collections::BTreeMap;
 use std::path::Path;
 use timeline::Timeline;
@@ -55,21 +56,8 @@ pub fn replay(
     odometry: OdometrySettings,
 ) -> ReplayReport {
     let mut r = Replayer::new(policy, odometry);
-    for entry in &recording.entries {
-        match &entry.frame {
-            Err(e) => r.damaged(entry.offset, entry.len, e.to_string()),
-            Ok(bytes) => match LogFrame::decode(bytes) {
-                Ok(frame) => r.frame(entry.offset, &frame, entry.host_time_us),
-                Err(e) => {
-                    if matches!(e, shared::LogError::UnsupportedVersion(_)) {
-                        r.other_version += 1;
-                    }
-                    r.damaged(entry.offset, entry.len, format!("frame: {e}"));
-                }
-            },
-        }
-    }
-    r.finish(recording, visits)
+    recording.entries.iter().for_each(|e| r.entry(e));
+    r.finish(recording.kind, visits)
 }
 
 /// Reads the files and replays: the log (recorded or raw), the policy blob
@@ -98,8 +86,10 @@ pub fn replay_files(
         }
         None => None,
     };
-    let recording = super::log_file::read(log)?;
-    let report = replay(&recording, &blob, training.as_ref(), odometry);
+    // entry by entry, as read: memory does not grow with the log
+    let mut r = Replayer::new(&blob, odometry);
+    let kind = log_file::read_each(log, &ranges::LOG_FILE, &mut |e| r.entry(&e))?;
+    let report = r.finish(kind, training.as_ref());
     if report.frames == 0 {
         let versions = if report.other_version > 0 {
             format!(
@@ -135,6 +125,8 @@ struct Replayer<'a> {
     policy_drove: u64,
     states: BTreeMap<u16, u64>,
     actions: Vec<u64>,
+    /// Entries read.
+    entries: u64,
 }
 
 impl<'a> Replayer<'a> {
@@ -151,6 +143,24 @@ impl<'a> Replayer<'a> {
             policy_drove: 0,
             states: BTreeMap::new(),
             actions: vec![0; policy.actions().len()],
+            entries: 0,
+        }
+    }
+
+    /// Adds one entry of the recording: a frame, or a damaged one.
+    fn entry(&mut self, entry: &Entry) {
+        self.entries += 1;
+        match &entry.frame {
+            Err(e) => self.damaged(entry.offset, entry.len, e.to_string()),
+            Ok(bytes) => match LogFrame::decode(bytes) {
+                Ok(frame) => self.frame(entry.offset, &frame, entry.host_time_us),
+                Err(e) => {
+                    if matches!(e, shared::LogError::UnsupportedVersion(_)) {
+                        self.other_version += 1;
+                    }
+                    self.damaged(entry.offset, entry.len, format!("frame: {e}"));
+                }
+            },
         }
     }
 
@@ -196,13 +206,13 @@ impl<'a> Replayer<'a> {
         }
     }
 
-    fn finish(mut self, recording: &Recording, visits: Option<&TrainingVisits>) -> ReplayReport {
+    fn finish(mut self, kind: SourceKind, visits: Option<&TrainingVisits>) -> ReplayReport {
         self.faults.finish();
         let coverage = self.coverage(visits);
         let (t, d, f) = (self.timeline, self.decisions, self.faults);
         ReplayReport {
-            source: recording.kind.to_string(),
-            entries: recording.entries.len() as u64,
+            source: kind.to_string(),
+            entries: self.entries,
             frames: t.frames,
             damaged: self.damaged,
             first_damaged: self.first_damaged,
@@ -212,7 +222,7 @@ impl<'a> Replayer<'a> {
             ticks: t.ticks,
             missing_ticks: t.missing_ticks,
             restarts: t.restarts,
-            host_seconds: match (recording.kind, t.host_times) {
+            host_seconds: match (kind, t.host_times) {
                 (SourceKind::Recorded, Some((first, last))) => {
                     Some(last.saturating_sub(first) as f64 / 1e6)
                 }

@@ -1,7 +1,9 @@
 //! A recorded log as `host view --log` plays it: every decoded frame
 //! checked against the policy stage by stage, as `host replay` checks it
 //! ([`DecisionCheck`]), with the robot's pose dead-reckoned from its wheel
-//! encoders, in one document the page reads (JSON).
+//! encoders ([`PlaybackFrame`], one at a time as the log is read: the
+//! caller writes each into the page's document), and what the page needs
+//! besides the frames ([`Playback`]).
 //!
 //! The pose: a log carries no position, so each robot's track starts at
 //! the arena's centre facing +x and adds each frame's encoder travel
@@ -11,21 +13,22 @@
 use super::decisions::DecisionCheck;
 use super::odometry::OdometrySettings;
 use super::report::FrameCheck;
-use crate::robot::log_file::Recording;
+use crate::robot::log_file::Entry;
 use serde::Serialize;
 use shared::camera::{ImageRegion, IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::{CameraConfig, Faults, PolicyBlob};
 use std::collections::BTreeMap;
 
-/// The checked log.
+/// The checked log, but its frames.
 #[derive(Clone, Debug, Serialize)]
 pub struct Playback {
     /// The policy's hasher.
     pub hasher: String,
     /// Actions of the policy.
     pub actions: usize,
-    /// Every frame that decoded, in log order.
-    pub frames: Vec<PlaybackFrame>,
+    /// Frames that decoded (the document's `frames` is their list).
+    #[serde(skip)]
+    pub frames: u64,
     /// Frames with a divergent stage.
     pub diverged: u64,
     /// Records or frames that did not decode (skipped).
@@ -79,27 +82,47 @@ impl CameraRegions {
     }
 }
 
-/// Checks every frame of `recording` against `policy` and tracks each
-/// robot from the centre of an arena of `arena` units (width, height).
-pub fn playback(
-    recording: &Recording,
-    policy: &PolicyBlob,
+/// Checks frame after frame against a policy and tracks each robot from
+/// the centre of the arena.
+pub struct Player<'a> {
+    policy: &'a PolicyBlob,
+    check: DecisionCheck<'a>,
     odometry: OdometrySettings,
     arena: [f64; 2],
-) -> Playback {
-    let mut check = DecisionCheck::new(policy);
-    let mut poses: BTreeMap<u8, [f64; 3]> = BTreeMap::new();
-    let mut frames = Vec::new();
-    let mut damaged = 0;
-    for entry in &recording.entries {
+    poses: BTreeMap<u8, [f64; 3]>,
+    frames: u64,
+    damaged: u64,
+}
+
+impl<'a> Player<'a> {
+    /// A player of `policy`'s robots on an arena of `arena` units (width,
+    /// height).
+    pub fn new(policy: &'a PolicyBlob, odometry: OdometrySettings, arena: [f64; 2]) -> Player<'a> {
+        Player {
+            policy,
+            check: DecisionCheck::new(policy),
+            odometry,
+            arena,
+            poses: BTreeMap::new(),
+            frames: 0,
+            damaged: 0,
+        }
+    }
+
+    /// The next entry of the log, checked: `None` for one that does not
+    /// decode (counted as damaged).
+    pub fn entry(&mut self, entry: &Entry) -> Option<PlaybackFrame> {
         let Some(frame) = entry.log_frame() else {
-            damaged += 1;
-            continue;
+            self.damaged += 1;
+            return None;
         };
-        let pose = poses
-            .entry(frame.robot_id)
-            .or_insert([arena[0] / 2.0, arena[1] / 2.0, 0.0]);
-        let (forward, turn) = odometry.travel(frame.encoder_counts);
+        self.frames += 1;
+        let arena = self.arena;
+        let pose =
+            self.poses
+                .entry(frame.robot_id)
+                .or_insert([arena[0] / 2.0, arena[1] / 2.0, 0.0]);
+        let (forward, turn) = self.odometry.travel(frame.encoder_counts);
         // the period's heading: half its turn before and half after
         let heading = pose[2] + turn / 2.0;
         *pose = [
@@ -107,20 +130,24 @@ pub fn playback(
             pose[1] + forward * heading.sin(),
             pose[2] + turn,
         ];
-        frames.push(PlaybackFrame {
-            check: check.frame(entry.offset, &frame),
+        Some(PlaybackFrame {
+            check: self.check.frame(entry.offset, &frame),
             robot_id: frame.robot_id,
             pose: *pose,
-        });
+        })
     }
-    Playback {
-        hasher: policy.hasher().to_string(),
-        actions: policy.actions().len(),
-        frames,
-        diverged: check.diverged,
-        damaged,
-        camera: CameraRegions::of(&CameraConfig::DEFAULT),
-        faults: Faults::NAMED.iter().map(|(f, name)| (f.0, *name)).collect(),
+
+    /// What the page needs besides the frames.
+    pub fn finish(self) -> Playback {
+        Playback {
+            hasher: self.policy.hasher().to_string(),
+            actions: self.policy.actions().len(),
+            frames: self.frames,
+            diverged: self.check.diverged,
+            damaged: self.damaged,
+            camera: CameraRegions::of(&CameraConfig::DEFAULT),
+            faults: Faults::NAMED.iter().map(|(f, name)| (f.0, *name)).collect(),
+        }
     }
 }
 
