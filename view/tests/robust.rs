@@ -21,6 +21,16 @@ fn status_of(reply: &str) -> u16 {
         .unwrap_or(0)
 }
 
+/// A POST of `path` with the header lines `head` and no body: the
+/// answer's status and the answer.
+fn post(address: SocketAddr, path: &str, head: &str) -> (u16, String) {
+    let reply = raw(
+        address,
+        format!("POST {path} HTTP/1.1\r\n{head}\r\n\r\n").as_bytes(),
+    );
+    (status_of(&reply), reply)
+}
+
 /// `/state.json`'s step, and how long the answer took.
 fn timed_step(address: SocketAddr) -> (u64, Duration) {
     let start = Instant::now();
@@ -193,11 +203,8 @@ fn a_cross_origin_post_or_a_foreign_host_is_refused_and_the_page_s_own_are_obeye
         (format!("Host: {address}\r\nOrigin: null"), "opaque origin"),
     ] {
         for path in ["/control?action=pause", "/settings?seed=99"] {
-            let reply = raw(
-                address,
-                format!("POST {path} HTTP/1.1\r\n{head}\r\nContent-Length: 0\r\n\r\n").as_bytes(),
-            );
-            assert_eq!(status_of(&reply), 403, "{what} {path}: {reply}");
+            let (status, reply) = post(address, path, &head);
+            assert_eq!(status, 403, "{what} {path}: {reply}");
         }
     }
     let reply = raw(
@@ -220,12 +227,8 @@ fn a_cross_origin_post_or_a_foreign_host_is_refused_and_the_page_s_own_are_obeye
         format!("Host: localhost:{port}\r\nOrigin: http://localhost:{port}"),
         format!("Host: {address}"),
     ] {
-        let reply = raw(
-            address,
-            format!("POST /control?action=pause HTTP/1.1\r\n{head}\r\nContent-Length: 0\r\n\r\n")
-                .as_bytes(),
-        );
-        assert_eq!(status_of(&reply), 200, "{head}: {reply}");
+        let (status, reply) = post(address, "/control?action=pause", &head);
+        assert_eq!(status, 200, "{head}: {reply}");
     }
     assert_eq!(state(address)["frame"]["paused"], true);
 }
@@ -346,12 +349,12 @@ fn conflicting_content_lengths_or_a_transfer_encoding_are_refused() {
         "Transfer-Encoding: chunked",
         "Content-Length: 0\r\nTransfer-Encoding: chunked",
     ] {
-        let reply = raw(
+        let (status, reply) = post(
             address,
-            format!("POST /control?action=play HTTP/1.1\r\nHost: {address}\r\n{head}\r\n\r\n")
-                .as_bytes(),
+            "/control?action=play",
+            &format!("Host: {address}\r\n{head}"),
         );
-        assert_eq!(status_of(&reply), 400, "{head}: {reply}");
+        assert_eq!(status, 400, "{head}: {reply}");
     }
     assert_eq!(state(address)["frame"]["paused"], true);
 }
