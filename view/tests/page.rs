@@ -268,3 +268,22 @@ fn a_policy_trained_for_other_sensors_chosen_on_the_page_shows_the_warning() {
         warning
     );
 }
+
+#[test]
+fn another_site_s_page_in_the_browser_cannot_drive_the_view() {
+    let target = serve(small(8), false, Speed::Real);
+    // another origin (another port): what any page open in the browser is
+    let other = serve(small(9), true, Speed::Real);
+    let mut page = Browser::open(&format!("http://{other}/"), SIZE);
+    page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+    let sent = page.eval(&format!(
+        "fetch('http://{target}/control?action=pause', {{ method: 'POST', mode: 'no-cors' }}).then(() => 'sent', (e) => 'failed: ' + e)"
+    ));
+    assert_eq!(sent, "sent", "the browser did not send the request");
+    let socket = page.eval(&format!(
+        "new Promise((done) => {{ const w = new WebSocket('ws://{target}/stream'); w.onopen = () => done('open'); w.onerror = () => done('refused'); }})"
+    ));
+    assert_eq!(socket, "refused");
+    let s = state(target);
+    assert_eq!(s["frame"]["paused"], false, "another site's page paused it");
+}
