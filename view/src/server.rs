@@ -47,9 +47,9 @@ pub const REAL_TIME: f64 = 50.0;
 /// Steps one `step` control may ask for.
 pub const MAX_STEPS_PER_CONTROL: u64 = 1_000_000;
 
-/// Longest the simulation's thread steps while holding the control lock:
-/// it then lets waiting requests in, so every request is answered while
-/// steps run (a step of the largest world takes about 10 ms).
+/// Longest the simulation's thread steps while holding the control lock
+/// (but at least one step): it then lets waiting requests in, so every
+/// request is answered while steps run.
 pub const SLICE: Duration = Duration::from_millis(10);
 
 /// Behind by more than this, paced stepping drops its backlog and goes on
