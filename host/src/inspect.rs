@@ -1,7 +1,14 @@
-//! Human-readable rendering of a policy blob.
+//! Human-readable rendering of a policy blob, and the fields a searched
+//! table was scored on, from its search log (`<name>.search.json`, the
+//! JSON `host search` writes: `world.field`, `search.also_field` and
+//! `result`, the packed table).
 
 use shared::{PolicyBlob, StateHasher};
 use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Where the shipped policies' search logs are, from the repository's root.
+pub const PUBLISHED_LOGS: &str = "docs/policy-search/runs";
 
 /// The blob's header ([`summary`]), then one line per state with its
 /// decoded inputs (the role too, for a hasher that has the role bit) and
@@ -167,6 +174,56 @@ pub fn escaped(s: &str) -> String {
         }
     }
     out
+}
+
+/// `text` (a [`summary`] or [`render`] of `blob`, read from `file`) with,
+/// after its field line, every field a searched table was scored on, when
+/// its search log is found: `<name>.search.json` beside `file` (where
+/// `host search` writes it) or in [`PUBLISHED_LOGS`], and the log's result
+/// is this blob's table. The blob itself records only the first field.
+pub fn with_search_log(text: &str, blob: &PolicyBlob, file: &Path) -> String {
+    let Some((fields, log)) = search_log(blob, file) else {
+        return text.to_string();
+    };
+    let line = format!(
+        "searched   on {} fields: {} (its log {})",
+        fields.len(),
+        fields
+            .iter()
+            .map(|f| escaped(f))
+            .collect::<Vec<_>>()
+            .join(", "),
+        log.display()
+    );
+    let mut out = String::new();
+    for l in text.lines() {
+        out.push_str(l);
+        out.push('\n');
+        if l.starts_with("field      ") {
+            out.push_str(&line);
+            out.push('\n');
+        }
+    }
+    out
+}
+
+/// The fields of the search log of `blob` and the log's path, if one is
+/// found whose result is the blob's table.
+fn search_log(blob: &PolicyBlob, file: &Path) -> Option<(Vec<String>, PathBuf)> {
+    let name = format!("{}.search.json", blob.provenance().name);
+    let beside = file.parent().map(|d| d.join(&name));
+    let published = Path::new(PUBLISHED_LOGS).join(&name);
+    beside.into_iter().chain([published]).find_map(|path| {
+        let log: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).ok()?).ok()?;
+        let result: Vec<u8> = serde_json::from_value(log["result"].clone()).ok()?;
+        if result != blob.table().packed() {
+            return None;
+        }
+        let first = log["world"]["field"].as_str()?.to_string();
+        let also: Vec<String> =
+            serde_json::from_value(log["search"]["also_field"].clone()).unwrap_or_default();
+        Some((std::iter::once(first).chain(also).collect(), path))
+    })
 }
 
 #[cfg(test)]

@@ -218,11 +218,12 @@ fn gap_table(json: &Path, doc: &Path) -> Result<()> {
 
 fn inspect_policy(file: &Path, summary: bool) -> Result<()> {
     let blob = sim::control::policy_file::read(file)?;
-    if summary {
-        print!("{}", host::inspect::summary(&blob));
+    let text = if summary {
+        host::inspect::summary(&blob)
     } else {
-        print!("{}", host::inspect::render(&blob));
-    }
+        host::inspect::render(&blob)
+    };
+    print!("{}", host::inspect::with_search_log(&text, &blob, file));
     Ok(())
 }
 
