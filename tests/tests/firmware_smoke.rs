@@ -567,6 +567,50 @@ fn sizes(elf: &std::path::Path) -> (u64, u64) {
     (n[0] + n[1], n[1] + n[2])
 }
 
+/// The flash below the A-Star bootloader, which starts at 0x7000
+/// (`../shared/docs/hardware.md` section 6).
+const FLASH_BUDGET: u64 = 0x7000;
+/// Static RAM (.data + .bss from 0x0100): the statics end by 0x0700,
+/// below the bootloader key at 0x0800, and leave the stack the top 1,024
+/// of the 2,560 bytes.
+const RAM_BUDGET: u64 = 1_536;
+
+/// Every image the simavr tests run (the default and the equivalence
+/// tests' variants, `scripts/test` builds them all) fits the flash below
+/// the bootloader and the static RAM budget: what `scripts/build-firmware`
+/// checks when it builds, checked again on the ELFs the tests run.
+#[test]
+fn every_image_fits_the_flash_below_the_bootloader_and_the_static_ram_budget() {
+    use tests::equivalence::{EIGHT_BIT, GENERAL, ROLE, SEARCH_ANNULUS, SEARCH_T, TEN_BIT, TIED};
+    use tests::zumo::{firmware_elf, firmware_elf_in};
+    let mut images = vec![firmware_elf()];
+    for v in [
+        EIGHT_BIT,
+        TEN_BIT,
+        ROLE,
+        TIED,
+        SEARCH_ANNULUS,
+        GENERAL,
+        SEARCH_T,
+    ] {
+        images.push(firmware_elf_in(v.elf_dir, v.build));
+    }
+    for elf in images {
+        let (flash, ram) = sizes(&elf);
+        println!("{}: flash {flash}, static RAM {ram}", elf.display());
+        assert!(
+            flash <= FLASH_BUDGET,
+            "{}: {flash} bytes of flash, over the {FLASH_BUDGET} below the bootloader",
+            elf.display()
+        );
+        assert!(
+            ram <= RAM_BUDGET,
+            "{}: {ram} bytes of static RAM, over the budget of {RAM_BUDGET}",
+            elf.display()
+        );
+    }
+}
+
 /// USB's share of an ELF: flash (code and flash-initialised data) and
 /// static RAM of the symbols of `board::usb` and `firmware::usb` and of
 /// `Board::serve_usb` (which inlines the port's work), from `avr-nm -S`.

@@ -92,6 +92,22 @@ fn frames_of(bytes: &[u8]) -> Vec<&[u8]> {
     out
 }
 
+/// Reads the bulk IN endpoint for 100 ms: at least three frames, each
+/// whole one after the first (which may have begun before the read)
+/// decoding; `after` names what they follow.
+fn frames_flow_again(z: &mut Zumo, after: &str) {
+    let usb = z.usb_read_bulk(BULK_IN, 100_000);
+    let frames = frames_of(&usb);
+    assert!(
+        frames.len() >= 3,
+        "{} frames over USB after {after}",
+        frames.len()
+    );
+    for f in &frames[1..] {
+        LogFrame::decode(f).unwrap_or_else(|e| panic!("a frame cut by {after}: {e}"));
+    }
+}
+
 fn plugged_zumo() -> Zumo {
     let mut z = Zumo::boot();
     z.plug_usb(true);
@@ -266,12 +282,7 @@ fn a_host_that_stops_reading_never_blocks_the_control_period() {
     // delivers whole frames again.
     let ticks: Vec<u32> = z.frames().into_iter().map(|f| f.unwrap().tick).collect();
     assert!(ticks.windows(2).all(|w| w[1] == w[0] + 1));
-    let usb = z.usb_read_bulk(BULK_IN, 100_000);
-    let frames = frames_of(&usb);
-    assert!(frames.len() >= 3);
-    for f in &frames[1..] {
-        LogFrame::decode(f).expect("a frame cut by the drop");
-    }
+    frames_flow_again(&mut z, "the drop");
 }
 
 /// A robot calibrated by the real procedure and driving (A pressed), its
@@ -367,8 +378,7 @@ fn pulling_the_cable_detaches_and_plugging_it_back_enumerates_again() {
     assert_eq!(z.usb_enumerate(9).device, DEVICE);
     assert_eq!(z.usb_address(), Some(9));
     z.usb_set_dtr(true).unwrap();
-    let usb = z.usb_read_bulk(BULK_IN, 100_000);
-    assert!(frames_of(&usb).len() >= 3);
+    frames_flow_again(&mut z, "the cable plugged back");
 }
 
 /// Suspend (USB 2.0 section 7.1.7.6: no bus activity for 3 ms): the
@@ -409,16 +419,7 @@ fn a_suspended_bus_freezes_the_usb_clock_while_the_robot_drives_on_and_wakes_up(
     assert_eq!(z.usb_address(), Some(5));
     assert_eq!(z.usb_control(setup(0x80, 8, 0, 0, 1), &[]), Ok(vec![1]));
     assert_eq!(z.usb_line_coding().0, 115_200);
-    let usb = z.usb_read_bulk(BULK_IN, 100_000);
-    let frames = frames_of(&usb);
-    assert!(
-        frames.len() >= 3,
-        "{} frames after the wake-up",
-        frames.len()
-    );
-    for f in &frames[1..] {
-        LogFrame::decode(f).expect("a frame cut by the suspend");
-    }
+    frames_flow_again(&mut z, "the suspend");
 }
 
 /// SET_FEATURE(ENDPOINT_HALT) halts an endpoint: its transactions stall
@@ -456,16 +457,7 @@ fn a_halted_endpoint_stalls_until_the_host_clears_the_halt() {
         .expect("CLEAR_FEATURE(ENDPOINT_HALT) on 0x02");
     assert_eq!(status(&mut z, 0x83), Ok(vec![0, 0]));
     assert_eq!(z.usb_out(BULK_OUT, b"hello"), Ok(()));
-    let usb = z.usb_read_bulk(BULK_IN, 100_000);
-    let frames = frames_of(&usb);
-    assert!(
-        frames.len() >= 3,
-        "{} frames after the halt was cleared",
-        frames.len()
-    );
-    for f in &frames[1..] {
-        LogFrame::decode(f).expect("a frame cut by the halt");
-    }
+    frames_flow_again(&mut z, "the halt");
 
     // An endpoint that does not exist, the wrong direction, remote wake-up
     // (the configuration says the device has none) and test mode stall.
