@@ -654,7 +654,7 @@ fn usb_sizes(elf: &std::path::Path) -> (u64, u64) {
 fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
     use shared::PolicyBlob;
     use tests::equivalence::TIED;
-    use tests::figures::{compiler_of, thousands, workspace, Figures, Outcome};
+    use tests::figures::{compiler_of, thousands, workspace, Figures};
     use tests::zumo::{firmware_elf, firmware_elf_in};
     const REGENERATE: &str = "UPDATE_FIGURES=1 cargo test -p tests --test firmware_smoke figures";
     let elf = firmware_elf();
@@ -984,7 +984,6 @@ fn the_figures_in_docs_firmware_md_are_the_ones_measured() {
         &["figure", "value", "budget", "measured by"],
         REGENERATE,
     ) {
-        Ok(Outcome::OtherCompiler(note)) => println!("note: {note}"),
         Ok(_) => {}
         Err(e) => panic!("{e:#}"),
     }
