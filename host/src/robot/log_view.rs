@@ -26,7 +26,7 @@ pub struct LogView {
     /// The field the robot drove on, as the live view draws it.
     pub field_png: Vec<u8>,
     /// Frames that decoded.
-    pub frames: u64,
+    pub frames: usize,
     /// Of them, frames with a divergent stage.
     pub diverged: u64,
 }

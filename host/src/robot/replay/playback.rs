@@ -28,7 +28,7 @@ pub struct Playback {
     pub actions: usize,
     /// Frames that decoded (the document's `frames` is their list).
     #[serde(skip)]
-    pub frames: u64,
+    pub frames: usize,
     /// Frames with a divergent stage.
     pub diverged: u64,
     /// Records or frames that did not decode (skipped).
@@ -90,7 +90,7 @@ pub struct Player<'a> {
     odometry: OdometrySettings,
     arena: [f64; 2],
     poses: BTreeMap<u8, [f64; 3]>,
-    frames: u64,
+    frames: usize,
     damaged: u64,
 }
 
