@@ -452,7 +452,8 @@ impl PyBatch {
 
     /// World `world` drawn as `host render` draws it: an RGB array of
     /// `size` x `size` pixels (field grey, pucks red, robots blue; with
-    /// `band` the target band outlined in cyan).
+    /// `band` the target band outlined in cyan and the pucks inside it
+    /// green).
     #[pyo3(signature = (world = 0, size = 800, footprints = false, band = false))]
     fn render<'py>(
         &self,
