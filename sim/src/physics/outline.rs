@@ -146,9 +146,9 @@ impl Outline {
     }
 
     /// [`Outline::pair_depth`], but stopping as soon as the depth is known
-    /// to be at most `stop`, with a depth at most `stop` (most pairs the
-    /// broadphase finds do not touch: the first normal tried, along the
-    /// centre line, shows it).
+    /// to be at most `stop`, with a depth at most `stop` (for a pair that
+    /// does not touch, the first normal tried, along the centre line,
+    /// often shows it).
     pub fn pair_depth_until(
         &self,
         dir_a: Vec2,
@@ -173,15 +173,20 @@ impl Outline {
 /// circle lies where one term is least (`n` along `delta - c_k`) or where
 /// two terms are equal; all of those are tried, in a fixed order, and the
 /// first least kept.
-pub fn hull_depth(circles: &[(Vec2, f64)], delta: Vec2) -> (f64, Vec2) {
+pub fn hull_depth<const N: usize>(circles: &[(Vec2, f64); N], delta: Vec2) -> (f64, Vec2) {
     hull_depth_until(circles, delta, f64::NEG_INFINITY)
 }
 
 /// [`hull_depth`], stopping once the least value so far is at most
 /// `stop`: then the depth is at most `stop` too, and that value is
 /// returned (the candidates come in the same order, so a search that does
-/// not stop returns exactly [`hull_depth`]'s).
-fn hull_depth_until(circles: &[(Vec2, f64)], delta: Vec2, stop: f64) -> (f64, Vec2) {
+/// not stop returns exactly [`hull_depth`]'s). The circles come as an
+/// array, whose loops the compiler unrolls.
+fn hull_depth_until<const N: usize>(
+    circles: &[(Vec2, f64); N],
+    delta: Vec2,
+    stop: f64,
+) -> (f64, Vec2) {
     let value = |n: Vec2| {
         circles
             .iter()
