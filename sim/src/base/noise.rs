@@ -8,7 +8,7 @@
 //! bounded by +-6), plain arithmetic that rounds the same on every machine.
 
 use crate::base::rng::SimRng;
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 
 /// What a draw is for: each use has its own stream.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -37,7 +37,29 @@ fn mix(mut z: u64) -> u64 {
 /// A generator for one use at one place: `seed` (the world's), `purpose`,
 /// and the two coordinates of the place (episode or step, robot).
 pub fn stream(seed: u64, purpose: Purpose, a: u64, b: u64) -> SimRng {
-    SimRng::seed_from_u64(mix(mix(mix(seed ^ purpose as u64) ^ a) ^ b))
+    seeded(mix(mix(mix(seed ^ purpose as u64) ^ a) ^ b))
+}
+
+/// `SimRng::seed_from_u64(state)`, in words rather than bytes (the
+/// sensors seed a few generators per robot and step): `rand_core`'s
+/// PCG32 fills the 32-byte seed four bytes at a time, little-endian, whose
+/// first 16 bytes are the state and the last 16 the increment, made odd.
+fn seeded(mut state: u64) -> SimRng {
+    const MUL: u64 = 0x5851_F42D_4C95_7F2D;
+    const INC: u64 = 0xA176_54E4_6FBE_17F3;
+    let mut word = || {
+        state = state.wrapping_mul(MUL).wrapping_add(INC);
+        let xorshifted = (((state >> 18) ^ state) >> 27) as u32;
+        u128::from(xorshifted.rotate_right((state >> 59) as u32))
+    };
+    let mut seed = [0u128; 2];
+    for half in &mut seed {
+        for k in 0..4 {
+            *half |= word() << (32 * k);
+        }
+    }
+    // `new` makes the increment `(stream << 1) | 1`: `from_seed`'s odd increment.
+    SimRng::new(seed[0], seed[1] >> 1)
 }
 
 /// A standard normal draw (Irwin-Hall: 12 uniforms less 6).
@@ -58,6 +80,19 @@ pub(crate) fn chance(rng: &mut SimRng, p: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn a_stream_is_the_generator_seeded_from_its_place_s_hash() {
+        for (seed, a, b) in [(0, 0, 0), (1, 5, 2), (u64::MAX, 1 << 40, 7), (3, 22_000, 4)] {
+            let hash = mix(mix(mix(seed ^ Purpose::Camera as u64) ^ a) ^ b);
+            let mut ours = stream(seed, Purpose::Camera, a, b);
+            let mut theirs = SimRng::seed_from_u64(hash);
+            for _ in 0..4 {
+                assert_eq!(ours.next_u64(), theirs.next_u64());
+            }
+        }
+    }
 
     #[test]
     fn the_same_place_draws_the_same_and_other_places_draw_otherwise() {

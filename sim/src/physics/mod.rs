@@ -428,8 +428,9 @@ impl StepContext<'_> {
     /// depth and normal ([`StepContext::outline_contact`]) instead of the
     /// centre line's, the same shares of the overlap.
     fn separate_outline(&mut self, i: usize, j: usize, outline: &Outline) -> bool {
-        let (overlap, normal) = self.outline_contact(i, j, outline);
-        if overlap <= self.config.overlap_threshold {
+        let threshold = self.config.overlap_threshold;
+        let (overlap, normal) = self.outline_contact(i, j, outline, threshold);
+        if overlap <= threshold {
             return false;
         }
         self.push_apart(i, j, overlap, normal);
@@ -438,14 +439,18 @@ impl StepContext<'_> {
 
     /// How deep bodies `i` and `j` (one of them a robot) overlap and the
     /// unit normal along which `j` leaves `i`: wedge against wedge, or a
-    /// wedge against a puck's circle.
-    fn outline_contact(&self, i: usize, j: usize, outline: &Outline) -> (f64, Vec2) {
+    /// wedge against a puck's circle. Two wedges' depth is only exact
+    /// above `stop` ([`Outline::pair_depth_until`]).
+    fn outline_contact(&self, i: usize, j: usize, outline: &Outline, stop: f64) -> (f64, Vec2) {
         let robots = self.robots.len();
         let delta = self.bodies[j].pos - self.bodies[i].pos;
         match (i < robots, j < robots) {
-            (true, true) => {
-                outline.pair_depth(self.robots[i].direction, self.robots[j].direction, delta)
-            }
+            (true, true) => outline.pair_depth_until(
+                self.robots[i].direction,
+                self.robots[j].direction,
+                delta,
+                stop,
+            ),
             (true, false) => {
                 outline.circle_depth(self.robots[i].direction, delta, self.bodies[j].radius)
             }
@@ -510,7 +515,7 @@ impl StepContext<'_> {
                         None => elastic_impulse(&mut x, &mut y),
                         Some(outline) => {
                             // The contact's normal now, as the discs' centre line.
-                            let (_, n) = self.outline_contact(a, b, &outline);
+                            let (_, n) = self.outline_contact(a, b, &outline, f64::NEG_INFINITY);
                             impulse_along(&mut x, &mut y, n);
                         }
                     }

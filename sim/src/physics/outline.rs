@@ -142,11 +142,26 @@ impl Outline {
     /// `b`'s centre at `delta` from robot `a`'s, facing `dir_b` and `dir_a`;
     /// and the unit normal along which `b` leaves `a`.
     pub fn pair_depth(&self, dir_a: Vec2, dir_b: Vec2, delta: Vec2) -> (f64, Vec2) {
+        self.pair_depth_until(dir_a, dir_b, delta, f64::NEG_INFINITY)
+    }
+
+    /// [`Outline::pair_depth`], but stopping as soon as the depth is known
+    /// to be at most `stop`, with a depth at most `stop` (for a pair that
+    /// does not touch, the first normal tried, along the centre line,
+    /// often shows it).
+    pub fn pair_depth_until(
+        &self,
+        dir_a: Vec2,
+        dir_b: Vec2,
+        delta: Vec2,
+        stop: f64,
+    ) -> (f64, Vec2) {
         let (a, b) = (dir_a * self.tip, dir_b * self.tip);
         let r = self.radius;
-        hull_depth(
+        hull_depth_until(
             &[(Vec2::ZERO, 2.0 * r), (a, r), (-b, r), (a - b, 0.0)],
             delta,
+            stop,
         )
     }
 }
@@ -158,7 +173,20 @@ impl Outline {
 /// circle lies where one term is least (`n` along `delta - c_k`) or where
 /// two terms are equal; all of those are tried, in a fixed order, and the
 /// first least kept.
-pub fn hull_depth(circles: &[(Vec2, f64)], delta: Vec2) -> (f64, Vec2) {
+pub fn hull_depth<const N: usize>(circles: &[(Vec2, f64); N], delta: Vec2) -> (f64, Vec2) {
+    hull_depth_until(circles, delta, f64::NEG_INFINITY)
+}
+
+/// [`hull_depth`], stopping once the least value so far is at most
+/// `stop`: then the depth is at most `stop` too, and that value is
+/// returned (the candidates come in the same order, so a search that does
+/// not stop returns exactly [`hull_depth`]'s). The circles come as an
+/// array, whose loops the compiler unrolls.
+fn hull_depth_until<const N: usize>(
+    circles: &[(Vec2, f64); N],
+    delta: Vec2,
+    stop: f64,
+) -> (f64, Vec2) {
     let value = |n: Vec2| {
         circles
             .iter()
@@ -167,17 +195,19 @@ pub fn hull_depth(circles: &[(Vec2, f64)], delta: Vec2) -> (f64, Vec2) {
             - delta.dot(n)
     };
     let mut best = (f64::INFINITY, Vec2::new(1.0, 0.0));
+    // Whether the search can stop.
     let mut consider = |n: Vec2| {
         let v = value(n);
         if v < best.0 {
             best = (v, n);
         }
+        best.0 <= stop
     };
     for &(c, _) in circles {
         let w = delta - c;
         let len = w.length();
-        if len > 0.0 {
-            consider(w * (1.0 / len));
+        if len > 0.0 && consider(w * (1.0 / len)) {
+            return best;
         }
     }
     for (k, &(ck, rk)) in circles.iter().enumerate() {
@@ -194,8 +224,9 @@ pub fn hull_depth(circles: &[(Vec2, f64)], delta: Vec2) -> (f64, Vec2) {
             }
             let (u, across) = (e * (1.0 / len), (1.0 - along * along).sqrt());
             let perp = Vec2::new(-u.y, u.x);
-            consider(u * along + perp * across);
-            consider(u * along - perp * across);
+            if consider(u * along + perp * across) || consider(u * along - perp * across) {
+                return best;
+            }
         }
     }
     best
@@ -304,6 +335,31 @@ mod tests {
                 .0
                 < -1e-6
         })
+    }
+
+    #[test]
+    fn a_depth_search_stops_only_at_or_below_its_bound_and_is_exact_above_it() {
+        let o = wedge();
+        let mut rng = SimRng::seed_from_u64(11);
+        let mut stopped = 0;
+        for _ in 0..2000 {
+            let delta = Vec2::new(rng.random_range(-30.0..30.0), rng.random_range(-30.0..30.0));
+            let (da, db) = (
+                Vec2::from_angle(rng.random_range(-3.2..3.2)),
+                Vec2::from_angle(rng.random_range(-3.2..3.2)),
+            );
+            let exact = o.pair_depth(da, db, delta);
+            for stop in [-5.0, 0.0, 1e-9, 2.0] {
+                let found = o.pair_depth_until(da, db, delta, stop);
+                if exact.0 > stop {
+                    assert_eq!(found, exact, "{delta:?} {stop}");
+                } else {
+                    assert!(found.0 <= stop, "{delta:?} {stop}");
+                    stopped += usize::from(found != exact);
+                }
+            }
+        }
+        assert!(stopped > 1000, "{stopped}");
     }
 
     #[test]

@@ -360,6 +360,52 @@ pub(crate) struct PixyCamera {
     merged: Vec<Blob>,
     /// Whether the processor has AVX2 ([`PixyCamera::silhouette`]).
     avx2: bool,
+    /// The points of the last wedge-fronted robots seen.
+    wedge: Option<WedgePoints>,
+}
+
+/// Lanes of a wedge's outline points the camera projects
+/// ([`PixyCamera::outline_silhouette`]): at most `RIM_POINTS + 3` points,
+/// in a power of two for [`halving_16`].
+const WEDGE_POINTS: usize = 16;
+const _: () = assert!(RIM_POINTS + 3 <= WEDGE_POINTS);
+
+/// The points of a wedge's outline that bound its silhouette, in the
+/// robot's frame (ahead, right): its tip, its tangent points and the rim
+/// points that lie on its round back, then the tip again in the lanes left.
+#[derive(Clone, Copy, Debug)]
+struct WedgePoints {
+    outline: Outline,
+    ahead: [f64; WEDGE_POINTS],
+    right: [f64; WEDGE_POINTS],
+}
+
+impl WedgePoints {
+    /// The points of `outline`, with the camera's rim points on a unit
+    /// circle (`rim_ahead`, `rim_right`).
+    fn new(
+        outline: &Outline,
+        rim_ahead: &[f64; RIM_POINTS],
+        rim_right: &[f64; RIM_POINTS],
+    ) -> WedgePoints {
+        let r = outline.radius();
+        let t = outline.tangent_point();
+        let mut points = WedgePoints {
+            outline: *outline,
+            ahead: [outline.tip(); WEDGE_POINTS],
+            right: [0.0; WEDGE_POINTS],
+        };
+        let on_back = (0..RIM_POINTS)
+            .filter(|&k| rim_ahead[k] * r < t.x)
+            .map(|k| Vec2::new(rim_ahead[k], rim_right[k]) * r);
+        // after the tip in lane 0
+        let sides = [t, Vec2::new(t.x, -t.y)];
+        for (n, p) in (1..).zip(sides.into_iter().chain(on_back)) {
+            points.ahead[n] = p.x;
+            points.right[n] = p.y;
+        }
+        points
+    }
 }
 
 /// Points along each edge of the image whose rays outline
@@ -404,6 +450,7 @@ impl PixyCamera {
             blobs: Vec::new(),
             merged: Vec::new(),
             avx2: has_avx2(),
+            wedge: None,
         }
     }
 
@@ -465,16 +512,20 @@ impl PixyCamera {
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
         let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
+        if outline != self.wedge.as_ref().map(|w| w.outline) {
+            self.wedge = outline.map(|o| WedgePoints::new(&o, &self.rim_ahead, &self.rim_right));
+        }
+        let wedge = self.wedge.as_ref();
         let robots = world.robots().len();
         world.any_body_in_box(min, max, |row| {
             for b in row {
                 let Some(c) = self.candidate(robots, robot, &lens, b) else {
                     continue;
                 };
-                let rect = match outline.filter(|_| c.index < robots) {
+                let rect = match wedge.filter(|_| c.index < robots) {
                     None => self.silhouette(c.ahead, c.side, c.radius, c.height),
-                    Some(o) => {
-                        self.outline_silhouette(&c, &lens, world.robots()[c.index].direction, &o)
+                    Some(w) => {
+                        self.outline_silhouette(&c, &lens, world.robots()[c.index].direction, w)
                     }
                 };
                 if let Some(rect) = rect {
@@ -616,56 +667,44 @@ impl PixyCamera {
     /// The clipped pixel box of a wedge-fronted robot, candidate `c`,
     /// facing `facing`: the prism on its outline, `c.height` tall, seen
     /// through the pinhole as a cylinder is (the bounding box of its
-    /// points at the bottom and the top): the rim points of the cylinder
-    /// that lie on the round back, the two tangent points and the tip.
-    /// `None` if it is out of the image or reaches behind the image plane.
-    /// A robot or two a frame: one point at a time.
+    /// points at the bottom and the top, `wedge`'s). `None` if it is out
+    /// of the image or reaches behind the image plane. A robot or two a
+    /// frame: each point's place ahead of and beside the lens is found
+    /// once for both rims, and the lanes keep to fixed-size arrays.
     fn outline_silhouette(
         &self,
         c: &Candidate,
         lens: &Lens,
         facing: Vec2,
-        outline: &Outline,
+        wedge: &WedgePoints,
     ) -> Option<Rect> {
         let right = Vec2::new(-facing.y, facing.x);
-        let r = outline.radius();
-        let t = outline.tangent_point();
-        let mut points = [Vec2::ZERO; RIM_POINTS + 3];
-        points[..3].copy_from_slice(&[Vec2::new(outline.tip(), 0.0), t, Vec2::new(t.x, -t.y)]);
-        let mut n = 3;
-        for k in 0..RIM_POINTS {
-            if self.rim_ahead[k] * r < t.x {
-                points[n] = Vec2::new(self.rim_ahead[k], self.rim_right[k]) * r;
-                n += 1;
-            }
-        }
-        let (mut min_x, mut max_x, mut min_y, mut max_y) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-        for z in [0.0, c.height] {
+        let offset = |k: usize| facing * wedge.ahead[k] + right * wedge.right[k];
+        let pf: [f64; WEDGE_POINTS] = std::array::from_fn(|k| c.ahead + offset(k).dot(lens.ahead));
+        let ps: [f64; WEDGE_POINTS] = std::array::from_fn(|k| c.side + offset(k).dot(lens.right));
+        let across = ps.map(|ps| self.fx * ps);
+        let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
+        for (rim, z) in [0.0, c.height].into_iter().enumerate() {
             let up = z - self.height;
-            for p in &points[..n] {
-                let offset = facing * p.x + right * p.y;
-                let (pf, ps) = (
-                    c.ahead + offset.dot(lens.ahead),
-                    c.side + offset.dot(lens.right),
-                );
-                let depth = pf * self.cos_tilt - up * self.sin_tilt;
-                if depth < self.near {
-                    return None;
-                }
-                let down = -pf * self.sin_tilt - up * self.cos_tilt;
-                let (x, y) = (self.fx * ps / depth, self.fy * down / depth);
-                min_x = min_x.min(x);
-                max_x = max_x.max(x);
-                min_y = min_y.min(y);
-                max_y = max_y.max(y);
+            let depth = pf.map(|pf| pf * self.cos_tilt - up * self.sin_tilt);
+            // the least depth (the one row, twice)
+            if halving_16(&[depth, depth], |a, b| if a < b { a } else { b }) < self.near {
+                return None;
             }
+            let down = pf.map(|pf| -pf * self.sin_tilt - up * self.cos_tilt);
+            x[rim] = std::array::from_fn(|k| across[k] / depth[k]);
+            y[rim] = std::array::from_fn(|k| self.fy * down[k] / depth[k]);
         }
+        let least = |v| halving_16(v, |a, b| if a < b { a } else { b });
+        let greatest = |v| halving_16(v, |a, b| if a > b { a } else { b });
         let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
+        // A zero's sign may differ from the point by point minimum; the
+        // pixel is the same for both.
         let rect = Rect {
-            left: first_pixel(cx + min_x, IMAGE_WIDTH),
-            right: last_pixel(cx + max_x, IMAGE_WIDTH),
-            top: first_pixel(cy + min_y, IMAGE_HEIGHT),
-            bottom: last_pixel(cy + max_y, IMAGE_HEIGHT),
+            left: first_pixel(cx + least(&x), IMAGE_WIDTH),
+            right: last_pixel(cx + greatest(&x), IMAGE_WIDTH),
+            top: first_pixel(cy + least(&y), IMAGE_HEIGHT),
+            bottom: last_pixel(cy + greatest(&y), IMAGE_HEIGHT),
         };
         (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
     }
@@ -955,6 +994,16 @@ fn halving(rims: &[[f64; RIM_POINTS]; 2], pick: impl Fn(f64, f64) -> f64) -> f64
     let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| pick(v[k], v[k + RIM_POINTS / 2]));
     let v: [f64; 2] = std::array::from_fn(|k| pick(pick(v[k], v[k + 2]), v[k + 4]));
     pick(v[1], v[0])
+}
+
+/// Both rows' values reduced by `pick` (the lesser or the greater of
+/// two), halving the lanes down to one.
+#[inline(always)]
+fn halving_16(rows: &[[f64; 16]; 2], pick: impl Fn(f64, f64) -> f64) -> f64 {
+    let v: [f64; 16] = std::array::from_fn(|k| pick(rows[0][k], rows[1][k]));
+    let v: [f64; 8] = std::array::from_fn(|k| pick(v[k], v[k + 8]));
+    let v: [f64; 4] = std::array::from_fn(|k| pick(v[k], v[k + 4]));
+    pick(pick(v[0], v[2]), pick(v[1], v[3]))
 }
 
 /// The first pixel of a span that starts at `v`: `floor(v)` within

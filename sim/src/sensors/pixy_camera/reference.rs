@@ -2,7 +2,8 @@
 //! every body near the lens visited, merging restarted after each merge),
 //! kept as the reference the faster stages must match block for block.
 
-use super::{Blob, InView, Lens, PixyCamera, Rect};
+use super::{first_pixel, last_pixel, Blob, Candidate, InView, Lens, PixyCamera, Rect};
+use crate::base::vec2::Vec2;
 use crate::physics::outline::Outline;
 use crate::world::World;
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
@@ -31,11 +32,10 @@ fn gather_in_view(camera: &mut PixyCamera, world: &World, robot: usize) {
             let Some(c) = camera.candidate(robots, robot, &lens, b) else {
                 continue;
             };
-            // A wedge's prism has one way of projecting, the stages' own.
             let rect = match outline.filter(|_| c.index < robots) {
                 None => silhouette(camera, c.ahead, c.side, c.radius, c.height),
                 Some(o) => {
-                    camera.outline_silhouette(&c, &lens, world.robots()[c.index].direction, &o)
+                    outline_silhouette(camera, &c, &lens, world.robots()[c.index].direction, &o)
                 }
             };
             if let Some(rect) = rect {
@@ -56,6 +56,60 @@ fn sort_nearest_first(in_view: &mut [InView]) {
             .unwrap_or(Ordering::Equal)
             .then(a.index.cmp(&b.index))
     });
+}
+
+/// The clipped pixel box of a wedge-fronted robot, candidate `c`, facing
+/// `facing`: the bounding box of the rim points of its round back, its
+/// tangent points and its tip, at the bottom and the top, one point at a
+/// time.
+fn outline_silhouette(
+    camera: &PixyCamera,
+    c: &Candidate,
+    lens: &Lens,
+    facing: Vec2,
+    outline: &Outline,
+) -> Option<Rect> {
+    let right = Vec2::new(-facing.y, facing.x);
+    let r = outline.radius();
+    let t = outline.tangent_point();
+    let mut points = [Vec2::ZERO; super::RIM_POINTS + 3];
+    points[..3].copy_from_slice(&[Vec2::new(outline.tip(), 0.0), t, Vec2::new(t.x, -t.y)]);
+    let mut n = 3;
+    for k in 0..super::RIM_POINTS {
+        if camera.rim_ahead[k] * r < t.x {
+            points[n] = Vec2::new(camera.rim_ahead[k], camera.rim_right[k]) * r;
+            n += 1;
+        }
+    }
+    let (mut min_x, mut max_x, mut min_y, mut max_y) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for z in [0.0, c.height] {
+        let up = z - camera.height;
+        for p in &points[..n] {
+            let offset = facing * p.x + right * p.y;
+            let (pf, ps) = (
+                c.ahead + offset.dot(lens.ahead),
+                c.side + offset.dot(lens.right),
+            );
+            let depth = pf * camera.cos_tilt - up * camera.sin_tilt;
+            if depth < camera.near {
+                return None;
+            }
+            let down = -pf * camera.sin_tilt - up * camera.cos_tilt;
+            let (x, y) = (camera.fx * ps / depth, camera.fy * down / depth);
+            min_x = min_x.min(x);
+            max_x = max_x.max(x);
+            min_y = min_y.min(y);
+            max_y = max_y.max(y);
+        }
+    }
+    let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
+    let rect = Rect {
+        left: first_pixel(cx + min_x, IMAGE_WIDTH),
+        right: last_pixel(cx + max_x, IMAGE_WIDTH),
+        top: first_pixel(cy + min_y, IMAGE_HEIGHT),
+        bottom: last_pixel(cy + max_y, IMAGE_HEIGHT),
+    };
+    (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
 }
 
 /// The clipped pixel box of a cylinder, one rim point at a time.
