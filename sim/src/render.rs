@@ -248,7 +248,7 @@ mod tests {
     use crate::scenario::Scenario;
 
     #[test]
-    fn the_band_option_adds_only_band_coloured_pixels_and_only_on_the_band() {
+    fn the_band_option_outlines_the_band_and_turns_only_the_pucks_in_it_green() {
         let (sim, _) = Scenario::default().build().unwrap();
         let plain = draw(&sim, RenderOptions::default());
         let banded = draw(
@@ -260,14 +260,31 @@ mod tests {
         );
         let scale = scale_of(sim.world(), plain.width());
         let layout = sim.world().config().field_layout();
-        let mut changed = 0;
+        let in_band_pucks: Vec<bool> =
+            pucks_in_band(sim.world(), sim.field(), &sim.config().thresholds).collect();
+        let (mut changed, mut green) = (0, 0);
         for (x, y, p) in banded.enumerate_pixels() {
             if p == plain.get_pixel(x, y) {
                 continue;
             }
+            let centre = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
+            if *p == PUCK_IN_BAND {
+                // a puck's pixel: the puck under it lies in the band
+                let puck = sim
+                    .world()
+                    .pucks()
+                    .iter()
+                    .position(|q| (q.pos - centre).length() <= q.radius + 1.0 / scale)
+                    .unwrap_or_else(|| panic!("({x}, {y}) is green off every puck"));
+                assert!(
+                    in_band_pucks[puck],
+                    "({x}, {y}): puck {puck} is not in the band"
+                );
+                green += 1;
+                continue;
+            }
             changed += 1;
             assert_eq!(*p, BAND, "pixel ({x}, {y})");
-            let centre = Vec2::new((f64::from(x) + 0.5) / scale, (f64::from(y) + 0.5) / scale);
             let value = f64::from(sim.field().evaluate(centre, &layout));
             assert!(
                 in_band(value, &sim.config().thresholds),
@@ -275,6 +292,15 @@ mod tests {
             );
         }
         assert!(changed > 100, "{changed} pixels outlined");
+        assert_eq!(
+            green > 0,
+            in_band_pucks.contains(&true),
+            "{green} green pixels"
+        );
+        assert!(
+            plain.pixels().all(|p| *p != PUCK_IN_BAND),
+            "green only with the band"
+        );
     }
 
     #[test]
