@@ -19,7 +19,7 @@
 //! 3. endpoint 0: a setup packet is read and answered (`Control::setup`);
 //!    an IN data stage goes out 64 bytes at a time, each packet when the
 //!    bank is free (TXINI); SET_ADDRESS's address is enabled once its
-//!    acknowledgement went out (waited for, about 100 us at most, within
+//!    acknowledgement went out (waited for, 150 us at most, within
 //!    the service); the SET_LINE_CODING data stage is read; SET_FEATURE /
 //!    CLEAR_FEATURE(ENDPOINT_HALT) set STALLRQ / clear it with STALLRQC
 //!    and reset the data toggle (RSTDT);
@@ -79,8 +79,8 @@ const STALLRQC: u8 = 1 << 4;
 const RSTDT: u8 = 1 << 3;
 const EPEN: u8 = 1 << 0;
 
-/// Polls of TXINI after SET_ADDRESS's status stage is armed (about 8
-/// cycles each: some 100 us): the host's IN token for it follows at once,
+/// Polls of TXINI after SET_ADDRESS's status stage is armed (12
+/// cycles each in the image: 150 us): the host's IN token for it follows at once,
 /// so the address is enabled within the same service, well inside the
 /// 2 ms USB 2.0 allows (section 9.2.6.3); a host slower than that gets it
 /// at the next service.
