@@ -175,6 +175,30 @@ pub struct LoopSummary {
     pub state_agreement: f64,
     /// Periods per second of wall time.
     pub periods_per_second: f64,
+    /// Where the simulated CPU cycles of a period go, means over every
+    /// period since boot of every robot.
+    pub cycles: CycleBudget,
+    /// Share of the wall time spent stepping the world (physics, sensing,
+    /// evaluation); the rest is simavr's.
+    pub world_time_share: f64,
+}
+
+/// Mean CPU cycles per control period, by what the firmware does in them
+/// (its GPIOR0 markers): reading the sensors (RC timing, the camera on
+/// I2C), deciding, logging, and waiting for the next period (a busy wait:
+/// simavr cannot wake from SLEEP), which simavr simulates cycle by cycle.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CycleBudget {
+    /// Cycles of one period (16 MHz x 20 ms).
+    pub period: f64,
+    /// Buttons, RC timing of the field sensors, the camera's read.
+    pub sensing: f64,
+    /// The decision: hash, table, motor writes.
+    pub decision: f64,
+    /// EEPROM, LEDs, the log frame.
+    pub logging: f64,
+    /// The rest: waiting for the next period.
+    pub waiting: f64,
 }
 
 /// N firmware instances driving the simulated world.
@@ -187,6 +211,8 @@ pub struct InTheLoop<'p> {
     counts: LoopCounts,
     /// A fixed stimulus every robot gets instead of its observation's.
     fixed: Option<Stimulus>,
+    /// Wall time spent stepping the world.
+    world_seconds: f64,
 }
 
 /// A stimulus held fixed: RC delays in CPU cycles and a camera frame.
@@ -236,6 +262,7 @@ impl<'p> InTheLoop<'p> {
             robots,
             counts: LoopCounts::default(),
             fixed: None,
+            world_seconds: 0.0,
         };
         run.check_frames()?;
         Ok(run)
@@ -296,10 +323,12 @@ impl<'p> InTheLoop<'p> {
             r.tick = tick;
             self.counts.periods += 1;
         }
+        let world = Instant::now();
         let report = self.sim.advance(&self.turns, false);
         if report.end.is_some() {
             self.sim.reset_episode();
         }
+        self.world_seconds += world.elapsed().as_secs_f64();
         self.check_frames()
     }
 
@@ -316,6 +345,7 @@ impl<'p> InTheLoop<'p> {
         self.check_frames()?;
         let seconds = start.elapsed().as_secs_f64();
         self.counts.avr_cycles = self.robots.iter().map(|r| r.zumo.cycles()).sum();
+        let cycles = self.cycle_budget();
         let c = &self.counts;
         let share = |n: u64| {
             if c.periods_checked == 0 {
@@ -330,7 +360,29 @@ impl<'p> InTheLoop<'p> {
             state_agreement: share(c.periods_state_agree),
             periods_per_second: c.periods as f64 / seconds.max(f64::MIN_POSITIVE),
             counts: c.clone(),
+            cycles,
+            world_time_share: self.world_seconds / seconds.max(f64::MIN_POSITIVE),
         })
+    }
+
+    /// Mean cycles per period over every robot's periods since boot.
+    fn cycle_budget(&self) -> CycleBudget {
+        let (mut period, mut sensing, mut decision, mut logging) = (0.0, 0.0, 0.0, 0.0);
+        let mean = |v: Vec<u64>| v.iter().sum::<u64>() as f64 / v.len().max(1) as f64;
+        for r in &self.robots {
+            period += mean(r.zumo.period_cycles());
+            sensing += mean(r.zumo.sensing_cycles());
+            decision += mean(r.zumo.decision_cycles());
+            logging += mean(r.zumo.logging_cycles());
+        }
+        let n = self.robots.len().max(1) as f64;
+        CycleBudget {
+            period: period / n,
+            sensing: sensing / n,
+            decision: decision / n,
+            logging: logging / n,
+            waiting: (period - sensing - decision - logging) / n,
+        }
     }
 
     /// Checks every log frame that arrived since the last call.
