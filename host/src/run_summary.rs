@@ -26,7 +26,8 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
-    fn new(totals: &Totals, seconds: f64) -> RunSummary {
+    /// The summary of a run's counters, `seconds` of wall time long.
+    pub fn new(totals: &Totals, seconds: f64) -> RunSummary {
         RunSummary {
             steps: totals.steps,
             formations: totals.formations,

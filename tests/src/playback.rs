@@ -42,6 +42,14 @@ pub fn driving_zumo(elf: &Path, model: &RobotSensors, latency_us: f64, usb: bool
         z.usb_open(4);
         z.stream_usb_in_background(firmware::usb::IN_EP, 7_000);
     }
+    calibrate_and_drive(&mut z, model, latency_us);
+    z
+}
+
+/// Calibrates a booted Zumo by the real procedure (as [`driving_zumo`]
+/// does), starts it driving with button A and stops right after its first
+/// decision. Panics unless the stored calibration is the simulator's.
+pub fn calibrate_and_drive(z: &mut Zumo, model: &RobotSensors, latency_us: f64) {
     let cal = model.calibration();
     let screen = |ticks: [u16; 3]| ticks.map(|t| Some(cycles_of_ticks(t, latency_us)));
     z.calibrate_cycles(
@@ -60,7 +68,6 @@ pub fn driving_zumo(elf: &Path, model: &RobotSensors, latency_us: f64, usb: bool
     );
     z.press_a();
     z.run_to_decision();
-    z
 }
 
 /// Plays one stimulus per control period and returns what the firmware did

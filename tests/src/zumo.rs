@@ -734,6 +734,34 @@ impl Zumo {
         assert_eq!(r, 0, "EEPROM write refused");
     }
 
+    /// Writes `robot_id` into the image's identity record in simulated
+    /// flash (`shared::FirmwareIdentity`, the only place the firmware reads
+    /// its id from): the image then runs as a build with
+    /// `FIRMWARE_ROBOT_ID=robot_id` does (its USB serial number aside), so
+    /// one ELF serves every robot of a swarm. Call it before the firmware
+    /// runs. Fails unless the image holds exactly one record.
+    pub fn set_robot_id(&mut self, robot_id: u8) -> anyhow::Result<()> {
+        let avr = self.state.avr;
+        // SAFETY: the core is live; `flash` holds `flashend + 1` bytes.
+        let flash =
+            unsafe { std::slice::from_raw_parts_mut((*avr).flash, (*avr).flashend as usize + 1) };
+        let len = shared::FirmwareIdentity::LEN;
+        let found: Vec<usize> = (0..=flash.len() - len)
+            .filter(|&i| {
+                let w = &flash[i..i + len];
+                shared::FirmwareIdentity::find_all(w).next().is_some()
+            })
+            .collect();
+        let [at] = found[..] else {
+            anyhow::bail!(
+                "the firmware image holds {} identity records, not one",
+                found.len()
+            );
+        };
+        flash[at + shared::FirmwareIdentity::ROBOT_ID_OFFSET] = robot_id;
+        Ok(())
+    }
+
     /// Reads bytes of the simulated EEPROM.
     pub fn read_eeprom(&mut self, offset: u16, len: usize) -> Vec<u8> {
         let mut desc = EepromDesc {
@@ -900,6 +928,18 @@ impl Zumo {
             );
         }
         self.state.decisions
+    }
+
+    /// Decisions the firmware has ended since boot (the tick of its last
+    /// period's log frame).
+    pub fn decisions(&self) -> u64 {
+        self.state.decisions
+    }
+
+    /// CPU cycles simulated since boot.
+    pub fn cycles(&self) -> u64 {
+        // SAFETY: the core is live while `self` is.
+        unsafe { (*self.state.avr).cycle }
     }
 
     /// simavr's handle of the running core (for the USB host's ioctls).
