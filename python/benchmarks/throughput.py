@@ -2,8 +2,7 @@
 one sitting: every configuration runs once per round, rounds alternate,
 and the figures are medians over the rounds, stated as ratios to `host
 bench` of the same sitting. Writes the raw runs as JSON; `--render` turns
-such a file into the markdown table of docs/python.md and
-docs/performance.md.
+such a file into the markdown table of docs/performance.md.
 
     cargo build --release -p host && scripts/test-python   # the release host, the wheel in target/python-venv
     python3 -m venv /tmp/vmas-venv && /tmp/vmas-venv/bin/pip install vmas
