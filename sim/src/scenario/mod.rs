@@ -11,7 +11,7 @@ pub mod flat_field;
 pub mod panel;
 pub mod sensor_choice;
 pub mod sensor_setup;
-pub mod shape_pucks;
+pub mod puck_rule;
 pub mod trained_for;
 
 use crate::base::ranges;
@@ -27,6 +27,7 @@ use crate::control::Controller;
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::ScalarField;
 use crate::scenario::arena::ArenaSpec;
+use crate::scenario::puck_rule::PuckRuleError;
 use crate::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::sensors::robot_noise::RobotNoise;
 use crate::simulation::Simulation;
@@ -380,6 +381,8 @@ pub enum ScenarioError {
     UnknownArena(String),
     /// A screen arena is needed where this arena (the thesis' square) was given.
     NotAScreen(String),
+    /// The field has no puck count by the puck rule.
+    PuckRule(Box<PuckRuleError>),
 }
 
 impl fmt::Display for ScenarioError {
@@ -403,6 +406,7 @@ impl fmt::Display for ScenarioError {
                 "--arena {arena}: a screen arena is needed ({} or a FILE.toml), not the thesis' square",
                 ArenaSpec::NAMES
             ),
+            ScenarioError::PuckRule(e) => e.fmt(f),
         }
     }
 }
@@ -412,6 +416,12 @@ impl std::error::Error for ScenarioError {}
 impl From<ConfigError> for ScenarioError {
     fn from(e: ConfigError) -> ScenarioError {
         ScenarioError::Config(e)
+    }
+}
+
+impl From<PuckRuleError> for ScenarioError {
+    fn from(e: PuckRuleError) -> ScenarioError {
+        ScenarioError::PuckRule(Box::new(e))
     }
 }
 
