@@ -11,6 +11,8 @@ use crate::train::TrainConfig;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use sim::base::ranges;
+use sim::scenario::puck_rule::rule_pucks;
+use sim::scenario::Arena;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -192,6 +194,8 @@ pub struct ArmSpec {
     /// (its published result files), by metric: the side-by-side that
     /// `docs/reproduction.md` tests ours against.
     pub author: BTreeMap<Metric, Vec<f64>>,
+    /// Why the arm's puck count is not the puck rule's, if it sets one.
+    pub pucks_reason: Option<String>,
 }
 
 /// What a chart shows.
@@ -304,13 +308,14 @@ struct ArmKeys {
     thesis: BTreeMap<Metric, f64>,
     #[serde(default)]
     author: BTreeMap<Metric, Vec<f64>>,
+    pucks_reason: Option<String>,
 }
 
 fn default_controller() -> ArmController {
     ArmController::Learn
 }
 
-const ARM_KEYS: [&str; 8] = [
+const ARM_KEYS: [&str; 9] = [
     "name",
     "row",
     "column",
@@ -319,6 +324,7 @@ const ARM_KEYS: [&str; 8] = [
     "policy",
     "thesis",
     "author",
+    "pucks_reason",
 ];
 
 impl ExperimentSpec {
@@ -463,10 +469,11 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     }
     let mut merged = defaults.clone();
     merge(&mut merged, table);
-    let config: TrainConfig = toml::Value::Table(merged)
+    let mut config: TrainConfig = toml::Value::Table(merged)
         .try_into()
         .with_context(context)?;
     config.validate().with_context(context)?;
+    config.pucks = effective_pucks(&config, keys.pucks_reason.as_deref()).with_context(context)?;
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
     }
@@ -490,11 +497,32 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
         policy: keys.policy,
         thesis: keys.thesis,
         author: keys.author,
+        pucks_reason: keys.pucks_reason,
     })
 }
 
+/// The arm's puck count: on a screen arena the puck rule's
+/// ([`sim::scenario::puck_rule`]) unless the arm sets another and says why
+/// (`pucks_reason`); elsewhere the count set, if any. An arena file that
+/// cannot be read leaves the count as set: the run fails naming the file.
+fn effective_pucks(config: &TrainConfig, reason: Option<&str>) -> Result<Option<usize>> {
+    let rule = match config.arena_choice().arena() {
+        Ok(arena @ Arena::Screen(_)) => Some(rule_pucks(&config.field, &arena)?),
+        Ok(Arena::Square(_)) => None,
+        Err(_) => return Ok(config.pucks),
+    };
+    match (config.pucks, rule, reason) {
+        (Some(n), Some(r), None) if n != r => bail!(
+            "pucks = {n}: the puck rule gives {} {r}; give the reason for another count as pucks_reason",
+            config.field
+        ),
+        (None, _, Some(_)) => bail!("pucks_reason without pucks: the count is the puck rule's"),
+        (pucks, rule, _) => Ok(pucks.or(rule)),
+    }
+}
+
 /// Writes `over` into `base`, merging nested tables key by key.
-fn merge(base: &mut toml::Table, over: toml::Table) {
+pub(crate) fn merge(base: &mut toml::Table, over: toml::Table) {
     for (key, value) in over {
         match (base.get_mut(&key), value) {
             (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
