@@ -55,6 +55,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench(args),
         Command::Train(args) => train(args),
         Command::Search(args) => search(args),
+        Command::Shape(args) => shape(args),
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
         Command::Policy(PolicyCommand::Gap(args)) => policy_gap(args),
@@ -165,8 +166,20 @@ fn train(args: TrainArgs) -> Result<()> {
 }
 
 fn search(args: SearchArgs) -> Result<()> {
-    let report = host::search::search(&args.request())?;
+    let request = args.request();
+    let mut progress = host::search::command::Progress::new(request.search.generations, 0);
+    let report = host::search::search(&request, &mut |g| {
+        progress.generation(g);
+        Ok(())
+    })?;
+    progress.done();
     println!("{report}");
+    Ok(())
+}
+
+fn shape(args: cli::shape::ShapeArgs) -> Result<()> {
+    let report = host::shape::shape(&args.request()?)?;
+    print!("{report}");
     Ok(())
 }
 

@@ -210,18 +210,30 @@ impl Progress {
 /// then on each `--also-field`, each at the run's noise and then at each
 /// `--also-noise`; on a screen each shape's puck count by the puck rule
 /// ([`sim::scenario::puck_rule`]) unless `--pucks` is given. The first is the run's own world.
+#[cfg(test)]
 fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
+    worlds_from(base_world(request)?, &request.search)
+}
+
+/// The run's own world: the file's (or [`default_world`]), the flags
+/// applied.
+fn base_world(request: &SearchRequest) -> Result<TrainConfig> {
     let mut base = match &request.config {
         Some(path) => TrainConfig::from_file(path)?,
         None => default_world(),
     };
     request.flags.apply(&mut base)?;
-    for &noise in &request.search.also_noise {
+    Ok(base)
+}
+
+/// [`worlds`] from the run's own world `base`.
+fn worlds_from(base: TrainConfig, settings: &SearchConfig) -> Result<Vec<TrainConfig>> {
+    for &noise in &settings.also_noise {
         sim::base::ranges::NOISE.check_as("also-noise", noise)?;
     }
-    let fields = std::iter::once(base.field.clone()).chain(request.search.also_field.clone());
+    let fields = std::iter::once(base.field.clone()).chain(settings.also_field.clone());
     let noises: Vec<f64> = std::iter::once(base.noise)
-        .chain(request.search.also_noise.iter().copied())
+        .chain(settings.also_noise.iter().copied())
         .collect();
     fields
         .flat_map(|field| noises.iter().map(move |&noise| (field.clone(), noise)))
@@ -257,9 +269,14 @@ pub fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, 
 /// The run's own world (the first of [`worlds`]) and a scorer of every
 /// world of the request, the settings checked.
 pub fn scorer(request: &SearchRequest) -> Result<(TrainConfig, Scorer)> {
-    let configs = worlds(request)?;
+    scorer_of(base_world(request)?, &request.search)
+}
+
+/// [`scorer`] of the run's own world `base` (its field, noise and counts
+/// as given) and `settings`.
+pub fn scorer_of(base: TrainConfig, settings: &SearchConfig) -> Result<(TrainConfig, Scorer)> {
+    let configs = worlds_from(base, settings)?;
     let config = configs[0].clone();
-    let settings = &request.search;
     settings.validate(config.learn.actions.len())?;
     let prepared = configs
         .iter()
@@ -329,7 +346,15 @@ pub fn run(
     start: PolicyTable,
     distil_steps: u64,
 ) -> Result<SearchLog> {
-    run_from(config, settings, scorer, start, distil_steps, &[], &mut |_| Ok(()))
+    run_from(
+        config,
+        settings,
+        scorer,
+        start,
+        distil_steps,
+        &[],
+        &mut |_| Ok(()),
+    )
 }
 
 /// The search from `start`, continuing after the generations `done` of an
