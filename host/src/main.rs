@@ -457,6 +457,9 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
         }
         None => {
             let name = args.run.experiment.as_deref().unwrap_or_default();
+            if let Some(campaign) = host::experiment::campaign::Campaign::at(name)? {
+                return run_campaign(&campaign, &args.run);
+            }
             let spec = host::experiment::ExperimentSpec::load(name)?;
             // progress lines; a closed stdout must not stop the trials
             let log = |line: &str| {
@@ -474,6 +477,34 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `host experiment FILE` of a campaign: its stages, into --out
+/// [default: out/<campaign>].
+fn run_campaign(
+    campaign: &host::experiment::campaign::Campaign,
+    args: &cli::learn::ExperimentRunArgs,
+) -> Result<()> {
+    let options = host::experiment::campaign::run::CampaignOptions {
+        out: args
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new("out").join(&campaign.name)),
+        scale: args.scale,
+        stages: args.stages.clone(),
+    };
+    let log = |line: &str| {
+        let _ = writeln!(std::io::stdout().lock(), "{line}");
+    };
+    let report = host::experiment::campaign::run(campaign, &options, &log)?;
+    println!(
+        "done in {:.0} s: {} stages run, {} skipped; outputs in {}",
+        report.seconds,
+        report.run.len(),
+        report.skipped.len(),
+        options.out.display()
+    );
+    Ok(())
 }
 
 fn monitor(args: MonitorArgs) -> Result<()> {

@@ -166,6 +166,7 @@ pub fn write(
         crate::atomic::write(&path, doc.as_bytes())?;
         written.push(path);
     }
+    written.extend(super::campaign::publish::write_pages(docs)?);
     Ok(written)
 }
 
@@ -193,6 +194,7 @@ pub fn check(docs: &Path, documents: &[Document], log: &dyn Fn(&str)) -> Result<
         }
         checked.push(path);
     }
+    checked.extend(super::campaign::publish::check_pages(docs)?);
     Ok(checked)
 }
 

@@ -221,7 +221,11 @@ fn evaluation(campaign: &Campaign, path: &Path) -> Result<Value> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut shapes = Map::new();
-    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+    for (i, line) in text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+    {
         let r: Value = serde_json::from_str(line)
             .with_context(|| format!("{} line {}: not JSON", path.display(), i + 1))?;
         let field = r["field"].as_str().unwrap_or_default().to_string();
@@ -232,9 +236,9 @@ fn evaluation(campaign: &Campaign, path: &Path) -> Result<Value> {
             .or_insert_with(|| json!({}))
             .as_object_mut()
             .context("a shape")?;
-        let c = shape.entry(label).or_insert_with(
-            || json!({"policy": controller, "seeds": [], "formations": []}),
-        );
+        let c = shape
+            .entry(label)
+            .or_insert_with(|| json!({"policy": controller, "seeds": [], "formations": []}));
         push(c, "seeds", r["seed"].clone())?;
         push(c, "formations", r["formations"].clone())?;
         c["steps_per_seed"] = r["steps"].clone();
@@ -475,7 +479,10 @@ pub fn tables(publication: &Publication, results: &Value) -> Result<String> {
             .iter()
             .map(|f| {
                 let shape = shapes[*f].as_object().unwrap_or(&empty);
-                own_counts(shape).into_iter().reduce(f64::max).unwrap_or(0.0)
+                own_counts(shape)
+                    .into_iter()
+                    .reduce(f64::max)
+                    .unwrap_or(0.0)
             })
             .collect();
         let heads: Vec<String> = held_out

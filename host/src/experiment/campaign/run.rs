@@ -250,10 +250,7 @@ fn run_stage(
     progress: &dyn Fn(&str),
 ) -> Result<()> {
     let out = &options.out;
-    let from = stage
-        .from
-        .as_ref()
-        .map(|f| out.join(format!("{f}.policy")));
+    let from = stage.from.as_ref().map(|f| out.join(format!("{f}.policy")));
     match &stage.work {
         Work::Search { world, search } => {
             let config = write_world(stage, &world_at(world, options.scale, out), out)?;
