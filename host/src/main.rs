@@ -437,6 +437,16 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             );
             Ok(())
         }
+        Some(ExperimentAction::List { page }) => {
+            for (name, text) in host::experiment::spec::BUILT_IN {
+                let spec = host::experiment::ExperimentSpec::parse(name, text)?;
+                let on = spec.page.as_deref().unwrap_or("-");
+                if page.as_deref().is_none_or(|p| p == on) {
+                    println!("{name} {} {on}", spec.trials);
+                }
+            }
+            Ok(())
+        }
         Some(ExperimentAction::Report {
             docs,
             check,
@@ -465,7 +475,7 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             let log = |line: &str| {
                 let _ = writeln!(std::io::stdout().lock(), "{line}");
             };
-            let report = host::experiment::run(&spec, &args.run.options(), &log)?;
+            let report = host::experiment::run(&spec, &args.run.options(spec.trials), &log)?;
             println!(
                 "done in {:.0} s: {} trials run, {} skipped, {} copied; wrote {}",
                 report.seconds,

@@ -228,11 +228,12 @@ impl<U> FromArgMatches for FlagsOf<U> {
     }
 }
 
-/// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
+/// `host experiment`'s arguments: an experiment to run, or `list`, `merge`
+/// or `report`.
 #[derive(Clone, Debug, Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct ExperimentArgs {
-    /// `merge` or `report` instead of a run.
+    /// `list`, `merge` or `report` instead of a run.
     #[command(subcommand)]
     pub action: Option<ExperimentAction>,
     /// The run.
@@ -253,11 +254,18 @@ pub enum ExperimentAction {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// From the published trials (<docs>/<document>/<name>/trials/): every
-    /// experiment's table.md, trials.csv and figures, and the documents
-    /// <docs>/reproduction.md and <docs>/robot-sensors.md from their
-    /// templates (<docs>/<document>/template.md). Run from the repository
-    /// root.
+    /// The built-in experiments, one a line: the name, the trials per arm
+    /// of its published run and its results page.
+    List {
+        /// Only the experiments of this results page (e.g. robot-sensors).
+        #[arg(long)]
+        page: Option<String>,
+    },
+    /// From the published trials (<docs>/<page>/<name>/trials/): every
+    /// experiment's table.md, trials.csv, figures and page
+    /// (<docs>/<page>/<name>.md), and each results page's index
+    /// (<docs>/<page>.md), from their templates (<docs>/<page>/template.md,
+    /// <docs>/<page>/<name>/template.md). Run from the repository root.
     Report {
         /// The docs directory.
         #[arg(long, default_value = "docs")]
@@ -269,7 +277,8 @@ pub enum ExperimentAction {
         /// quick run's page).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
-        /// Only these documents: reproduction, robot-sensors [default: both].
+        /// Only these results pages (reproduction, robot-sensors)
+        /// [default: every one].
         documents: Vec<String>,
     },
 }
@@ -277,18 +286,15 @@ pub enum ExperimentAction {
 /// `host experiment NAME`'s options.
 #[derive(Clone, Debug, Args)]
 pub struct ExperimentRunArgs {
-    /// The thesis' (annulus, transfer, letters, letters-ablation,
-    /// letters-generated, state-bits, obstacle, collisions) or the robot's
-    /// senses' (robot-senses-ablation, robot-senses-sweep, robustness,
-    /// robustness-thesis, robot-senses-letter, wedge, wedge-sweep,
-    /// every-shape, t-noise, held-out-noise): the files of experiments/,
-    /// built in; or the path of a TOML file (with `[[stages]]`: a campaign,
-    /// experiments/campaigns/, docs/policy-search.md).
+    /// A built-in experiment (a file of experiments/ by its stem; `host
+    /// experiment list` names them) or the path of a TOML file (with
+    /// `[[stages]]`: a campaign, experiments/campaigns/,
+    /// docs/policy-search.md).
     #[arg(required = true)]
     pub experiment: Option<String>,
-    /// Trials per arm.
-    #[arg(long, default_value_t = 10)]
-    pub trials: usize,
+    /// Trials per arm [default: the file's `trials`, else 10].
+    #[arg(long)]
+    pub trials: Option<usize>,
     /// Fraction of the thesis' step counts, for quick runs (0.05: about a
     /// minute for the annulus, long enough for its arms to form shapes); of
     /// a campaign's step and generation counts.
@@ -324,10 +330,11 @@ pub struct ExperimentRunArgs {
 }
 
 impl ExperimentRunArgs {
-    /// The run options these arguments give.
-    pub fn options(&self) -> RunOptions {
+    /// The run options these arguments give, `file_trials` per arm unless
+    /// `--trials` says.
+    pub fn options(&self, file_trials: usize) -> RunOptions {
         RunOptions {
-            trials: self.trials,
+            trials: self.trials.unwrap_or(file_trials),
             scale: self.scale,
             out: self.out.clone(),
             seed: self.seed,

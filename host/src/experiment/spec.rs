@@ -16,70 +16,9 @@ use sim::scenario::Arena;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The experiments shipped in `experiments/`, built into the binary so that
-/// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 18] = [
-    ("annulus", include_str!("../../../experiments/annulus.toml")),
-    (
-        "transfer",
-        include_str!("../../../experiments/transfer.toml"),
-    ),
-    ("letters", include_str!("../../../experiments/letters.toml")),
-    (
-        "letters-ablation",
-        include_str!("../../../experiments/letters-ablation.toml"),
-    ),
-    (
-        "letters-generated",
-        include_str!("../../../experiments/letters-generated.toml"),
-    ),
-    (
-        "state-bits",
-        include_str!("../../../experiments/state-bits.toml"),
-    ),
-    (
-        "obstacle",
-        include_str!("../../../experiments/obstacle.toml"),
-    ),
-    (
-        "collisions",
-        include_str!("../../../experiments/collisions.toml"),
-    ),
-    (
-        "robot-senses-ablation",
-        include_str!("../../../experiments/robot-senses-ablation.toml"),
-    ),
-    (
-        "robot-senses-sweep",
-        include_str!("../../../experiments/robot-senses-sweep.toml"),
-    ),
-    (
-        "robustness",
-        include_str!("../../../experiments/robustness.toml"),
-    ),
-    (
-        "robustness-thesis",
-        include_str!("../../../experiments/robustness-thesis.toml"),
-    ),
-    (
-        "robot-senses-letter",
-        include_str!("../../../experiments/robot-senses-letter.toml"),
-    ),
-    ("wedge", include_str!("../../../experiments/wedge.toml")),
-    (
-        "wedge-sweep",
-        include_str!("../../../experiments/wedge-sweep.toml"),
-    ),
-    (
-        "every-shape",
-        include_str!("../../../experiments/every-shape.toml"),
-    ),
-    ("t-noise", include_str!("../../../experiments/t-noise.toml")),
-    (
-        "held-out-noise",
-        include_str!("../../../experiments/held-out-noise.toml"),
-    ),
-];
+// The experiments shipped in `experiments/`, built into the binary so
+// that `host experiment NAME` works from any directory: `BUILT_IN`.
+include!(concat!(env!("OUT_DIR"), "/built_in.rs"));
 
 /// A parsed experiment file.
 #[derive(Clone, Debug, PartialEq)]
@@ -92,6 +31,12 @@ pub struct ExperimentSpec {
     pub thesis: String,
     /// The experiment seed every trial seed derives from.
     pub seed: u64,
+    /// Trials per arm of a run that does not say (`--trials`): the
+    /// published run's.
+    pub trials: usize,
+    /// The results page (`docs/PAGE.md`, `host experiment report PAGE`)
+    /// that shows its published trials, if any.
+    pub page: Option<String>,
     /// Points of the formations-over-time curves.
     pub sample_points: usize,
     /// The results table.
@@ -273,6 +218,9 @@ struct ExperimentFile {
     thesis: String,
     #[serde(default = "default_seed")]
     seed: u64,
+    #[serde(default = "default_trials")]
+    trials: usize,
+    page: Option<String>,
     #[serde(default = "default_sample_points")]
     sample_points: usize,
     #[serde(default)]
@@ -286,6 +234,10 @@ struct ExperimentFile {
 
 fn default_seed() -> u64 {
     1
+}
+
+fn default_trials() -> usize {
+    10
 }
 
 fn default_sample_points() -> usize {
@@ -358,6 +310,7 @@ impl ExperimentSpec {
         if file.arms.is_empty() {
             bail!("no [[arms]]");
         }
+        ranges::TRIALS.check_count("trials", file.trials as u64)?;
         if file.defaults.contains_key("output") {
             bail!("[defaults]: output settings are chosen by the experiment runner");
         }
@@ -427,6 +380,8 @@ impl ExperimentSpec {
             title: file.title,
             thesis: file.thesis,
             seed: file.seed,
+            trials: file.trials,
+            page: file.page,
             sample_points: file.sample_points.max(2),
             table: file.table,
             arms,
