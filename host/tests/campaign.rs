@@ -264,3 +264,70 @@ fn a_stage_with_a_bad_key_gets_an_error_naming_the_file_the_stage_and_the_key() 
         "{error}"
     );
 }
+
+#[test]
+fn a_publish_stage_writes_the_results_and_the_pages_tables_which_the_report_then_checks() {
+    let dir = tempfile::tempdir().unwrap();
+    let campaigns = dir.path().join("experiments/campaigns");
+    std::fs::create_dir_all(&campaigns).unwrap();
+    // scale 1 (a publish stage publishes nothing at another), tiny budgets
+    let text = SMALL
+        .replace("distil_oc = 500000", "distil_oc = 2000")
+        .replace("fitness_steps = 50000", "fitness_steps = 1000")
+        .replace("validation_steps = 50000", "validation_steps = 1000")
+        .replace("generations = 2", "generations = 1")
+        .replace("steps = 100000", "steps = 1000")
+        + r#"
+[[stages]]
+name = "publish"
+kind = "publish"
+dir = "small"
+evaluations = ["report"]
+report_fields = ["thesis:V", "letter:I"]
+targets = { ratio_field = "thesis:V", ratio = 1.15, least = 50.0, oc_at_least = 20.0 }
+"#;
+    let file = campaigns.join("small.toml");
+    std::fs::write(&file, text).unwrap();
+    let docs = dir.path().join("docs");
+    std::fs::create_dir_all(&docs).unwrap();
+    let page = "# Small\n\n<!-- results:begin -->\n<!-- results:end -->\nAfter.\n";
+    std::fs::write(docs.join("small.md"), page).unwrap();
+    let output = Command::new(env!("CARGO_BIN_EXE_host"))
+        .current_dir(dir.path())
+        .args(["experiment", "experiments/campaigns/small.toml"])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for published in [
+        "small/runs/first.policy",
+        "small/runs/second.search.json",
+        "small/runs/report.jsonl",
+        "small/results.json",
+    ] {
+        assert!(docs.join(published).exists(), "{published}");
+    }
+    let rendered = std::fs::read_to_string(docs.join("small.md")).unwrap();
+    assert!(
+        rendered.contains("| thesis:V | orbital construction | ")
+            && rendered.contains("| thesis:V | the first search | ")
+            && rendered.contains("| second | thesis:V | robot | 1 | original | ")
+            && rendered.ends_with("<!-- results:end -->\nAfter.\n"),
+        "{rendered}"
+    );
+    let checked = host::experiment::campaign::publish::check_pages(&docs).unwrap();
+    assert_eq!(checked, [docs.join("small.md")]);
+    // a page whose tables are not the results' fails the check
+    std::fs::write(
+        docs.join("small.md"),
+        rendered.replace("| thesis:V | orbital construction | ", "| thesis:V | OC | "),
+    )
+    .unwrap();
+    let error = host::experiment::campaign::publish::check_pages(&docs)
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("small.md"), "{error}");
+}

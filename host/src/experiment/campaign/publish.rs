@@ -109,6 +109,7 @@ impl Publication {
         let docs = Path::new("docs");
         let dir = docs.join(&self.dir);
         let runs = dir.join("runs");
+        crate::atomic::check_writable(&runs)?;
         let mut written = Vec::new();
         let copy = |from: PathBuf, written: &mut Vec<PathBuf>| -> Result<()> {
             if let Some(name) = from.file_name().filter(|_| from.exists()) {
