@@ -274,3 +274,26 @@ fn a_run_killed_mid_search_and_run_again_ends_with_the_table_of_an_unbroken_run(
     assert_eq!(table(broken.path()), table(unbroken.path()));
     assert_eq!(finished(&state), 4);
 }
+
+#[test]
+fn host_train_ends_by_saying_what_it_trained_for_and_pointing_to_host_shape() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = host()
+        .current_dir(dir.path())
+        .args(["train", "--steps", "2000", "--out", "t"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = |start: &str| {
+        text.lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no {start} line in:\n{text}"))
+            .to_string()
+    };
+    assert!(
+        line("trained for").ends_with("annulus, sensors disc, arena thesis"),
+        "{text}"
+    );
+    assert!(line("for the robot").contains("host shape IMAGE"), "{text}");
+}
