@@ -470,6 +470,9 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             if let Some(campaign) = host::experiment::campaign::Campaign::at(name)? {
                 return run_campaign(&campaign, &args.run);
             }
+            if !args.run.stages.is_empty() {
+                anyhow::bail!("--stages: {name} is an experiment, not a campaign with [[stages]]");
+            }
             let spec = host::experiment::ExperimentSpec::load(name)?;
             // progress lines; a closed stdout must not stop the trials
             let log = |line: &str| {
@@ -495,6 +498,19 @@ fn run_campaign(
     campaign: &host::experiment::campaign::Campaign,
     args: &cli::learn::ExperimentRunArgs,
 ) -> Result<()> {
+    let unused = [
+        ("--seed", args.seed.is_some()),
+        ("--threads", args.threads.is_some()),
+        ("--shard", args.shard.is_some()),
+        ("--reuse", !args.reuse.is_empty()),
+        ("--view", args.view.is_some()),
+    ];
+    if let Some((flag, _)) = unused.iter().find(|(_, given)| *given) {
+        anyhow::bail!(
+            "{flag}: a campaign ({}) takes its seeds and settings from its file",
+            campaign.name
+        );
+    }
     let options = host::experiment::campaign::run::CampaignOptions {
         out: args
             .out

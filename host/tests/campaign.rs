@@ -331,3 +331,28 @@ targets = { ratio_field = "thesis:V", ratio = 1.15, least = 50.0, oc_at_least = 
         .to_string();
     assert!(error.contains("small.md"), "{error}");
 }
+
+#[test]
+fn stages_are_refused_for_an_experiment_and_trial_flags_for_a_campaign() {
+    let host = |args: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_host"))
+            .current_dir(root())
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(!output.status.success(), "{args:?}");
+        String::from_utf8(output.stderr).unwrap()
+    };
+    let error = host(&["experiment", "annulus", "--stages", "x"]);
+    assert!(error.contains("--stages"), "{error}");
+    let error = host(&[
+        "experiment",
+        "experiments/campaigns/policy-search.toml",
+        "--seed",
+        "3",
+    ]);
+    assert!(
+        error.contains("--seed") && error.contains("policy-search"),
+        "{error}"
+    );
+}
