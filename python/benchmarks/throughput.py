@@ -168,8 +168,8 @@ def render(results: dict) -> str:
     base, base_cpu = statistics.median(rows[0]["runs"]), statistics.median(rows[0]["cpu_runs"])
     load = ", ".join(f"{x:.1f}" for x in results["load_average"])
     lines = [
-        f"Measured {results['date']} (commit {results['commit']}) on {results['machine']}, "
-        f"{results['rounds']} alternating rounds in one sitting (1-minute load average before and after each round: {load}). "
+        f"Measured at commit {results['commit']} on {results['machine']}, "
+        f"{results['rounds']} alternating rounds (1-minute load average before and after each round: {load}). "
         "A step is one world's step (all 8 robots); medians over the rounds.",
         "",
         "| configuration | steps/s (each round) | median | vs host bench | steps per CPU-second | "
