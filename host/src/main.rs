@@ -451,11 +451,13 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             docs,
             check,
             scale,
+            experiments,
             documents,
         }) => {
             ranges::SCALE.check(scale)?;
             let log = |line: &str| eprintln!("{line}");
-            let documents = host::experiment::report::documents(&documents)?;
+            let documents =
+                host::experiment::report::documents(&documents, experiments.as_deref())?;
             if check {
                 let checked = host::experiment::report::check(&docs, &documents, &log)?;
                 println!("{} are what the published trials give", paths(&checked));

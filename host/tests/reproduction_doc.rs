@@ -27,7 +27,7 @@ fn the_rendered_pages_are_what_the_committed_trials_give() {
     let docs = Path::new("docs");
     let stale = std::cell::RefCell::new(Vec::new());
     let log = |line: &str| stale.borrow_mut().push(line.to_string());
-    let all = documents(&[]).unwrap();
+    let all = documents(&[], None).unwrap();
     if let Err(e) = host::experiment::report::check(docs, &all, &log) {
         panic!("{e:#}");
     }
@@ -292,7 +292,7 @@ fn recompute(expr: &str, sources: &[Source]) -> Option<String> {
 fn every_verdict_on_the_page_follows_the_one_rule() {
     std::env::set_current_dir(root()).unwrap();
     let docs = Path::new("docs");
-    let document = documents(&["reproduction".to_string()]).unwrap().remove(0);
+    let document = documents(&["reproduction".to_string()], None).unwrap().remove(0);
     let sources = document.sources(docs, 1.0, &|_| {}).unwrap();
     let side = SideBySide::load(&docs.join("reproduction/side-by-side")).unwrap();
     // each page's template and the page: the index, then each experiment's
@@ -345,12 +345,19 @@ fn every_verdict_on_the_page_follows_the_one_rule() {
     );
 }
 
-/// The page types none of the figures the trials or the runs give: the
+/// The pages type none of the figures the trials or the runs give: the
 /// learners' side-by-side table and its comparisons, and the figures with
 /// wall segments, are rendered.
 #[test]
 fn the_template_types_no_figure_of_the_runs() {
-    let template = std::fs::read_to_string(root().join("docs/reproduction/template.md")).unwrap();
+    // the index's template and every experiment page's
+    let dir = root().join("docs/reproduction");
+    let mut template = std::fs::read_to_string(dir.join("template.md")).unwrap();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        if let Ok(text) = std::fs::read_to_string(entry.unwrap().path().join("template.md")) {
+            template.push_str(&text);
+        }
+    }
     let mut prose = String::new();
     let mut rest = template.as_str();
     while let Some(open) = rest.find("{{") {

@@ -277,6 +277,10 @@ pub enum ExperimentAction {
         /// quick run's page).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
+        /// The experiments of the `*.toml` files in this directory (each
+        /// file's `page` key) instead of the built-in ones.
+        #[arg(long, value_name = "DIR")]
+        experiments: Option<PathBuf>,
         /// Only these results pages (reproduction, robot-sensors)
         /// [default: every one].
         documents: Vec<String>,

@@ -6,7 +6,8 @@
 //! `<docs>/<dir>/<name>.md` from its template (`<docs>/<dir>/<name>/template.md`,
 //! [`super::template`]; without one, a page of its table and how to
 //! reproduce it), and the group's index `<docs>/<dir>.md` from
-//! `<docs>/<dir>/template.md`; with the trials published before the
+//! `<docs>/<dir>/template.md` (without one, a list of the experiments'
+//! pages); with the trials published before the
 //! clamping border (`<docs>/<dir>/wall-segments/trials.tsv`) and the
 //! learners' side by side (`<docs>/<dir>/side-by-side/`) where the group
 //! has them. Every page of a group sees all of the group's experiments.
@@ -35,7 +36,8 @@ pub struct Document {
     /// Directory under the docs of its templates and trials, and the stem
     /// of its index page.
     pub dir: String,
-    /// The built-in experiments it shows, in name order.
+    /// The experiments it shows, in name order: built-in names, or paths
+    /// of files.
     pub experiments: Vec<String>,
 }
 
@@ -45,14 +47,37 @@ struct PageKey {
     page: Option<String>,
 }
 
-/// Every page group the built-in experiments name, in name order.
-pub fn all_documents() -> Result<Vec<Document>> {
+/// Every page group the experiments name, in name order: the built-in
+/// ones, or with `dir` the `*.toml` files in it (by path).
+pub fn all_documents(dir: Option<&Path>) -> Result<Vec<Document>> {
+    let files: Vec<(String, String)> = match dir {
+        None => BUILT_IN
+            .iter()
+            .map(|(name, text)| (name.to_string(), text.to_string()))
+            .collect(),
+        Some(dir) => {
+            let mut files = Vec::new();
+            let entries = std::fs::read_dir(dir)
+                .with_context(|| format!("cannot list the experiments in {}", dir.display()))?;
+            for entry in entries {
+                let path = entry
+                    .with_context(|| format!("cannot list the experiments in {}", dir.display()))?
+                    .path();
+                if path.extension().is_some_and(|e| e == "toml") {
+                    let text = std::fs::read_to_string(&path)
+                        .with_context(|| format!("cannot read {}", path.display()))?;
+                    files.push((path.display().to_string(), text));
+                }
+            }
+            files.sort();
+            files
+        }
+    };
     let mut groups: BTreeMap<String, Vec<String>> = BTreeMap::new();
-    for (name, text) in BUILT_IN {
-        let key: PageKey =
-            toml::from_str(text).with_context(|| format!("built-in experiment {name}"))?;
+    for (name, text) in files {
+        let key: PageKey = toml::from_str(&text).with_context(|| format!("experiment {name}"))?;
         if let Some(page) = key.page {
-            groups.entry(page).or_default().push(name.to_string());
+            groups.entry(page).or_default().push(name);
         }
     }
     Ok(groups
@@ -74,14 +99,14 @@ impl Document {
         let mut out = Vec::new();
         for name in &self.experiments {
             let spec = ExperimentSpec::load(name)?;
-            let dir = docs.join(&self.dir).join(name);
+            let dir = docs.join(&self.dir).join(&spec.name);
             let published: Published = published::load(&spec, &dir, scale, spec.seed)?;
             for stale in &published.stale {
                 log(&format!("left out: {stale}"));
             }
             let segments = published::wall_segments(
                 &docs.join(&self.dir).join("wall-segments/trials.tsv"),
-                name,
+                &spec.name,
             )?;
             out.push(Source {
                 spec,
@@ -93,11 +118,22 @@ impl Document {
         Ok(out)
     }
 
-    /// The index page the template and the trials give.
+    /// The index page the template and the trials give; without a
+    /// template, a list of the experiments' pages.
     pub fn render(&self, docs: &Path, sources: &[Source]) -> Result<String> {
         let path = docs.join(&self.dir).join("template.md");
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = match std::fs::read_to_string(&path) {
+            Ok(text) => text,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                let mut text = format!("# {}\n\n", self.dir);
+                for s in sources {
+                    let name = &s.spec.name;
+                    text.push_str(&format!("- [{}]({}/{name}.md)\n", s.spec.title, self.dir));
+                }
+                text
+            }
+            Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+        };
         self.render_text(docs, sources, &text, &path)
     }
 
@@ -154,10 +190,11 @@ fn default_template(spec: &ExperimentSpec) -> String {
     )
 }
 
-/// The documents named (all for none); an unknown name is an error that
-/// lists the known ones.
-pub fn documents(names: &[String]) -> Result<Vec<Document>> {
-    let all = all_documents()?;
+/// The documents named (all for none) of the experiments in `dir` (the
+/// built-in ones for none); an unknown name is an error that lists the
+/// known ones.
+pub fn documents(names: &[String], dir: Option<&Path>) -> Result<Vec<Document>> {
+    let all = all_documents(dir)?;
     if names.is_empty() {
         return Ok(all);
     }
@@ -241,7 +278,7 @@ mod tests {
 
     #[test]
     fn every_built_in_experiment_names_the_results_page_that_shows_it() {
-        let documents = all_documents().unwrap();
+        let documents = all_documents(None).unwrap();
         let listed: Vec<&str> = documents
             .iter()
             .flat_map(|d| d.experiments.iter().map(String::as_str))
