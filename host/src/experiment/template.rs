@@ -1,5 +1,6 @@
-//! The templates of the results pages (`docs/reproduction.md`, `docs/robot-sensors.md` and their experiments' pages): markdown with `{{ ... }}`
-//! expressions, each rendered from an experiment's published trials, so
+//! The templates of the results pages (`docs/reproduction.md`,
+//! `docs/robot-sensors.md` and their experiments' pages): markdown with
+//! `{{ ... }}` expressions, each rendered from an experiment's published trials, so
 //! that every figure the document states comes from the trials (or is
 //! checked against them).
 //!
