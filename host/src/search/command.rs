@@ -602,6 +602,55 @@ mod tests {
     }
 
     #[test]
+    fn a_search_resumed_after_its_first_generation_ends_as_an_unbroken_one() {
+        let unbroken = small(2, Start::Random);
+        let settings = small_settings(2, Start::Random);
+        let flags = TrainFlags::parse([
+            "--sensors",
+            "robot",
+            "--noise",
+            "1",
+            "--seed",
+            "3",
+            "--distil-oc",
+            "20000",
+        ])
+        .unwrap();
+        let request = SearchRequest {
+            config: None,
+            flags,
+            search: settings.clone(),
+        };
+        let (config, scorer) = scorer(&request).unwrap();
+        let (start, _) = start_table(&config, &settings.start).unwrap();
+        let mut new = Vec::new();
+        let resumed = run_from(
+            &config,
+            &settings,
+            &scorer,
+            start.clone(),
+            0,
+            &unbroken.generations[..1],
+            &mut |g| {
+                new.push(g.generation);
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(new, [1, 2], "only the generations not run before");
+        assert_eq!(resumed, unbroken);
+        // a generation of other settings is not resumed from
+        let mut other = unbroken.generations[0].clone();
+        other.fitness_seeds[0] ^= 2;
+        let e = run_from(&config, &settings, &scorer, start, 0, &[other], &mut |_| {
+            Ok(())
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("generation 0 of the earlier run"), "{e}");
+    }
+
+    #[test]
     fn the_result_never_forms_fewer_than_the_start_on_the_validation_worlds() {
         for start in [Start::Orbital, Start::Random] {
             let log = small(2, start);
