@@ -35,7 +35,7 @@ use crate::zumo::Zumo;
 use anyhow::{bail, Context, Result};
 use host::robot::replay::decisions::DecisionCheck;
 use host::run_summary::RunSummary;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use shared::{LogFrame, MotorCommand, PolicyBlob, RobotProfile, Role, RunMode, State};
 use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::scenario::Scenario;
@@ -485,7 +485,7 @@ impl<'p> InTheLoop<'p> {
             for frame in frames {
                 let f = frame.map_err(|e| anyhow::anyhow!("robot {}: a log frame: {e}", r.id))?;
                 if let Some(recorded) = &mut self.recorded {
-                    recorded.push((r.id, f.clone()));
+                    recorded.push((r.id, f));
                 }
                 let consistent = r.check.frame(0, &f).stages.is_empty();
                 while r.pending.front().is_some_and(|p| p.0 < f.tick) {
@@ -501,6 +501,161 @@ impl<'p> InTheLoop<'p> {
         }
         Ok(())
     }
+}
+
+/// One published run (an element of `docs/in-the-loop-runs.json`'s
+/// array): the settings it ran with (`field`, `policy`, `seed`; the others
+/// are ignored here) and what `in-the-loop --json --compare` printed.
+#[derive(Clone, Debug, Deserialize)]
+pub struct PublishedRun {
+    /// `--field`.
+    pub field: String,
+    /// `--policy`.
+    pub policy: String,
+    /// `--seed`.
+    pub seed: u64,
+    /// Steps run.
+    pub steps: u64,
+    /// Formations in the loop.
+    pub formations: u64,
+    /// Periods played.
+    pub periods: u64,
+    /// Periods whose turn came from the pins.
+    pub periods_from_pins: u64,
+    /// Share of consistent decisions.
+    pub decisions_consistent: f64,
+    /// Share of states agreeing with the model's.
+    pub state_agreement: f64,
+    /// Wall-clock speed.
+    pub periods_per_second: f64,
+    /// CPU cycles simulated.
+    pub avr_cycles: u64,
+    /// CPU cycles fast-forwarded (absent: none).
+    #[serde(default)]
+    pub cycles_skipped: u64,
+    /// Where a period's cycles went.
+    pub cycles: CyclesOfRun,
+    /// `host run`'s summary of the same steps and seed (`None`: run
+    /// without `--compare`).
+    pub simulator: Option<SimulatorRun>,
+}
+
+/// A published run's [`CycleBudget`] (`waiting_skipped` absent: 0).
+#[derive(Clone, Debug, Deserialize)]
+pub struct CyclesOfRun {
+    /// Cycles of a period.
+    pub period: f64,
+    /// Sensing.
+    pub sensing: f64,
+    /// Deciding.
+    pub decision: f64,
+    /// Logging.
+    pub logging: f64,
+    /// Waiting.
+    pub waiting: f64,
+    /// Of the waiting, fast-forwarded.
+    #[serde(default)]
+    pub waiting_skipped: f64,
+}
+
+/// The part of `host run`'s summary a published run's table shows.
+#[derive(Clone, Debug, Deserialize)]
+pub struct SimulatorRun {
+    /// Formations.
+    pub formations: u64,
+}
+
+/// The tables `docs/in-the-loop.md` shows of the published runs (the
+/// JSON array of [`PublishedRun`]): each run's formations, checks and
+/// speed, a sum row per policy and field, then each run's cycles.
+pub fn runs_tables(json: &str) -> Result<String> {
+    let runs: Vec<PublishedRun> =
+        serde_json::from_str(json).context("the published runs are not a JSON array of runs")?;
+    let k = crate::figures::thousands;
+    let stem = |p: &str| {
+        Path::new(p)
+            .file_stem()
+            .map_or(p.to_string(), |s| s.to_string_lossy().into_owned())
+    };
+    let mut out = vec![
+        "| policy | field | seed | steps | formations (loop) | formations (`host run`) | decisions consistent | state agreement | periods from the pins | periods per second |".to_string(),
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |".to_string(),
+    ];
+    // Per policy and field: runs, steps, formations in the loop and in
+    // `host run` (`None` once a run was not compared).
+    let mut groups: Vec<(String, String, u64, u64, u64, Option<u64>)> = Vec::new();
+    for r in &runs {
+        let host = r.simulator.as_ref().map(|s| s.formations);
+        out.push(format!(
+            "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {} of {} | {:.0} |",
+            stem(&r.policy),
+            r.field,
+            r.seed,
+            k(r.steps),
+            r.formations,
+            host.map_or(String::new(), |f| f.to_string()),
+            r.decisions_consistent,
+            r.state_agreement,
+            k(r.periods_from_pins),
+            k(r.periods),
+            r.periods_per_second
+        ));
+        let key = (stem(&r.policy), r.field.clone());
+        let i = match groups.iter().position(|g| (&g.0, &g.1) == (&key.0, &key.1)) {
+            Some(i) => i,
+            None => {
+                groups.push((key.0, key.1, 0, 0, 0, Some(0)));
+                groups.len() - 1
+            }
+        };
+        let g = &mut groups[i];
+        g.2 += 1;
+        g.3 += r.steps;
+        g.4 += r.formations;
+        g.5 = g.5.zip(host).map(|(a, b)| a + b);
+    }
+    for (policy, field, runs, steps, loop_formations, host_formations) in groups {
+        let (host, ratio) = match host_formations {
+            Some(h) => (
+                h.to_string(),
+                format!("ratio {:.2}", loop_formations as f64 / h.max(1) as f64),
+            ),
+            None => (String::new(), String::new()),
+        };
+        let runs = if runs == 1 {
+            "1 run".to_string()
+        } else {
+            format!("{runs} runs")
+        };
+        out.push(format!(
+            "| {policy} | {field}: sum | {runs} | {} | {loop_formations} | {host} | | | | {ratio} |",
+            k(steps)
+        ));
+    }
+    out.push(String::new());
+    out.push("| policy | field | seed | AVR cycles | fast-forwarded | period | sensing | deciding | logging | waiting | of it fast-forwarded |".to_string());
+    out.push(
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |".to_string(),
+    );
+    for r in &runs {
+        let c = &r.cycles;
+        let n = |x: f64| k(x.round() as u64);
+        out.push(format!(
+            "| {} | {} | {} | {} | {:.0} % | {} | {} | {} | {} | {} | {} |",
+            stem(&r.policy),
+            r.field,
+            r.seed,
+            k(r.avr_cycles),
+            100.0 * r.cycles_skipped as f64 / r.avr_cycles.max(1) as f64,
+            n(c.period),
+            n(c.sensing),
+            n(c.decision),
+            n(c.logging),
+            n(c.waiting),
+            n(c.waiting_skipped)
+        ));
+    }
+    Ok(out.join("\n"))
 }
 
 /// Counts one played period's frame.

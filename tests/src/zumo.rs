@@ -961,7 +961,7 @@ impl Zumo {
             {
                 self.skip_wait();
             }
-            self.tester.run();
+            self.step();
             // SAFETY: as above.
             assert!(
                 unsafe { (*self.state.avr).cycle } < deadline,
@@ -969,6 +969,24 @@ impl Zumo {
             );
         }
         self.state.decisions
+    }
+
+    /// Runs one instruction, then the cycle timers and interrupts due, with
+    /// simavr's own stepping: what `AvrTester::run` does, without its
+    /// per-instruction bookkeeping (UART flushes and async components,
+    /// none of which a `Zumo` uses). Panics if the core stops running
+    /// (crashed, or asleep: nothing here wakes it).
+    fn step(&mut self) {
+        let avr = self.state.avr;
+        // SAFETY: the core is live; simavr steps it on this thread.
+        let state = unsafe {
+            ffi::avr_run(avr);
+            (*avr).state
+        };
+        assert!(
+            state == ffi::cpu_Running as c_int,
+            "the AVR stopped running (simavr state {state}: crashed or asleep)"
+        );
     }
 
     /// Makes [`Zumo::run_to_decision`] fast-forward the firmware's busy
@@ -1020,7 +1038,7 @@ impl Zumo {
             snapshot.extend_from_slice(self.data_space());
             let mut n = 0;
             loop {
-                self.tester.run();
+                self.step();
                 n += 1;
                 // SAFETY: as above.
                 let back = unsafe { (*avr).pc } == pc;
@@ -1044,7 +1062,7 @@ impl Zumo {
             if !idle {
                 // Another instruction to start from: a register holding a
                 // dead value may differ at this one.
-                self.tester.run();
+                self.step();
                 continue;
             }
             // SAFETY: the core is live; the pool's head is its earliest timer.

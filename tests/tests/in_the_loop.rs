@@ -238,3 +238,26 @@ fn skipping_the_busy_wait_changes_no_frame_counter_or_world() {
     assert_eq!(skipped.cycles.sensing, simulated.cycles.sensing);
     assert_eq!(skipped.cycles.logging, simulated.cycles.logging);
 }
+
+#[test]
+fn the_docs_tables_of_the_runs_are_the_ones_the_runs_json_gives() {
+    let root = tests::figures::workspace();
+    let json = std::fs::read_to_string(root.join("docs/in-the-loop-runs.json")).unwrap();
+    let tables = tests::in_the_loop::runs_tables(&json).unwrap();
+    let doc = std::fs::read_to_string(root.join("docs/in-the-loop.md")).unwrap();
+    let (begin, end) = (RUNS_BEGIN, "<!-- in-the-loop-runs end -->");
+    let section = doc
+        .split_once(begin)
+        .and_then(|(_, rest)| rest.split_once(end))
+        .map(|(section, _)| section.trim())
+        .expect("docs/in-the-loop.md marks the runs' tables");
+    assert!(
+        section == tables,
+        "docs/in-the-loop.md's tables differ from docs/in-the-loop-runs.json's runs; between the \
+         markers it must read:\n{tables}"
+    );
+}
+
+/// The line before the runs' tables in `docs/in-the-loop.md`.
+const RUNS_BEGIN: &str = "<!-- in-the-loop-runs begin: generated from docs/in-the-loop-runs.json \
+                          by tests::in_the_loop::runs_tables (the test prints them); do not edit -->";
