@@ -567,7 +567,8 @@ pub struct SimulatorRun {
 
 /// The tables `docs/in-the-loop.md` shows of the published runs (the
 /// JSON array of [`PublishedRun`]): each run's formations, checks and
-/// speed, a sum row per policy and field, then each run's cycles.
+/// speed, a sum row per policy and field of more than one run, then each
+/// run's cycles.
 pub fn runs_tables(json: &str) -> Result<String> {
     let runs: Vec<PublishedRun> =
         serde_json::from_str(json).context("the published runs are not a JSON array of runs")?;
@@ -614,7 +615,8 @@ pub fn runs_tables(json: &str) -> Result<String> {
         g.4 += r.formations;
         g.5 = g.5.zip(host).map(|(a, b)| a + b);
     }
-    for (policy, field, runs, steps, loop_formations, host_formations) in groups {
+    let summed = groups.into_iter().filter(|g| g.2 > 1);
+    for (policy, field, runs, steps, loop_formations, host_formations) in summed {
         let (host, ratio) = match host_formations {
             Some(h) => (
                 h.to_string(),
@@ -622,13 +624,8 @@ pub fn runs_tables(json: &str) -> Result<String> {
             ),
             None => (String::new(), String::new()),
         };
-        let runs = if runs == 1 {
-            "1 run".to_string()
-        } else {
-            format!("{runs} runs")
-        };
         out.push(format!(
-            "| {policy} | {field}: sum | {runs} | {} | {loop_formations} | {host} | | | | {ratio} |",
+            "| {policy} | {field}: sum | {runs} runs | {} | {loop_formations} | {host} | | | | {ratio} |",
             k(steps)
         ));
     }
