@@ -4,7 +4,6 @@
 //! and no script to edit.
 
 use assert_cmd::Command;
-use std::path::Path;
 
 fn host() -> Command {
     Command::cargo_bin("host").unwrap()
@@ -98,25 +97,4 @@ fn a_new_experiment_file_runs_at_a_tiny_scale_and_renders_its_page() {
     let stale = report(&["--check"]);
     assert!(!stale.status.success());
     assert!(String::from_utf8_lossy(&stale.stderr).contains("tiny.md"));
-}
-
-#[test]
-fn every_file_in_experiments_is_built_in_and_names_its_page() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../experiments");
-    let mut stems: Vec<String> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
-        .collect();
-    stems.sort();
-    let built_in: Vec<&str> = host::experiment::spec::BUILT_IN
-        .iter()
-        .map(|(n, _)| *n)
-        .collect();
-    assert_eq!(stems, built_in);
-    for (name, text) in host::experiment::spec::BUILT_IN {
-        let page = text.lines().any(|l| l.starts_with("page = "));
-        assert!(page, "experiments/{name}.toml names no page");
-    }
 }
