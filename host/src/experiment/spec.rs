@@ -4,7 +4,14 @@
 //! An arm is a [`TrainConfig`]: the file's `[defaults]` table with the
 //! arm's own keys merged over it (nested tables such as `learn` key by
 //! key), plus the arm-only keys `name`, `row`, `column`, `controller`,
-//! `pretrain` and `thesis`. See docs/training.md for the format.
+//! `pretrain`, `policy`, `thesis`, `author` and `pucks_reason`. On a screen
+//! arena an arm's puck count is the puck rule's
+//! ([`sim::scenario::puck_rule`]) unless it sets `pucks` and
+//! `pucks_reason`. The file's `page` names the results page of its
+//! published trials and `trials` the trials per arm of a run that does not
+//! say. The built-in experiments are the `*.toml` files directly in
+//! `experiments/` ([`BUILT_IN`], listed by `host/build.rs`). See
+//! docs/training.md for the format.
 
 use super::metric::Metric;
 use crate::train::TrainConfig;
