@@ -292,7 +292,9 @@ fn recompute(expr: &str, sources: &[Source]) -> Option<String> {
 fn every_verdict_on_the_page_follows_the_one_rule() {
     std::env::set_current_dir(root()).unwrap();
     let docs = Path::new("docs");
-    let document = documents(&["reproduction".to_string()], None).unwrap().remove(0);
+    let document = documents(&["reproduction".to_string()], None)
+        .unwrap()
+        .remove(0);
     let sources = document.sources(docs, 1.0, &|_| {}).unwrap();
     let side = SideBySide::load(&docs.join("reproduction/side-by-side")).unwrap();
     // each page's template and the page: the index, then each experiment's

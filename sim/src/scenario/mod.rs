@@ -9,9 +9,9 @@ pub mod arena_choice;
 pub mod choices;
 pub mod flat_field;
 pub mod panel;
+pub mod puck_rule;
 pub mod sensor_choice;
 pub mod sensor_setup;
-pub mod puck_rule;
 pub mod trained_for;
 
 use crate::base::ranges;
