@@ -11,23 +11,34 @@ fn host() -> Command {
 /// steps in `dir`, writing `s/NAME.policy`; `args` adds the world's flags.
 /// Returns what it printed.
 fn tiny_search(dir: &std::path::Path, args: &[&str], steps: &str, name: &str) -> String {
-    let out = host()
-        .current_dir(dir)
-        .arg("search")
-        .args(args)
-        .args(["--start", "random", "--generations", "1"])
-        .args(["--population", "2", "--elites", "1"])
-        .args(["--fitness-seeds", "1", "--fitness-steps", steps])
-        .args(["--validation-seeds", "1", "--validation-steps", steps])
-        .args(["--out", "s", "--name", name])
-        .output()
-        .unwrap();
+    let out = tiny_search_of(dir, args, steps, name, "1");
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
+}
+
+/// [`tiny_search`] of `generations` generations, whatever its outcome.
+fn tiny_search_of(
+    dir: &std::path::Path,
+    args: &[&str],
+    steps: &str,
+    name: &str,
+    generations: &str,
+) -> std::process::Output {
+    host()
+        .current_dir(dir)
+        .arg("search")
+        .args(args)
+        .args(["--start", "random", "--generations", generations])
+        .args(["--population", "2", "--elites", "1"])
+        .args(["--fitness-seeds", "1", "--fitness-steps", steps])
+        .args(["--validation-seeds", "1", "--validation-steps", steps])
+        .args(["--out", "s", "--name", name])
+        .output()
+        .unwrap()
 }
 
 #[test]
@@ -171,21 +182,8 @@ fn the_search_help_shows_the_world_and_the_search_and_none_of_the_learners_setti
 fn a_search_without_world_flags_is_the_robots_on_the_tv_at_the_default_noise_and_prints_a_line_per_generation(
 ) {
     let dir = tempfile::tempdir().unwrap();
-    let out = host()
-        .current_dir(dir.path())
-        .arg("search")
-        .args(["--start", "random", "--generations", "2"])
-        .args(["--population", "2", "--elites", "1"])
-        .args(["--fitness-seeds", "1", "--fitness-steps", "300"])
-        .args(["--validation-seeds", "1", "--validation-steps", "300"])
-        .args(["--out", "s", "--name", "plain"])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = tiny_search_of(dir.path(), &[], "300", "plain", "2");
+    assert!(out.status.success());
     let log: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.path().join("s/plain.search.json")).unwrap())
             .unwrap();

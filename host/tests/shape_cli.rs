@@ -55,16 +55,18 @@ fn tiny_run() -> &'static (tempfile::TempDir, PathBuf) {
                 "--generations",
                 "2",
                 "--scale",
-                "0.08",
+                "0.05",
             ],
         );
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        succeeded(&out);
         (dir, PathBuf::from("o"))
     })
+}
+
+/// Fails with the command's stderr unless it succeeded.
+fn succeeded(out: &std::process::Output) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -98,11 +100,7 @@ fn a_shape_drawn_dark_on_light_is_refused_naming_invert_and_runs_with_invert() {
             "0.01",
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeded(&out);
     // the inverted image is the light-on-dark one, to within rounding
     let inverted = image::open(dir.path().join("o/dark.field.png"))
         .unwrap()
@@ -143,11 +141,7 @@ fn a_tiny_run_writes_a_blob_flash_accepts_and_a_report_whose_result_host_run_rep
         .arg(dir.join(out).join("ell.policy"))
         .output()
         .unwrap();
-    assert!(
-        flash.status.success(),
-        "{}",
-        String::from_utf8_lossy(&flash.stderr)
-    );
+    succeeded(&flash);
     let report = json(&dir.join(out).join("ell.report.json"));
     for key in ["pucks", "hasher", "seeds", "steps", "minutes"] {
         assert!(!report[key].is_null(), "{key} missing: {report}");
@@ -182,11 +176,7 @@ fn a_tiny_run_writes_a_blob_flash_accepts_and_a_report_whose_result_host_run_rep
             .args(["--controller", "policy:o/ell.policy", "--json"])
             .output()
             .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+        succeeded(&run);
         let summary: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
         total += summary["formations"].as_u64().unwrap();
     }
@@ -226,7 +216,7 @@ fn a_run_killed_mid_search_and_run_again_ends_with_the_table_of_an_unbroken_run(
         "--generations",
         "4",
         "--scale",
-        "0.05",
+        "0.02",
     ];
     let unbroken = tempfile::tempdir().unwrap();
     draw(&unbroken.path().join("ell.png"), &L_SHAPE, false);

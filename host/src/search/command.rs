@@ -497,9 +497,9 @@ mod tests {
         }
     }
 
-    /// [`small`], also scored on `also_field`.
-    fn small_over(threads: usize, start: Start, also_field: Vec<FieldSource>) -> SearchLog {
-        let flags = TrainFlags::parse([
+    /// The small search's world: the robot's senses and noise on the TV.
+    fn small_flags() -> TrainFlags {
+        TrainFlags::parse([
             "--sensors",
             "robot",
             "--noise",
@@ -509,7 +509,12 @@ mod tests {
             "--distil-oc",
             "20000",
         ])
-        .unwrap();
+        .unwrap()
+    }
+
+    /// [`small`], also scored on `also_field`.
+    fn small_over(threads: usize, start: Start, also_field: Vec<FieldSource>) -> SearchLog {
+        let flags = small_flags();
         let request = SearchRequest {
             config: None,
             flags,
@@ -605,20 +610,9 @@ mod tests {
     fn a_search_resumed_after_its_first_generation_ends_as_an_unbroken_one() {
         let unbroken = small(2, Start::Random);
         let settings = small_settings(2, Start::Random);
-        let flags = TrainFlags::parse([
-            "--sensors",
-            "robot",
-            "--noise",
-            "1",
-            "--seed",
-            "3",
-            "--distil-oc",
-            "20000",
-        ])
-        .unwrap();
         let request = SearchRequest {
             config: None,
-            flags,
+            flags: small_flags(),
             search: settings.clone(),
         };
         let (config, scorer) = scorer(&request).unwrap();
