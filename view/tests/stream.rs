@@ -102,10 +102,8 @@ fn a_shipped_policy_file_drives_the_robots_after_a_settings_change() {
 
 #[test]
 fn a_viewer_that_stops_reading_is_dropped_and_the_others_go_on() {
-    let settings = view::ViewSettings {
-        pucks: Some(600),
-        ..small(4)
-    };
+    let mut settings = small(4);
+    settings.world.pucks = Some(600);
     let address = serve(settings, false, Speed::Max);
     let idle = viewer(address);
     let mut reader = viewer(address);

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use shared::blob::name_prefix;
 use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
-use sim::scenario::choices::ScenarioChoices;
+use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
@@ -260,7 +260,7 @@ impl TrainConfig {
 
     /// The arena the run uses.
     pub fn arena_choice(&self) -> ArenaChoice {
-        self.choices().arena_choice()
+        self.world().arena_choice()
     }
 
     /// The sensor model and arena the run trains for, as its policy blob
@@ -278,8 +278,15 @@ impl TrainConfig {
     /// The world's settings by name, the controller random.
     pub fn choices(&self) -> ScenarioChoices {
         ScenarioChoices {
-            field: self.field.clone(),
             controller: ControllerChoice::Random,
+            world: self.world(),
+        }
+    }
+
+    /// The world's settings by name.
+    pub fn world(&self) -> WorldChoices {
+        WorldChoices {
+            field: self.field.clone(),
             sensors: self.sensors.clone(),
             arena: self.arena.clone(),
             robots: self.robots,

@@ -1,6 +1,7 @@
 //! The world's settings as a user names them (`--field`, `--sensors`,
 //! `--arena`, `--robots`, `--pucks`, `--seed`, `--noise`, `--walls`): what
-//! `host run`, training and the live view (`view`) turn into a [`Scenario`].
+//! `host run`, training and the live view (`view`) turn into a [`Scenario`]:
+//! [`WorldChoices`], with a controller [`ScenarioChoices`].
 
 use crate::config::{BroadPhase, Walls};
 use crate::fields::source::FieldSource;
@@ -8,13 +9,13 @@ use crate::scenario::arena_choice::ArenaChoice;
 use crate::scenario::sensor_choice::SensorChoice;
 use crate::scenario::{ControllerChoice, Scenario, ScenarioError};
 
-/// A world's settings by name; `None` takes the arena's own.
+/// A world's settings by name; `None` takes the arena's own. The settings
+/// every front end shares (the training config, `host run`, the live view),
+/// kept in one struct so that each hands it on whole.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ScenarioChoices {
+pub struct WorldChoices {
     /// The field.
     pub field: FieldSource,
-    /// The controller.
-    pub controller: ControllerChoice,
     /// The sensor model.
     pub sensors: SensorChoice,
     /// The arena; `None` for [`ArenaChoice::default_for`] the sensor model.
@@ -31,13 +32,12 @@ pub struct ScenarioChoices {
     pub walls: Option<Walls>,
 }
 
-impl Default for ScenarioChoices {
+impl Default for WorldChoices {
     /// [`Scenario::default`]'s: the thesis' standard run.
-    fn default() -> ScenarioChoices {
+    fn default() -> WorldChoices {
         let s = Scenario::default();
-        ScenarioChoices {
+        WorldChoices {
             field: s.field,
-            controller: s.controller,
             sensors: SensorChoice::default(),
             arena: None,
             robots: s.robots,
@@ -49,28 +49,40 @@ impl Default for ScenarioChoices {
     }
 }
 
-impl ScenarioChoices {
+impl WorldChoices {
     /// The arena named, or the sensor model's default.
     pub fn arena_choice(&self) -> ArenaChoice {
         self.arena
             .clone()
             .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
     }
+}
 
+/// A world's settings and its controller by name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScenarioChoices {
+    /// The controller.
+    pub controller: ControllerChoice,
+    /// The world.
+    pub world: WorldChoices,
+}
+
+impl ScenarioChoices {
     /// The scenario, arena and sensor files read and checked (the counts,
     /// noise and settings are checked when it is prepared or built).
     pub fn scenario(&self) -> Result<Scenario, ScenarioError> {
+        let w = &self.world;
         Ok(Scenario {
-            field: self.field.clone(),
+            field: w.field.clone(),
             controller: self.controller.clone(),
-            robots: self.robots,
-            pucks: self.pucks,
-            seed: self.seed,
+            robots: w.robots,
+            pucks: w.pucks,
+            seed: w.seed,
             broad_phase: BroadPhase::Grid,
-            arena: self.arena_choice().arena()?,
-            sensors: self.sensors.setup()?,
-            noise: self.noise,
-            walls: self.walls,
+            arena: w.arena_choice().arena()?,
+            sensors: w.sensors.setup()?,
+            noise: w.noise,
+            walls: w.walls,
         })
     }
 }
