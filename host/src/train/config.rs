@@ -4,7 +4,7 @@
 //! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::learn::{LearnConfig, LearnerRules, MAX_N_STEP};
+use crate::learn::{LearnConfig, MAX_N_STEP};
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
@@ -119,9 +119,6 @@ pub struct TrainConfig {
     /// on a screen].
     #[arg(long)]
     pub walls: Option<Walls>,
-    /// The learner's rules (docs/training.md, "Learner rules and the border").
-    #[command(flatten)]
-    pub rules: LearnerRules,
     /// Decaying exploration: the exploration probability falls linearly
     /// from --epsilon at step 0 to 0 at this step (in steps of
     /// 1,000) and stays 0 [default: none, --epsilon throughout].
@@ -225,7 +222,6 @@ impl Default for TrainConfig {
             select: None,
             distil_oc: None,
             walls: None,
-            rules: LearnerRules::default(),
             epsilon_decay: None,
             n_step: None,
         }
@@ -387,7 +383,6 @@ impl TrainConfig {
             ranges::DISC_RADIUS.check_as("obstacle_discs.radius", discs.radius)?;
         }
         self.learn.validate()?;
-        self.rules.validate()?;
         ranges::INITIAL_Q.check(self.learn.initial_q)?;
         for a in &self.learn.actions {
             ranges::ANGULAR_SPEED.check(f64::from(*a))?;

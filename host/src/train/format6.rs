@@ -10,10 +10,10 @@
 //! unchanged (the two formats differ only in the rewards format 5's
 //! readers know).
 
-use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig};
+use super::format7::{LearnConfigV7, LearnerRules, QLearnerV7, StateV7, TrainConfigV7};
 use super::selection::{SelectConfig, Selected};
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
+use crate::learn::PendingSteps;
 use serde::{Deserialize, Serialize};
 use sim::config::{SuccessSignal, Walls};
 use sim::fields::source::FieldSource;
@@ -27,11 +27,11 @@ pub struct StateV6 {
     config: TrainConfigV6,
     field_crc: u32,
     sim: SimulationState,
-    learner: QLearner,
+    learner: QLearnerV7,
     selected: Option<Selected>,
 }
 
-/// A [`TrainConfig`] without `n_step`.
+/// A [`TrainConfigV7`] without `n_step`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV6 {
     field: FieldSource,
@@ -43,7 +43,7 @@ pub struct TrainConfigV6 {
     steps: u64,
     seed: u64,
     stuck_limit: Option<u64>,
-    learn: LearnConfig,
+    learn: LearnConfigV7,
     output: OutputConfig,
     formation_check: FormationCheck,
     success: SuccessSignal,
@@ -58,7 +58,7 @@ pub struct TrainConfigV6 {
 
 impl TrainConfigV6 {
     /// The settings in this layout, if the run's returns are one-step.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV6> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV6> {
         c.n_step.is_none().then(|| TrainConfigV6 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),
@@ -84,10 +84,10 @@ impl TrainConfigV6 {
     }
 }
 
-impl From<TrainConfigV6> for TrainConfig {
+impl From<TrainConfigV6> for TrainConfigV7 {
     /// The settings, returns one-step.
-    fn from(c: TrainConfigV6) -> TrainConfig {
-        TrainConfig {
+    fn from(c: TrainConfigV6) -> TrainConfigV7 {
+        TrainConfigV7 {
             field: c.field,
             sensors: c.sensors,
             arena: c.arena,
@@ -116,7 +116,7 @@ impl From<TrainConfigV6> for TrainConfig {
 impl StateV6 {
     /// The state in this layout, if its returns are one-step (so no robot
     /// has a step waiting).
-    pub fn of(state: &TrainingState) -> Option<StateV6> {
+    pub fn of(state: &StateV7) -> Option<StateV6> {
         if !state.pending.is_empty() {
             return None;
         }
@@ -130,8 +130,8 @@ impl StateV6 {
     }
 
     /// The state, its returns one-step.
-    pub fn into_state(self) -> TrainingState {
-        TrainingState {
+    pub fn into_v7(self) -> StateV7 {
+        StateV7 {
             config: self.config.into(),
             field_crc: self.field_crc,
             sim: self.sim,
