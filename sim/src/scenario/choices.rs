@@ -8,11 +8,13 @@ use crate::fields::source::FieldSource;
 use crate::scenario::arena_choice::ArenaChoice;
 use crate::scenario::sensor_choice::SensorChoice;
 use crate::scenario::{ControllerChoice, Scenario, ScenarioError};
+use serde::Serialize;
 
 /// A world's settings by name; `None` takes the arena's own. The settings
 /// every front end shares (the training config, `host run`, the live view),
-/// kept in one struct so that each hands it on whole.
-#[derive(Clone, Debug, PartialEq)]
+/// kept in one struct so that each hands it on whole. Serialised, its
+/// fields are the settings' names (a test checks each front end by them).
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WorldChoices {
     /// The field.
     pub field: FieldSource,
