@@ -5,15 +5,15 @@
 //! flags of `host train`. The world's settings are the fields of
 //! `WorldChoices`, which the training config, `host run` and the live view
 //! hand on whole to the scenario. These tests find every setting in each
-//! front end (the flags, the file keys, the checkpoint's fields, the table
-//! of ranges, the view's URL parameters and page controls, Python's
-//! keyword arguments) and fail on a missing or an extra one; the settings
-//! a front end does not offer are listed here, each with why.
+//! front end (the flags, the file keys, the checkpoint's fields, the view's
+//! URL parameters and page controls, Python's keyword arguments) and fail
+//! on a missing or an extra one; the settings a front end does not offer
+//! are listed here, each with why. (Every numeric flag has its row in the
+//! table of ranges: `host/src/cli/flag_ranges.rs` checks that.)
 
 use clap::Args;
 use host::train::{checkpoint, TrainConfig, TrainFlags, Trainer};
 use serde_json::Value;
-use sim::base::ranges;
 use sim::scenario::choices::WorldChoices;
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -29,12 +29,7 @@ const RENAMED_FLAGS: [(&str, &str); 5] = [
 
 /// Settings of files only, no flag: a list, and the settings of the thesis
 /// author's runs, which experiment files set.
-const FILE_ONLY: [&str; 3] = ["learn.actions", "success", "obstacle_discs"];
-
-/// Numeric settings without a row in the table of ranges: any value is a
-/// run (a seed, a name), or the setting is checked against the rules
-/// between settings instead (a probability in [0, 1]).
-const NO_RANGE_ROW: [&str; 4] = ["seed", "learn.alpha", "learn.gamma", "learn.epsilon"];
+const FILE_ONLY: [&str; 3] = ["learn.actions", "obstacle_discs", "success"];
 
 /// World settings the live view does not offer: the border keeps the one
 /// the server was started with.
@@ -153,46 +148,6 @@ fn every_training_setting_is_a_file_key_a_flag_and_a_field_of_the_checkpoint() {
     assert_eq!(
         recorded, file,
         "the checkpoint records the settings by name"
-    );
-}
-
-#[test]
-fn every_numeric_training_setting_has_a_row_in_the_table_of_ranges() {
-    let rows: BTreeSet<&str> = ranges::SECTIONS
-        .iter()
-        .flat_map(|(_, rows)| rows.iter().flat_map(|r| r.keys.iter().copied()))
-        .collect();
-    let command = TrainFlags::augment_args(clap::Command::new("train"));
-    let numeric = |id: &str| {
-        let parser = command
-            .get_arguments()
-            .find(|a| a.get_id() == id)
-            .unwrap()
-            .get_value_parser()
-            .type_id();
-        let of = |p: clap::builder::ValueParser| p.type_id();
-        [
-            of(clap::value_parser!(u64).into()),
-            of(clap::value_parser!(u32).into()),
-            of(clap::value_parser!(usize).into()),
-            of(clap::value_parser!(f64).into()),
-        ]
-        .contains(&parser)
-    };
-    let mut without = Vec::new();
-    for (id, key) in flags() {
-        let last = key.rsplit('.').next().unwrap();
-        let named = [key.as_str(), last, &format!("--{}", id.replace('_', "-"))]
-            .iter()
-            .any(|k| rows.contains(k));
-        let select = key == "select" && rows.contains(format!("select.{}", &id[7..]).as_str());
-        if numeric(&id) && !named && !select && !NO_RANGE_ROW.contains(&key.as_str()) {
-            without.push(key);
-        }
-    }
-    assert!(
-        without.is_empty(),
-        "numeric settings without a row in sim::base::ranges: {without:?}"
     );
 }
 

@@ -48,11 +48,17 @@ fn resumes_exactly(config: TrainConfig, first: u64, steps: u64) -> u16 {
     drop(head);
     for bytes in [current, earlier].iter().filter(|b| !b.is_empty()) {
         let state = checkpoint::decode(bytes).unwrap();
-        assert_eq!(
-            state.config, config,
-            "the checkpoint of format {} keeps the run's settings",
-            bytes[8]
-        );
+        if u16::from(bytes[8]) == checkpoint::VERSION {
+            assert_eq!(state.config, config, "the checkpoint keeps the settings");
+        } else {
+            // an earlier format may name a default (the arena) outright
+            assert_eq!(
+                state.config.scenario().unwrap(),
+                config.scenario().unwrap(),
+                "the checkpoint of format {} keeps the run's settings",
+                bytes[8]
+            );
+        }
         let mut resumed = Trainer::restart(state).unwrap();
         resumed.run(steps - first);
         assert_eq!(resumed.learner().table(), straight.learner().table());
@@ -299,7 +305,7 @@ fn n_step_returns_are_the_same_per_seed_resume_exactly_with_steps_waiting_and_ch
     }
     let mut bad = n_step(Some(65), host::learn::Updates::Sequential);
     let e = Trainer::start(bad.clone(), None).err().unwrap().to_string();
-    assert!(e.contains("n_step = 65") && e.contains("1 to 64"), "{e}");
+    assert!(e.contains("n_step = 65") && e.contains("[1, 64]"), "{e}");
     bad.n_step = Some(0);
     assert!(Trainer::start(bad, None).is_err());
 }
@@ -404,17 +410,23 @@ fn edited_checkpoint(state: &TrainingState, edit: impl FnOnce(&mut ciborium::Val
     framed
 }
 
+/// The field `key` of a struct's map in CBOR.
+fn field<'a>(value: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
+    let (_, inner) = value
+        .as_map_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|(k, _)| k.as_text() == Some(key))
+        .unwrap();
+    inner
+}
+
 /// The map entries of `value`'s field `key` (a struct's map in CBOR).
 fn entries<'a>(
     value: &'a mut ciborium::Value,
     key: &str,
 ) -> &'a mut Vec<(ciborium::Value, ciborium::Value)> {
-    let map = value.as_map_mut().unwrap();
-    let (_, inner) = map
-        .iter_mut()
-        .find(|(k, _)| k.as_text() == Some(key))
-        .unwrap();
-    inner.as_map_mut().unwrap()
+    field(value, key).as_map_mut().unwrap()
 }
 
 #[test]
@@ -431,16 +443,12 @@ fn a_setting_a_checkpoint_lacks_takes_its_default() {
     let mut t = trainer(config.clone());
     t.run(200);
     let bytes = edited_checkpoint(&t.state(), |body| {
-        let settings = entries(body, "config");
-        settings.retain(|(k, _)| !matches!(k.as_text(), Some("n_step" | "epsilon_decay")));
-        let (_, learn) = settings
-            .iter_mut()
-            .find(|(k, _)| k.as_text() == Some("learn"))
-            .unwrap();
-        learn
+        let settings = field(body, "config");
+        entries(settings, "learn").retain(|(k, _)| k.as_text() != Some("tie_tolerance"));
+        settings
             .as_map_mut()
             .unwrap()
-            .retain(|(k, _)| k.as_text() != Some("tie_tolerance"));
+            .retain(|(k, _)| !matches!(k.as_text(), Some("n_step" | "epsilon_decay")));
     });
     let state = checkpoint::decode(&bytes).unwrap();
     assert_eq!(
@@ -480,18 +488,13 @@ fn a_checkpoint_with_an_unknown_or_mistyped_setting_is_refused_naming_the_file_a
         "{e}"
     );
     let mistyped = edited_checkpoint(&t.state(), |body| {
-        let settings = entries(body, "config");
-        let (_, steps) = settings
-            .iter_mut()
-            .find(|(k, _)| k.as_text() == Some("steps"))
-            .unwrap();
-        *steps = "many".into();
+        *field(field(body, "config"), "steps") = "many".into();
     });
     let path = dir.path().join("mistyped.ckpt");
     std::fs::write(&path, mistyped).unwrap();
     let e = format!("{:#}", checkpoint::load(&path).unwrap_err());
     assert!(
-        e.contains("mistyped.ckpt") && e.contains("does not decode") && e.contains("many"),
+        e.contains("mistyped.ckpt") && e.contains("setting steps: invalid type"),
         "{e}"
     );
 }

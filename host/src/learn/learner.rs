@@ -140,9 +140,7 @@ impl LearnConfig {
             ("learn.gamma", self.gamma),
             ("learn.epsilon", self.epsilon),
         ] {
-            if !(0.0..=1.0).contains(&value) {
-                bail!("{name} = {value}: must be in [0, 1]");
-            }
+            sim::base::ranges::FRACTION.check_as(name, value)?;
         }
         sim::base::ranges::TIE_TOLERANCE.check(self.tie_tolerance)?;
         if !self.initial_q.is_finite() {

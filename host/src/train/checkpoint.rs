@@ -28,8 +28,6 @@
 //! that wrote them did. Files are written atomically (temporary file, then
 //! rename): a run killed at any moment leaves the old checkpoint or the
 //! new one.
-//!
-//! [`TrainConfig`]: super::TrainConfig
 
 use super::format1::StateV1;
 use super::format2::StateV2;
@@ -38,6 +36,7 @@ use super::format4::StateV4;
 use super::format6::StateV6;
 use super::format7::StateV7;
 use super::trainer::TrainingState;
+use super::TrainConfig;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use sim::base::ranges;
@@ -243,10 +242,25 @@ pub fn decode(bytes: &[u8]) -> Result<TrainingState, CheckpointError> {
         7 => postcard::from_bytes::<StateV7>(body),
         _ => {
             return ciborium::from_reader(body)
-                .map_err(|e| CheckpointError::Malformed(e.to_string()))
+                .map_err(|e| CheckpointError::Malformed(why_malformed(body, e.to_string())))
         }
     };
     old.map(StateV7::into_state).map_err(malformed)
+}
+
+/// Why a format-8 body does not decode: the setting at fault and its
+/// problem when a setting is (`setting learn.alpha: invalid type: ...`),
+/// else the CBOR decoder's `error`.
+fn why_malformed(body: &[u8], error: String) -> String {
+    let settings = ciborium::from_reader::<ciborium::Value, _>(body)
+        .ok()
+        .and_then(|v| v.into_map().ok())
+        .and_then(|m| m.into_iter().find(|(k, _)| k.as_text() == Some("config")))
+        .and_then(|(_, v)| serde_json::to_value(v).ok());
+    match settings.map(serde_path_to_error::deserialize::<_, TrainConfig>) {
+        Some(Err(e)) => format!("setting {}: {}", e.path(), e.inner()),
+        _ => error,
+    }
 }
 
 /// Writes a checkpoint atomically.

@@ -4,7 +4,7 @@
 //! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::learn::{LearnConfig, MAX_N_STEP};
+use crate::learn::LearnConfig;
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
@@ -397,8 +397,8 @@ impl TrainConfig {
         if let Some(steps) = self.epsilon_decay {
             ranges::STEPS.check_count("epsilon_decay", steps)?;
         }
-        if let Some(n) = self.n_step.filter(|n| !(1..=MAX_N_STEP).contains(n)) {
-            bail!("n_step = {n}: must be 1 to {MAX_N_STEP} rewards per update");
+        if let Some(n) = self.n_step {
+            ranges::N_STEP.check_count("n_step", u64::from(n))?;
         }
         ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
