@@ -2,9 +2,12 @@
 //! taken from a training config's own flags, and what only a scenario has.
 
 use clap::{Arg, ArgMatches, Args, FromArgMatches};
-use host::train::{TrainConfig, TrainFlags};
-use sim::config::BroadPhase;
+use host::train::TrainConfig;
+use sim::config::{BroadPhase, Walls};
+use sim::fields::source::FieldSource;
+use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::choices::ScenarioChoices;
+use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::trained_for;
 use sim::scenario::{ControllerChoice, Scenario};
 
@@ -15,9 +18,7 @@ use sim::scenario::{ControllerChoice, Scenario};
 #[derive(Clone, Debug)]
 pub struct ScenarioArgs {
     own: ScenarioOwnArgs,
-    /// The training config of the world flags given, read as `host
-    /// train` reads them ([`TrainFlags`]).
-    config: TrainConfig,
+    world: ArgMatches,
 }
 
 /// What a scenario has and a training run does not.
@@ -57,13 +58,9 @@ impl Args for ScenarioArgs {
 
 impl FromArgMatches for ScenarioArgs {
     fn from_arg_matches(matches: &ArgMatches) -> Result<ScenarioArgs, clap::Error> {
-        let mut config = TrainConfig::default();
-        TrainFlags::from_arg_matches(matches)?
-            .apply(&mut config)
-            .map_err(|e| clap::Error::raw(clap::error::ErrorKind::ValueValidation, e))?;
         Ok(ScenarioArgs {
             own: ScenarioOwnArgs::from_arg_matches(matches)?,
-            config,
+            world: matches.clone(),
         })
     }
 
@@ -76,7 +73,7 @@ impl FromArgMatches for ScenarioArgs {
 impl ScenarioArgs {
     /// The scenario, with robot sensor and arena files read and checked.
     pub fn scenario(self) -> anyhow::Result<Scenario> {
-        let mut scenario = self.config.scenario()?;
+        let mut scenario = self.config().scenario()?;
         scenario.controller = self.own.controller;
         if self.own.naive {
             scenario.broad_phase = BroadPhase::Naive;
@@ -93,7 +90,7 @@ impl ScenarioArgs {
             return Ok(None);
         };
         let blob = sim::control::policy_file::read(path)?;
-        let here = self.config.trained_for();
+        let here = self.config().trained_for();
         Ok(trained_for::mismatch(blob.trained_for(), &here)
             .map(|why| format!("policy file {}: {why}", path.display())))
     }
@@ -102,7 +99,30 @@ impl ScenarioArgs {
     pub fn choices(&self) -> ScenarioChoices {
         ScenarioChoices {
             controller: self.own.controller.clone(),
-            ..self.config.choices()
+            ..self.config().choices()
         }
+    }
+
+    /// The training config of the world flags given.
+    fn config(&self) -> TrainConfig {
+        let mut config = TrainConfig::default();
+        let m = &self.world;
+        if let Some(field) = m.get_one::<FieldSource>("field") {
+            config.field = field.clone();
+        }
+        if let Some(sensors) = m.get_one::<SensorChoice>("sensors") {
+            config.sensors = sensors.clone();
+        }
+        config.arena = m.get_one::<ArenaChoice>("arena").cloned();
+        config.robots = m.get_one::<usize>("robots").copied();
+        config.pucks = m.get_one::<usize>("pucks").copied();
+        if let Some(&seed) = m.get_one::<u64>("seed") {
+            config.seed = seed;
+        }
+        if let Some(&noise) = m.get_one::<f64>("noise") {
+            config.noise = noise;
+        }
+        config.walls = m.get_one::<Walls>("walls").copied();
+        config
     }
 }
