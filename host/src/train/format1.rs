@@ -2,10 +2,11 @@
 //! the settings of the thesis author's runs existed (formation checks every
 //! N steps on a stale Eval, the success signal, innies, obstacle discs; the
 //! simulation's stale signal) and before rectangular and screen arenas
-//! (a square arena's side only). Settings and states that use none of them
-//! keep this layout: a checkpoint is byte for byte what earlier builds
-//! wrote (format-1 files keep loading), and an experiment trial's hash is
-//! the one earlier builds gave it (`experiment::plan`).
+//! (a square arena's side only). Format-1 files are read into format 7's
+//! layout ([`super::format7`]); settings and states that use none of the
+//! newer settings convert to this layout again, byte for byte what earlier
+//! builds wrote (`checkpoint::write_earlier_format`), and an experiment
+//! trial's settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 1 in
 //! their order, the types they share with the newer formats unchanged.

@@ -2,10 +2,11 @@
 //! the noise models (the robots' motion, the robot senses' noise and
 //! latency) and before a run's arena and noise were settings: the thesis'
 //! square or a rectangular arena of fixed settings, every count given.
-//! Settings and states that use nothing newer, but something format 1
-//! lacks, keep this layout: a checkpoint is byte for byte what earlier
-//! builds wrote, and an experiment trial's hash the one they gave it
-//! (`experiment::plan`).
+//! Format-2 files are read into format 7's layout ([`super::format7`]);
+//! settings and states that use nothing newer, but something format 1
+//! lacks, convert to this layout again, byte for byte what earlier builds
+//! wrote (`checkpoint::write_earlier_format`), and an experiment trial's
+//! settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 2 in
 //! their order, the types they share with the newest format unchanged.

@@ -1,10 +1,11 @@
 //! Format 3: the training settings and state as they were laid out before
 //! the arena's border became a setting (`physics.walls`, the run's
 //! `walls`) and before the learner's rules (`rules`: tie tolerance,
-//! batched updates). Every format-3 run's border was wall segments; states
-//! that use segments and the default rules keep this layout, so a
-//! checkpoint is byte for byte what earlier builds wrote and an experiment
-//! trial's hash the one they gave it (`experiment::plan`).
+//! batched updates). Every format-3 run's border was wall segments. Files
+//! are read into format 7's layout ([`super::format7`]); states that use
+//! segments and the default rules convert to this layout again, byte for
+//! byte what earlier builds wrote (`checkpoint::write_earlier_format`), and
+//! an experiment trial's settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list format 3's fields in their
 //! order, the types they share with the newest format unchanged.

@@ -1,10 +1,11 @@
 //! Format 4: the training state as it was laid out before the robots'
 //! outline ([`sim::config::robot_shape::RobotShape`]) was a world setting
-//! and before decaying exploration (`epsilon_decay`). A state whose robots
-//! are discs and whose exploration does not decay keeps this layout (or an
-//! older one), so its checkpoint is byte for byte what earlier builds wrote
-//! and an experiment trial's hash the one they gave it; format 5 (the
-//! current layout) holds the rest.
+//! and before decaying exploration (`epsilon_decay`). Files are read into
+//! format 7's layout ([`super::format7`]); a state whose robots are discs
+//! and whose exploration does not decay converts to this layout (or an
+//! older one) again, byte for byte what earlier builds wrote
+//! (`checkpoint::write_earlier_format`), and an experiment trial's settings
+//! that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 4 in
 //! their order, the types they share with the newest format unchanged.

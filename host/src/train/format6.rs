@@ -1,9 +1,10 @@
 //! Formats 5 and 6: the training state as it was laid out before n-step
 //! returns (`n_step`, and the robots' waiting steps beside the learner).
-//! A state of one-step returns keeps this layout (or an older one), so
-//! its checkpoint is byte for byte what earlier builds wrote and an
-//! experiment trial's hash the one they gave it; format 7 (the current
-//! layout) holds the rest.
+//! Files are read into format 7's layout ([`super::format7`]); a state of
+//! one-step returns converts to this layout (or an older one) again, byte
+//! for byte what earlier builds wrote (`checkpoint::write_earlier_format`),
+//! and an experiment trial's settings that do hash in it
+//! (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of formats 5 and
 //! 6 in their order, the types they share with the newest format
