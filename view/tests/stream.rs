@@ -54,7 +54,7 @@ fn controls_step_exactly_and_refused_settings_change_nothing() {
     assert_eq!(status, 200);
     let at = wait_for_step(address, 250);
     for (path, says) in [
-        ("/settings?robots=0", "world.robots = 0"),
+        ("/settings?robots=0", "robots = 0: outside"),
         ("/settings?noise=-1", "noise"),
         ("/settings?field=/etc/passwd", "field=/etc/passwd"),
         ("/settings?controller=policy:none.policy", "none.policy"),

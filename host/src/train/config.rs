@@ -368,13 +368,7 @@ impl TrainConfig {
     /// the setting.
     pub fn validate(&self) -> Result<()> {
         ranges::STEPS.check_count("steps", self.steps)?;
-        if let Some(robots) = self.robots {
-            ranges::ROBOTS.check_count("robots", robots as u64)?;
-        }
-        if let Some(pucks) = self.pucks {
-            ranges::PUCKS.check_count("pucks", pucks as u64)?;
-        }
-        ranges::NOISE.check(self.noise)?;
+        sim::scenario::choices::check_world_ranges(self.robots, self.pucks, self.noise)?;
         if let Some(limit) = self.stuck_limit {
             ranges::STUCK_LIMIT.check_count("stuck_limit", limit)?;
         }

@@ -3,6 +3,7 @@
 //! `host run`, training and the live view (`view`) turn into a [`Scenario`]:
 //! [`WorldChoices`], with a controller [`ScenarioChoices`].
 
+use crate::base::ranges::{self, RangeError};
 use crate::config::{BroadPhase, Walls};
 use crate::fields::source::FieldSource;
 use crate::scenario::arena_choice::ArenaChoice;
@@ -87,4 +88,22 @@ impl ScenarioChoices {
             walls: w.walls,
         })
     }
+}
+
+/// Checks the world's counts and noise against their rows of the table of
+/// ranges, named as every front end names them (`robots`, `pucks`,
+/// `noise`): the one check of these settings, which a training config and
+/// a scenario both make.
+pub fn check_world_ranges(
+    robots: Option<usize>,
+    pucks: Option<usize>,
+    noise: f64,
+) -> Result<(), RangeError> {
+    if let Some(robots) = robots {
+        ranges::ROBOTS.check_count("robots", robots as u64)?;
+    }
+    if let Some(pucks) = pucks {
+        ranges::PUCKS.check_count("pucks", pucks as u64)?;
+    }
+    ranges::NOISE.check(noise)
 }
