@@ -477,12 +477,16 @@ fn a_checkpoint_with_an_unknown_or_mistyped_setting_is_refused_naming_the_file_a
     let mut t = trainer(small(37));
     t.run(100);
     let dir = tempfile::tempdir().unwrap();
+    // the refusal of a file `name` holding `bytes`
+    let refusal = |name: &str, bytes: Vec<u8>| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        format!("{:#}", checkpoint::load(&path).unwrap_err())
+    };
     let unknown = edited_checkpoint(&t.state(), |body| {
         entries(body, "config").push(("pucks_per_robot".into(), 3.into()));
     });
-    let path = dir.path().join("unknown.ckpt");
-    std::fs::write(&path, unknown).unwrap();
-    let e = format!("{:#}", checkpoint::load(&path).unwrap_err());
+    let e = refusal("unknown.ckpt", unknown);
     assert!(
         e.contains("unknown.ckpt") && e.contains("pucks_per_robot"),
         "{e}"
@@ -490,9 +494,7 @@ fn a_checkpoint_with_an_unknown_or_mistyped_setting_is_refused_naming_the_file_a
     let mistyped = edited_checkpoint(&t.state(), |body| {
         *field(field(body, "config"), "steps") = "many".into();
     });
-    let path = dir.path().join("mistyped.ckpt");
-    std::fs::write(&path, mistyped).unwrap();
-    let e = format!("{:#}", checkpoint::load(&path).unwrap_err());
+    let e = refusal("mistyped.ckpt", mistyped);
     assert!(
         e.contains("mistyped.ckpt") && e.contains("setting steps: invalid type"),
         "{e}"
