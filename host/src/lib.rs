@@ -19,4 +19,5 @@ pub mod report;
 pub mod robot;
 pub mod run_summary;
 pub mod search;
+pub mod shape;
 pub mod train;

@@ -55,6 +55,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bench(args) => bench(args),
         Command::Train(args) => train(args),
         Command::Search(args) => search(args),
+        Command::Shape(args) => shape(args),
         Command::Experiment(args) => experiment(args),
         Command::Policy(PolicyCommand::Inspect { file, summary }) => inspect_policy(&file, summary),
         Command::Policy(PolicyCommand::Gap(args)) => policy_gap(args),
@@ -165,8 +166,20 @@ fn train(args: TrainArgs) -> Result<()> {
 }
 
 fn search(args: SearchArgs) -> Result<()> {
-    let report = host::search::search(&args.request())?;
+    let request = args.request();
+    let mut progress = host::search::command::Progress::new(request.search.generations, 0);
+    let report = host::search::search(&request, &mut |g| {
+        progress.generation(g);
+        Ok(())
+    })?;
+    progress.done();
     println!("{report}");
+    Ok(())
+}
+
+fn shape(args: cli::shape::ShapeArgs) -> Result<()> {
+    let report = host::shape::shape(&args.request()?)?;
+    print!("{report}");
     Ok(())
 }
 
@@ -424,15 +437,27 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             );
             Ok(())
         }
+        Some(ExperimentAction::List { page }) => {
+            for (name, text) in host::experiment::spec::BUILT_IN {
+                let spec = host::experiment::ExperimentSpec::parse(name, text)?;
+                let on = spec.page.as_deref().unwrap_or("-");
+                if page.as_deref().is_none_or(|p| p == on) {
+                    println!("{name} {} {on}", spec.trials);
+                }
+            }
+            Ok(())
+        }
         Some(ExperimentAction::Report {
             docs,
             check,
             scale,
+            experiments,
             documents,
         }) => {
             ranges::SCALE.check(scale)?;
             let log = |line: &str| eprintln!("{line}");
-            let documents = host::experiment::report::documents(&documents)?;
+            let documents =
+                host::experiment::report::documents(&documents, experiments.as_deref())?;
             if check {
                 let checked = host::experiment::report::check(&docs, &documents, &log)?;
                 println!("{} are what the published trials give", paths(&checked));
@@ -444,12 +469,18 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
         }
         None => {
             let name = args.run.experiment.as_deref().unwrap_or_default();
+            if let Some(campaign) = host::experiment::campaign::Campaign::at(name)? {
+                return run_campaign(&campaign, &args.run);
+            }
+            if !args.run.stages.is_empty() {
+                anyhow::bail!("--stages: {name} is an experiment, not a campaign with [[stages]]");
+            }
             let spec = host::experiment::ExperimentSpec::load(name)?;
             // progress lines; a closed stdout must not stop the trials
             let log = |line: &str| {
                 let _ = writeln!(std::io::stdout().lock(), "{line}");
             };
-            let report = host::experiment::run(&spec, &args.run.options(), &log)?;
+            let report = host::experiment::run(&spec, &args.run.options(spec.trials), &log)?;
             println!(
                 "done in {:.0} s: {} trials run, {} skipped, {} copied; wrote {}",
                 report.seconds,
@@ -461,6 +492,47 @@ fn experiment(args: ExperimentArgs) -> Result<()> {
             Ok(())
         }
     }
+}
+
+/// `host experiment FILE` of a campaign: its stages, into --out
+/// [default: out/<campaign>].
+fn run_campaign(
+    campaign: &host::experiment::campaign::Campaign,
+    args: &cli::learn::ExperimentRunArgs,
+) -> Result<()> {
+    let unused = [
+        ("--seed", args.seed.is_some()),
+        ("--threads", args.threads.is_some()),
+        ("--shard", args.shard.is_some()),
+        ("--reuse", !args.reuse.is_empty()),
+        ("--view", args.view.is_some()),
+    ];
+    if let Some((flag, _)) = unused.iter().find(|(_, given)| *given) {
+        anyhow::bail!(
+            "{flag}: a campaign ({}) takes its seeds and settings from its file",
+            campaign.name
+        );
+    }
+    let options = host::experiment::campaign::run::CampaignOptions {
+        out: args
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new("out").join(&campaign.name)),
+        scale: args.scale,
+        stages: args.stages.clone(),
+    };
+    let log = |line: &str| {
+        let _ = writeln!(std::io::stdout().lock(), "{line}");
+    };
+    let report = host::experiment::campaign::run(campaign, &options, &log)?;
+    println!(
+        "done in {:.0} s: {} stages run, {} skipped; outputs in {}",
+        report.seconds,
+        report.run.len(),
+        report.skipped.len(),
+        options.out.display()
+    );
+    Ok(())
 }
 
 fn monitor(args: MonitorArgs) -> Result<()> {

@@ -174,13 +174,17 @@ pub fn write_png<S: SensorModel>(
     path: &Path,
 ) -> Result<(u32, u32)> {
     let img = draw(sim, options);
-    let size = img.dimensions();
+    write_image(&img, path)?;
+    Ok(img.dimensions())
+}
+
+/// Writes an image as a PNG atomically.
+pub fn write_image(img: &image::RgbImage, path: &Path) -> Result<()> {
     crate::atomic::write_with(path, |w| {
         let mut buf = std::io::Cursor::new(Vec::new());
         img.write_to(&mut buf, image::ImageFormat::Png)
             .map_err(std::io::Error::other)?;
         w.write_all(buf.get_ref())
     })
-    .with_context(|| format!("cannot write image {}", path.display()))?;
-    Ok(size)
+    .with_context(|| format!("cannot write image {}", path.display()))
 }

@@ -3,6 +3,9 @@
 //! and `experiments/`) names subcommands and flags that `host ... --help`
 //! lists, and built-in experiments that `experiments/` holds; every
 //! repository path a page names in code, and every relative link, exists.
+//! And the docs say what is, in pages one can read: every page under
+//! `docs/` has at most 600 lines (`docs/guide.md` at most 300), and no
+//! heading of any page carries a date (`2026-12-02`) or a "sitting".
 //!
 //! What counts as a command: the words after `host` (or a path ending in
 //! `/host`, or `cargo run ... -p host --`) up to a shell separator (`|`,
@@ -479,4 +482,117 @@ fn the_check_finds_a_subcommand_a_flag_an_experiment_and_a_file_that_do_not_exis
         }
         assert_eq!(missing_paths(&root, &piece.text), Vec::<String>::new());
     }
+}
+
+/// The most lines a page under `docs/` may have, and the guide.
+const PAGE_LINES: usize = 600;
+const GUIDE_LINES: usize = 300;
+
+/// The pages under `docs/` longer than they may be, as `page: N lines`.
+fn long_pages(root: &Path) -> Vec<String> {
+    pages(root)
+        .iter()
+        .filter(|page| page.starts_with(root.join("docs")))
+        .filter_map(|page| {
+            let lines = std::fs::read_to_string(page)
+                .expect("a tracked page reads")
+                .lines()
+                .count();
+            let name = page.strip_prefix(root).unwrap_or(page);
+            let most = if name == Path::new("docs/guide.md") {
+                GUIDE_LINES
+            } else {
+                PAGE_LINES
+            };
+            (lines > most).then(|| format!("{}: {lines} lines (at most {most})", name.display()))
+        })
+        .collect()
+}
+
+#[test]
+fn every_page_under_docs_has_at_most_600_lines_and_the_guide_at_most_300() {
+    let root = repository();
+    assert!(
+        root.join("docs/guide.md").is_file(),
+        "docs/guide.md, the user guide, is missing"
+    );
+    let long = long_pages(&root);
+    assert!(
+        long.is_empty(),
+        "pages too long (split them by purpose; history belongs in git):\n{}",
+        long.join("\n")
+    );
+}
+
+/// Whether a heading names a date (`2026-12-02`, `2026/12/02`) or a
+/// sitting: a page says what is, and git keeps when it was done.
+fn dated_heading(heading: &str) -> bool {
+    let bytes = heading.as_bytes();
+    let date = (0..bytes.len()).any(|at| {
+        let digits = |from: usize, n: usize| {
+            bytes
+                .get(from..from + n)
+                .is_some_and(|d| d.iter().all(u8::is_ascii_digit))
+        };
+        let dash = |i: usize| matches!(bytes.get(i), Some(b'-' | b'/'));
+        digits(at, 4) && dash(at + 4) && digits(at + 5, 2) && dash(at + 7) && digits(at + 8, 2)
+    });
+    let sitting = heading
+        .to_lowercase()
+        .split(|c: char| !c.is_alphanumeric())
+        .any(|word| word == "sitting" || word == "sittings");
+    date || sitting
+}
+
+/// The headings of a markdown page (outside code blocks), with their lines.
+fn headings(text: &str) -> Vec<(usize, &str)> {
+    let mut fenced = false;
+    let mut found = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        if line.trim_start().starts_with("```") {
+            fenced = !fenced;
+            continue;
+        }
+        let hashes = line.len() - line.trim_start_matches('#').len();
+        if !fenced && (1..=6).contains(&hashes) && line[hashes..].starts_with(' ') {
+            found.push((i + 1, line));
+        }
+    }
+    found
+}
+
+#[test]
+fn no_heading_carries_a_date_or_a_sitting() {
+    let root = repository();
+    let mut problems = Vec::new();
+    for page in pages(&root) {
+        let text = std::fs::read_to_string(&page).expect("a tracked page reads");
+        let name = page
+            .strip_prefix(&root)
+            .unwrap_or(&page)
+            .display()
+            .to_string();
+        for (line, heading) in headings(&text) {
+            if dated_heading(heading) {
+                problems.push(format!("{name}:{line}: {heading}"));
+            }
+        }
+    }
+    assert!(
+        problems.is_empty(),
+        "headings that date their section (say what is; git keeps when):\n{}",
+        problems.join("\n")
+    );
+}
+
+#[test]
+fn the_heading_check_finds_a_date_and_a_sitting_but_not_a_comment_in_code() {
+    let page = "# Speed\n\n## 2026-12-02, evening: the camera\n\n### The camera (2026/12/01)\n\n## Earlier sittings\n\n```sh\n# a comment, 2026-12-02, one sitting\n```\n\n## The standard step, 24,828 instructions\n#not a heading 2026-12-02\n";
+    let dated: Vec<usize> = headings(page)
+        .into_iter()
+        .filter(|(_, heading)| dated_heading(heading))
+        .map(|(line, _)| line)
+        .collect();
+    assert_eq!(dated, [3, 5, 7]);
+    assert_eq!(headings(page).len(), 5);
 }

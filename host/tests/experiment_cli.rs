@@ -37,12 +37,32 @@ fn every_experiment_file_is_built_in() {
 }
 
 #[test]
-fn the_help_names_every_built_in_experiment() {
-    let out = host().args(["experiment", "--help"]).output().unwrap();
-    let help = String::from_utf8_lossy(&out.stdout);
-    for (name, _) in host::experiment::spec::BUILT_IN {
-        assert!(help.contains(name), "`host experiment --help` lacks {name}");
+fn the_list_names_every_built_in_experiment_with_its_trials_and_page() {
+    // from the repository root, against which files name their arenas
+    let out = host()
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join(".."))
+        .args(["experiment", "list"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let list = String::from_utf8_lossy(&out.stdout);
+    for (name, text) in host::experiment::spec::BUILT_IN {
+        let spec = host::experiment::ExperimentSpec::parse(name, text).unwrap();
+        let line = format!("{name} {} {}", spec.trials, spec.page.unwrap());
+        assert!(
+            list.lines().any(|l| l == line),
+            "`host experiment list` lacks {line}"
+        );
     }
+    assert!(list.contains("every-shape 10 robot-sensors"), "{list}");
+    assert!(
+        list.contains("robot-senses-sweep 3 robot-sensors"),
+        "{list}"
+    );
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! docs/policy-search.md's results table says what
-//! docs/policy-search/results.json holds (the JSON `scripts/policy-search`
-//! publishes; `scripts/policy-search-publish.py` renders the page).
+//! docs/policy-search/results.json holds (the JSON the publish stage of
+//! experiments/campaigns/policy-search.toml writes; `host experiment
+//! report` renders the page's tables from it).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -108,20 +109,39 @@ fn the_shipped_general_policy_is_the_general_table_that_ranks_first_on_the_shape
 }
 
 /// Every table of the page, the held-out shapes' and the targets' among
-/// them, is what the publisher renders from the published JSON.
+/// them, is what the renderer gives from the published JSON.
 #[test]
-fn the_policy_search_pages_tables_are_what_the_publisher_renders_from_its_json() {
-    let root = root();
-    let output = std::process::Command::new("python3")
-        .arg(root.join("scripts/policy-search-publish.py"))
-        .arg("--check")
-        .arg(root.join("docs/policy-search/results.json"))
-        .arg(root.join("docs/policy-search.md"))
-        .output()
-        .expect("python3 runs the publisher");
+fn the_policy_search_pages_tables_are_what_the_renderer_gives_from_its_json() {
+    let checked = host::experiment::campaign::publish::check_pages(&root().join("docs")).unwrap();
     assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+        checked.iter().any(|p| p.ends_with("policy-search.md")),
+        "{checked:?}"
     );
+}
+
+/// The tables name each controller as the campaign's stage that made it.
+#[test]
+fn every_published_controller_is_named_by_the_label_of_the_stage_that_made_its_table() {
+    let campaign = host::experiment::campaign::Campaign::load(
+        &root().join("experiments/campaigns/policy-search.toml"),
+    )
+    .unwrap();
+    let results = results();
+    let mut named = 0;
+    for controllers in results["shapes"].as_object().unwrap().values() {
+        for (name, c) in controllers.as_object().unwrap() {
+            let policy = c["policy"].as_str().unwrap();
+            if policy == "oc" {
+                assert_eq!(name, "orbital construction");
+                continue;
+            }
+            let run = Path::new(policy).file_stem().unwrap().to_str().unwrap();
+            let stage = campaign
+                .stage(run)
+                .unwrap_or_else(|| panic!("no stage {run}"));
+            assert_eq!(name, &stage.label, "{run}");
+            named += 1;
+        }
+    }
+    assert!(named > 100, "{named}");
 }

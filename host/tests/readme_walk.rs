@@ -35,6 +35,7 @@ const HOST: &str = env!("CARGO_BIN_EXE_host");
 /// value here whether or not the README's command has them.
 const TINY: &[(&str, &[(&str, &str)])] = &[
     ("train", &[("--steps", "2000")]),
+    ("shape", &[("--generations", "1"), ("--scale", "0.005")]),
     ("render", &[("--steps", "2000"), ("--size", "200")]),
     ("experiment", &[("--scale", "0.0005"), ("--trials", "1")]),
 ];

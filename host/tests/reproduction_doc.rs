@@ -8,7 +8,7 @@
 
 use host::experiment::metric::Metric;
 use host::experiment::published::SegmentTrial;
-use host::experiment::report::DOCUMENTS;
+use host::experiment::report::documents;
 use host::experiment::side_by_side::SideBySide;
 use host::experiment::spec::ExperimentSpec;
 use host::experiment::template::{self, Source};
@@ -27,9 +27,8 @@ fn the_rendered_pages_are_what_the_committed_trials_give() {
     let docs = Path::new("docs");
     let stale = std::cell::RefCell::new(Vec::new());
     let log = |line: &str| stale.borrow_mut().push(line.to_string());
-    if let Err(e) =
-        host::experiment::report::check(docs, &host::experiment::report::DOCUMENTS, &log)
-    {
+    let all = documents(&[], None).unwrap();
+    if let Err(e) = host::experiment::report::check(docs, &all, &log) {
         panic!("{e:#}");
     }
     assert!(
@@ -293,36 +292,51 @@ fn recompute(expr: &str, sources: &[Source]) -> Option<String> {
 fn every_verdict_on_the_page_follows_the_one_rule() {
     std::env::set_current_dir(root()).unwrap();
     let docs = Path::new("docs");
-    let document = DOCUMENTS[0];
+    let document = documents(&["reproduction".to_string()], None)
+        .unwrap()
+        .remove(0);
     let sources = document.sources(docs, 1.0, &|_| {}).unwrap();
     let side = SideBySide::load(&docs.join("reproduction/side-by-side")).unwrap();
-    let template_text = std::fs::read_to_string(docs.join("reproduction/template.md")).unwrap();
-    let page = std::fs::read_to_string(docs.join("reproduction.md")).unwrap();
-    let page_lines: std::collections::HashSet<&str> = page.lines().collect();
+    // each page's template and the page: the index, then each experiment's
+    let mut pairs = vec![(
+        docs.join("reproduction/template.md"),
+        docs.join("reproduction.md"),
+    )];
+    for name in &document.experiments {
+        let dir = docs.join("reproduction").join(name);
+        pairs.push((dir.join("template.md"), dir.with_extension("md")));
+    }
     let (mut verdicts, mut missing) = (0, Vec::new());
-    for line in template_text.lines() {
-        let mut expected = String::new();
-        let mut rest = line;
-        let mut judged = false;
-        while let Some(open) = rest.find("{{") {
-            expected.push_str(&rest[..open]);
-            let close = rest[open..].find("}}").unwrap() + open;
-            let expr = rest[open + 2..close].trim();
-            match recompute(expr, &sources) {
-                Some(v) => {
-                    expected.push_str(&v);
-                    judged = true;
-                    verdicts += 1;
+    for (template_path, page_path) in pairs {
+        let Ok(template_text) = std::fs::read_to_string(&template_path) else {
+            continue;
+        };
+        let page = std::fs::read_to_string(&page_path).unwrap();
+        let page_lines: std::collections::HashSet<&str> = page.lines().collect();
+        for line in template_text.lines() {
+            let mut expected = String::new();
+            let mut rest = line;
+            let mut judged = false;
+            while let Some(open) = rest.find("{{") {
+                expected.push_str(&rest[..open]);
+                let close = rest[open..].find("}}").unwrap() + open;
+                let expr = rest[open + 2..close].trim();
+                match recompute(expr, &sources) {
+                    Some(v) => {
+                        expected.push_str(&v);
+                        judged = true;
+                        verdicts += 1;
+                    }
+                    None => expected.push_str(
+                        &template::render(&format!("{{{{{expr}}}}}"), &sources, &side).unwrap(),
+                    ),
                 }
-                None => expected.push_str(
-                    &template::render(&format!("{{{{{expr}}}}}"), &sources, &side).unwrap(),
-                ),
+                rest = &rest[close + 2..];
             }
-            rest = &rest[close + 2..];
-        }
-        expected.push_str(rest);
-        if judged && !page_lines.contains(expected.as_str()) {
-            missing.push(expected);
+            expected.push_str(rest);
+            if judged && !page_lines.contains(expected.as_str()) {
+                missing.push(expected);
+            }
         }
     }
     assert!(verdicts > 100, "only {verdicts} verdicts found");
@@ -333,12 +347,19 @@ fn every_verdict_on_the_page_follows_the_one_rule() {
     );
 }
 
-/// The page types none of the figures the trials or the runs give: the
+/// The pages type none of the figures the trials or the runs give: the
 /// learners' side-by-side table and its comparisons, and the figures with
 /// wall segments, are rendered.
 #[test]
 fn the_template_types_no_figure_of_the_runs() {
-    let template = std::fs::read_to_string(root().join("docs/reproduction/template.md")).unwrap();
+    // the index's template and every experiment page's
+    let dir = root().join("docs/reproduction");
+    let mut template = std::fs::read_to_string(dir.join("template.md")).unwrap();
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        if let Ok(text) = std::fs::read_to_string(entry.unwrap().path().join("template.md")) {
+            template.push_str(&text);
+        }
+    }
     let mut prose = String::new();
     let mut rest = template.as_str();
     while let Some(open) = rest.find("{{") {

@@ -132,3 +132,81 @@ fn bad_search_settings_are_refused_naming_them() {
         assert!(e.contains(says), "{args:?}: {e}");
     }
 }
+
+#[test]
+fn the_search_help_shows_the_world_and_the_search_and_none_of_the_learners_settings() {
+    let out = host().args(["search", "--help"]).output().unwrap();
+    assert!(out.status.success());
+    let help = String::from_utf8(out.stdout).unwrap();
+    for shown in [
+        "The world searched in:",
+        "The search:",
+        "--field",
+        "--population",
+        "--also-noise",
+        "[default: robot]",
+        "[default: tv75]",
+        "[default: 1]",
+    ] {
+        assert!(help.contains(shown), "{shown} missing from:\n{help}");
+    }
+    for hidden in [
+        "--alpha",
+        "--gamma",
+        "--epsilon",
+        "--initial-q",
+        "--n-step",
+        "--checkpoint-every",
+        "--tie-tolerance",
+    ] {
+        assert!(!help.contains(hidden), "{hidden} shown in:\n{help}");
+    }
+    let refused = host().args(["search", "--alpha", "0.5"]).output().unwrap();
+    assert!(!refused.status.success());
+    let e = String::from_utf8_lossy(&refused.stderr);
+    assert!(e.contains("host search does not use --alpha"), "{e}");
+}
+
+#[test]
+fn a_search_without_world_flags_is_the_robots_on_the_tv_at_the_default_noise_and_prints_a_line_per_generation(
+) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = host()
+        .current_dir(dir.path())
+        .arg("search")
+        .args(["--start", "random", "--generations", "2"])
+        .args(["--population", "2", "--elites", "1"])
+        .args(["--fitness-seeds", "1", "--fitness-steps", "300"])
+        .args(["--validation-seeds", "1", "--validation-steps", "300"])
+        .args(["--out", "s", "--name", "plain"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("s/plain.search.json")).unwrap())
+            .unwrap();
+    assert_eq!(log["world"]["sensors"], "robot");
+    assert_eq!(log["world"]["arena"], "tv75");
+    assert_eq!(log["world"]["noise"], 1.0);
+    // its output is a pipe here: one progress line per generation
+    let progress = String::from_utf8(out.stderr).unwrap();
+    let lines: Vec<&str> = progress
+        .lines()
+        .filter(|l| l.starts_with("generation "))
+        .collect();
+    assert_eq!(lines.len(), 2, "{progress}");
+    assert!(
+        lines[0].starts_with("generation 1/2  best "),
+        "{}",
+        lines[0]
+    );
+    assert!(lines[1].contains("time left 0m00s"), "{}", lines[1]);
+    assert!(
+        !progress.contains('\r'),
+        "no live line in a pipe: {progress:?}"
+    );
+}

@@ -1,10 +1,10 @@
-"""Learning figures of the examples and the rewards (docs/python.md,
+"""Learning figures of the examples and the rewards (docs/python-results.md,
 "Examples that learn"): each learner trains for the same budget of
 world-steps on the standard annulus (8 robots, 250 pucks, disc sensors),
 its policy is exported as a policy blob, and the blob's greedy table is
 run on 10 evaluation seeds; random actions and robots standing still
 (forward speed 0) are run on the same seeds. Writes the runs as JSON;
-`--render` turns such a file into the table of docs/python.md.
+`--render` turns such a file into the table of docs/python-results.md.
 
     scripts/test-python                                    # the wheel in target/python-venv
     python3 -m venv /tmp/ml && /tmp/ml/bin/pip install stable-baselines3 target/wheels/zumo_swarm-*.whl
@@ -125,7 +125,7 @@ def run(args) -> dict:
 
 
 def render(results: dict) -> str:
-    """The markdown table of docs/python.md."""
+    """The markdown table of docs/python-results.md."""
     head = (
         f"Measured {results['date']} on {results['machine']} (1-minute load average {', '.join(map(str, results['load_average']))}), "
         f"{results['budget_steps']:,} world-steps of training each, seed 1; every policy then run greedily for "

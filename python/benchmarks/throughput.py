@@ -2,8 +2,7 @@
 one sitting: every configuration runs once per round, rounds alternate,
 and the figures are medians over the rounds, stated as ratios to `host
 bench` of the same sitting. Writes the raw runs as JSON; `--render` turns
-such a file into the markdown table of docs/python.md and
-docs/performance.md.
+such a file into the markdown table of docs/performance.md.
 
     cargo build --release -p host && scripts/test-python   # the release host, the wheel in target/python-venv
     python3 -m venv /tmp/vmas-venv && /tmp/vmas-venv/bin/pip install vmas
@@ -169,8 +168,8 @@ def render(results: dict) -> str:
     base, base_cpu = statistics.median(rows[0]["runs"]), statistics.median(rows[0]["cpu_runs"])
     load = ", ".join(f"{x:.1f}" for x in results["load_average"])
     lines = [
-        f"Measured {results['date']} (commit {results['commit']}) on {results['machine']}, "
-        f"{results['rounds']} alternating rounds in one sitting (1-minute load average before and after each round: {load}). "
+        f"Measured at commit {results['commit']} on {results['machine']}, "
+        f"{results['rounds']} alternating rounds (1-minute load average before and after each round: {load}). "
         "A step is one world's step (all 8 robots); medians over the rounds.",
         "",
         "| configuration | steps/s (each round) | median | vs host bench | steps per CPU-second | "

@@ -13,7 +13,7 @@ plus Gumbel noise fixed per world and state), the noise redrawn every
 softmax), so PPO's ratios are as usual; but a state's action stays the same
 for hundreds of steps, as a greedy learner's does. With actions sampled
 afresh at every step (--redraw 0) no setting we tried formed an annulus
-(docs/python.md, "How the greedy learner explores").
+(docs/python-results.md, "How the greedy learner explores").
 
 It prints a line every update, logs as CleanRL does (each ended episode's
 return, length and last Eval, the losses and steps per second, to

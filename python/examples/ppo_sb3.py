@@ -5,7 +5,7 @@ each robot's action comes from its own state alone, through the same layers, so 
 is a table over hashed states, exactly what a robot looks up; the critic sees every robot's features
 (the reward is the world's). Exploration is consistent in time, as in marl_ppo.py: each world acts
 on its own draw of the policy (Gumbel noise fixed per world, robot and state), redrawn every few
-rollouts; SB3 would sample every discrete action afresh, which learns nothing here (docs/python.md).
+rollouts; SB3 would sample every discrete action afresh, which learns nothing here (docs/python-results.md).
 VecMonitor measures each episode's return and last Eval; they are logged as CleanRL logs them, with
 each evaluation, to out/runs/RUN/scalars.csv and to TensorBoard when it is installed (run_log.py), and SB3
 prints its table every rollout. Every 100,000 steps the greedy table runs on one evaluation world, and

@@ -18,7 +18,7 @@ naming) holds:
 
 :func:`evaluate` runs a greedy table on the evaluation seeds (1001 to
 1010, none of them a training seed), as ``python/benchmarks/learning.py``
-measures the tables of docs/python.md.
+measures the tables of docs/python-results.md.
 """
 
 from __future__ import annotations

@@ -1,6 +1,8 @@
-"""docs/python.md shows the examples that run and the figures that were
-measured: the example files verbatim, and the throughput table rendered
-from the results file of the benchmark (python/benchmarks/throughput.py)."""
+"""The Python pages show the examples that run and the figures that were
+measured: docs/python-examples.md the example files verbatim,
+docs/python-results.md the learning tables rendered from their results
+files, docs/performance.md the throughput table rendered from the results
+file of the benchmark (python/benchmarks/throughput.py)."""
 
 import argparse
 import importlib.util
@@ -18,23 +20,22 @@ def benchmark(repo, name):
 
 
 def test_the_examples_in_the_docs_are_the_example_files(repo):
-    doc = (repo / "docs" / "python.md").read_text()
+    doc = (repo / "docs" / "python-examples.md").read_text()
     for name in ["tabular_q.py", "ppo_sb3.py"]:
         code = (repo / "python" / "examples" / name).read_text()
-        assert f"```python\n{code}```" in doc, f"docs/python.md does not show python/examples/{name} as it is"
+        assert f"```python\n{code}```" in doc, f"docs/python-examples.md does not show python/examples/{name} as it is"
 
 
-def test_the_throughput_tables_are_rendered_from_the_measured_results(repo):
+def test_the_throughput_table_is_rendered_from_the_measured_results(repo):
     throughput = benchmark(repo, "throughput")
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
-    for doc in ["python.md", "performance.md"]:
-        assert table in (repo / "docs" / doc).read_text(), f"docs/{doc} does not hold the rendered table"
+    assert table in (repo / "docs" / "performance.md").read_text(), "docs/performance.md does not hold the rendered table"
 
 
 def test_the_learning_table_is_rendered_from_the_measured_results(repo):
     learning = benchmark(repo, "learning")
     table = learning.render(json.loads((repo / "docs" / "python-learning.json").read_text()))
-    assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered learning table"
+    assert table in (repo / "docs" / "python-results.md").read_text(), "docs/python-results.md does not hold the rendered learning table"
 
 
 def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results(repo):
@@ -58,7 +59,7 @@ def test_what_the_docs_say_of_the_learning_figures_holds_in_the_measured_results
 def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
     learning = benchmark(repo, "learning")
     results = json.loads((repo / "docs" / "python-learning-1m.json").read_text())
-    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    assert learning.render(results) in (repo / "docs" / "python-results.md").read_text()
     assert results["budget_steps"] <= 1_000_000 and len(results["eval_seeds"]) == 10
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
     still, random = by[("robots standing still", None)], by[("random actions", None)]
@@ -75,7 +76,7 @@ def test_the_million_step_learning_table_is_rendered_and_what_the_docs_say_of_it
 def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
     learning = benchmark(repo, "learning")
     results = json.loads((repo / "docs" / "python-learning-q.json").read_text())
-    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    assert learning.render(results) in (repo / "docs" / "python-results.md").read_text()
     by = {(r["learner"].split(" (")[0], r["reward"]): r for r in results["rows"]}
     still, random = by[("robots standing still", None)], by[("random actions", None)]
     tabular, shared = by[("tabular Q", "reference")], by[("shared Q-network", "reference")]
@@ -88,7 +89,7 @@ def test_the_multi_agent_learning_table_is_rendered_and_what_the_docs_say_of_it_
 def test_the_exploration_table_is_rendered_and_what_the_docs_say_of_it_holds(repo):
     learning = benchmark(repo, "learning")
     results = json.loads((repo / "docs" / "python-learning-exploration.json").read_text())
-    assert learning.render(results) in (repo / "docs" / "python.md").read_text()
+    assert learning.render(results) in (repo / "docs" / "python-results.md").read_text()
     rows = {r["learner"]: r for r in results["rows"]}
     greedy = rows["tabular Q (tabular_q.py)"]
     variant = lambda initial_q, epsilon: rows[f"tabular Q (tabular_q.py), initial Q {initial_q}, epsilon {epsilon}"]

@@ -1,5 +1,5 @@
 """A tabular Q-learner written in Python over the environment (the
-example of docs/python.md) forms an annulus within a step budget in which
+example of docs/python-examples.md) forms an annulus within a step budget in which
 random actions form none."""
 
 import sys

@@ -15,7 +15,7 @@ dependency of this package)::
 ``torch.set_num_threads(1)`` first: PyTorch's default, a thread per core,
 contends with the worlds' threads for every core, and a small network
 gains nothing from them (without it this example ran 13 times slower on
-2 cores, docs/python.md).
+2 cores, docs/python-examples.md).
 
 SB3 resets an environment in the step that ends its episode and puts the
 last observation in ``infos[i]["terminal_observation"]``: the adapter runs

@@ -1,199 +1,95 @@
-//! Each shape of the TV's report takes its puck count
-//! (`sim::scenario::shape_pucks`): pucks placed with every centre on the
-//! shape reach the success Eval, and one more puck (up to the arena's 12)
-//! placed the same way does not.
-//!
-//! The arrangement: the candidate centres of a half-unit grid over the
-//! floor, a puck's radius from the walls, in order of their distance from
-//! the shape's band (`thresholds`; on a letter `1 - value`, so the
-//! brightest first), each kept if it does not overlap a puck kept before.
-//! "On the shape": inside the band on the annulus, a field value of at
-//! least [`ON_A_LETTER`] on a letter.
+//! The puck rule (`sim::scenario::puck_rule`) gives every shape of the
+//! published results on the TV (`tv75`) the count those results were run
+//! with, places that count on the shape reaching success and one more (up
+//! to the arena's 12) not, and refuses a shape too small for six pucks.
 
-use sim::base::vec2::Vec2;
-use sim::config::Thresholds;
-use sim::episodes::eval::eval;
 use sim::fields::source::FieldSource;
-use sim::scenario::shape_pucks::{training_shapes, turned_shapes, tv_pucks, tv_shapes};
-use sim::scenario::{arena::ArenaSpec, Arena, Scenario};
-use sim::world::World;
+use sim::scenario::arena::ArenaSpec;
+use sim::scenario::puck_rule::{rule_pucks, Placement, PuckRuleError, LEAST_PUCKS};
+use sim::scenario::Arena;
 
-/// The least field value of a letter's shape (the letters' fields fall off
-/// from 1 on the stroke).
-const ON_A_LETTER: f32 = 0.8;
+/// The counts the published trials and tables were run with, by shape: the
+/// TV's report (the annulus, the thesis' T, L, V, X and Z, our I), our T,
+/// L and X, and our T and L turned or mirrored.
+const PUBLISHED: [(&str, usize); 14] = [
+    ("annulus", 12),
+    ("thesis:T", 12),
+    ("thesis:L", 12),
+    ("thesis:V", 12),
+    ("thesis:X", 12),
+    ("thesis:Z", 12),
+    ("letter:I", 11),
+    ("letter:T", 10),
+    ("letter:L", 12),
+    ("letter:X", 12),
+    ("letter:T@rot90", 9),
+    ("letter:T@rot180", 10),
+    ("letter:L@mirror", 12),
+    ("letter:L@rot180", 12),
+];
 
-/// How far a value lies from the band `[T_o, T_i]`.
-fn band_distance(v: f32, t: &Thresholds) -> f64 {
-    let v = f64::from(v);
-    (t.outie - v).max(v - t.innie).max(0.0)
+fn tv() -> Arena {
+    Arena::Screen(Box::new(ArenaSpec::tv75()))
 }
 
-/// `n` pucks placed on `field` on the TV: their Eval, the success Eval,
-/// and whether every centre is on the shape.
-fn placed(field: &FieldSource, n: usize) -> (f64, f64, bool) {
-    let scenario = Scenario {
-        field: field.clone(),
-        arena: Arena::Screen(Box::new(ArenaSpec::tv75())),
-        pucks: Some(n),
-        ..Scenario::default()
-    };
-    let prepared = scenario.prepare().unwrap();
-    let c = prepared.config();
-    let (layout, shape, t) = (c.world.field_layout(), prepared.field(), &c.thresholds);
-    let r = c.world.puck_radius;
-    let mut candidates = Vec::new();
-    let (mut y, step) = (r, 0.5);
-    while y <= c.world.arena_height - r {
-        let mut x = r;
-        while x <= c.world.arena_width - r {
-            let p = Vec2::new(x, y);
-            candidates.push((shape.evaluate(p, &layout), p));
-            x += step;
-        }
-        y += step;
-    }
-    // stable: equal distances keep the grid's order
-    candidates.sort_by(|a, b| band_distance(a.0, t).total_cmp(&band_distance(b.0, t)));
-    let mut kept: Vec<(f32, Vec2)> = Vec::new();
-    for (v, p) in candidates {
-        if kept.len() == n {
-            break;
-        }
-        if kept.iter().all(|(_, q)| (p - *q).length() >= 2.0 * r) {
-            kept.push((v, p));
+#[test]
+fn every_published_shape_gets_the_count_its_results_were_run_with() {
+    let wrong: Vec<String> = PUBLISHED
+        .iter()
+        .filter_map(|&(name, published)| {
+            let field: FieldSource = name.parse().unwrap();
+            let n = rule_pucks(&field, &tv()).unwrap();
+            (n != published).then(|| format!("{name}: rule {n}, published {published}"))
+        })
+        .collect();
+    assert!(wrong.is_empty(), "{wrong:?}");
+}
+
+#[test]
+fn the_count_reaches_success_on_the_shape_and_one_more_puck_does_not() {
+    for &(name, n) in &PUBLISHED {
+        let placement = Placement::new(&name.parse().unwrap(), &tv()).unwrap();
+        assert_eq!(placement.cap, 12);
+        assert!(placement.reaches_success(n), "{name} with {n} pucks");
+        if n < placement.cap {
+            assert!(!placement.reaches_success(n + 1), "{name} with {}", n + 1);
         }
     }
-    assert_eq!(kept.len(), n, "{field}: room for {} pucks only", kept.len());
-    let on_shape = kept.iter().all(|&(v, _)| {
-        if *field == FieldSource::Annulus {
-            band_distance(v, t) == 0.0
-        } else {
-            v >= ON_A_LETTER
-        }
+}
+
+#[test]
+fn an_image_gets_a_count_by_the_same_rule_as_a_letter() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bar.png");
+    // a bright horizontal bar across the middle of a dark image
+    let img = image::GrayImage::from_fn(64, 64, |_, y| {
+        image::Luma([if (24..40).contains(&y) { 255 } else { 0 }])
     });
-    let pucks: Vec<Vec2> = kept.iter().map(|&(_, p)| p).collect();
-    let world = World::scene(c, &[], &pucks, 1);
-    (eval(&world, shape, t), c.episode.success_eval, on_shape)
-}
-
-/// `field`'s count reaches success with every puck on the shape; one more
-/// does not, unless the count is already the arena's 12.
-fn check(field: &str) {
-    let field: FieldSource = field.parse().unwrap();
-    let n = tv_pucks(&field).unwrap();
-    assert!((6..=12).contains(&n), "{field}: {n}");
-    let (e, success, on_shape) = placed(&field, n);
-    assert!(on_shape, "{field}: a puck's centre is off the shape");
-    assert!(e > success, "{field} with {n} pucks: Eval {e} <= {success}");
-    if n < 12 {
-        let (e, success, _) = placed(&field, n + 1);
-        assert!(e <= success, "{field} with {} pucks: Eval {e}", n + 1);
-    }
+    img.save(&path).unwrap();
+    let field = FieldSource::Image(path);
+    let n = rule_pucks(&field, &tv()).unwrap();
+    assert!((LEAST_PUCKS..=12).contains(&n), "{n}");
+    assert!(Placement::new(&field, &tv()).unwrap().reaches_success(n));
 }
 
 #[test]
-fn twelve_pucks_on_the_annulus_reach_success() {
-    check("annulus");
+fn a_shape_too_small_for_six_pucks_is_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dot.png");
+    // one bright pixel: room on the shape for hardly a puck
+    let img = image::GrayImage::from_fn(64, 64, |x, y| {
+        image::Luma([if (x, y) == (32, 32) { 255 } else { 0 }])
+    });
+    img.save(&path).unwrap();
+    let field = FieldSource::Image(path);
+    let e = rule_pucks(&field, &tv()).unwrap_err();
+    assert!(matches!(e, PuckRuleError::TooFew { most, .. } if most < LEAST_PUCKS));
+    assert!(e.to_string().contains("dot.png"), "{e}");
 }
 
 #[test]
-fn twelve_pucks_on_the_thesis_t_reach_success() {
-    check("thesis:T");
-}
-
-#[test]
-fn twelve_pucks_on_the_thesis_l_reach_success() {
-    check("thesis:L");
-}
-
-#[test]
-fn twelve_pucks_on_the_thesis_v_reach_success() {
-    check("thesis:V");
-}
-
-#[test]
-fn twelve_pucks_on_the_thesis_x_reach_success() {
-    check("thesis:X");
-}
-
-#[test]
-fn twelve_pucks_on_the_thesis_z_reach_success() {
-    check("thesis:Z");
-}
-
-#[test]
-fn eleven_pucks_on_our_i_reach_success_and_twelve_do_not() {
-    check("letter:I");
-}
-
-#[test]
-fn ten_pucks_on_our_t_reach_success_and_eleven_do_not() {
-    check("letter:T");
-}
-
-#[test]
-fn twelve_pucks_on_our_l_reach_success() {
-    check("letter:L");
-}
-
-#[test]
-fn twelve_pucks_on_our_x_reach_success() {
-    check("letter:X");
-}
-
-#[test]
-fn nine_pucks_on_our_t_turned_a_quarter_reach_success_and_ten_do_not() {
-    check("letter:T@rot90");
-}
-
-#[test]
-fn ten_pucks_on_our_t_upside_down_reach_success_and_eleven_do_not() {
-    check("letter:T@rot180");
-}
-
-#[test]
-fn twelve_pucks_on_our_l_mirrored_reach_success() {
-    check("letter:L@mirror");
-}
-
-#[test]
-fn twelve_pucks_on_our_l_upside_down_reach_success() {
-    check("letter:L@rot180");
-}
-
-#[test]
-fn every_shape_searched_on_but_not_reported_is_checked_above() {
-    let names: Vec<String> = training_shapes().map(|(f, _)| f.to_string()).collect();
-    assert_eq!(names, ["letter:T", "letter:L", "letter:X"]);
-    let names: Vec<String> = turned_shapes().map(|(f, _)| f.to_string()).collect();
-    assert_eq!(
-        names,
-        [
-            "letter:T@rot90",
-            "letter:T@rot180",
-            "letter:L@mirror",
-            "letter:L@rot180"
-        ]
-    );
-}
-
-#[test]
-fn every_shape_of_the_report_is_checked_above() {
-    let names: Vec<String> = tv_shapes().map(|(f, _)| f.to_string()).collect();
-    assert_eq!(
-        names,
-        ["annulus", "thesis:T", "thesis:L", "thesis:V", "thesis:X", "thesis:Z", "letter:I"]
-    );
-}
-
-#[test]
-fn the_policy_search_page_gives_every_count() {
-    let page = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/policy-search.md"),
-    )
-    .unwrap();
-    for (field, pucks) in tv_shapes().chain(training_shapes()).chain(turned_shapes()) {
-        let row = format!("| {field} | {pucks} |");
-        assert!(page.contains(&row), "docs/policy-search.md lacks {row}");
-    }
+fn a_field_that_cannot_be_loaded_is_an_error_naming_it() {
+    let field = FieldSource::Image("no-such-image.png".into());
+    let e = rule_pucks(&field, &tv()).unwrap_err();
+    assert!(e.to_string().contains("no-such-image.png"), "{e}");
 }

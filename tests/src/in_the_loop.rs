@@ -35,7 +35,7 @@ use crate::zumo::Zumo;
 use anyhow::{bail, Context, Result};
 use host::robot::replay::decisions::DecisionCheck;
 use host::run_summary::RunSummary;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use shared::{LogFrame, MotorCommand, PolicyBlob, RobotProfile, Role, RunMode, State};
 use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::scenario::Scenario;
@@ -132,6 +132,60 @@ struct Firmware<'p> {
     pending: VecDeque<(u32, MotorCommand, State)>,
     /// The tick of the last decision.
     tick: u64,
+    /// Its cycle markers' spans so far.
+    marks: MarkTally,
+}
+
+/// A sum of cycle spans and their number.
+#[derive(Clone, Copy, Debug, Default)]
+struct Tally {
+    sum: u64,
+    n: u64,
+}
+
+impl Tally {
+    fn mean(self) -> f64 {
+        self.sum as f64 / self.n.max(1) as f64
+    }
+}
+
+/// The spans between one robot's cycle markers, fed in order as they
+/// arrive (the markers themselves are dropped): from each marker `from`
+/// to the next `to` for sensing (4 to 1), deciding (1 to 2) and logging
+/// (2 to 3), as `Zumo`'s span methods measure them, and between
+/// consecutive period starts (4).
+#[derive(Clone, Debug, Default)]
+struct MarkTally {
+    open: [Option<u64>; 3],
+    spans: [Tally; 3],
+    last_start: Option<u64>,
+    periods: Tally,
+}
+
+impl MarkTally {
+    /// The (from, to) markers of `spans`: sensing, deciding, logging.
+    const SPANS: [(u8, u8); 3] = [(4, 1), (1, 2), (2, 3)];
+
+    fn feed(&mut self, marks: &[(u8, u64)]) {
+        for &(v, cycle) in marks {
+            for (k, (from, to)) in Self::SPANS.into_iter().enumerate() {
+                if v == from {
+                    self.open[k] = Some(cycle);
+                } else if v == to {
+                    if let Some(start) = self.open[k].take() {
+                        self.spans[k].sum += cycle - start;
+                        self.spans[k].n += 1;
+                    }
+                }
+            }
+            if v == 4 {
+                if let Some(last) = self.last_start.replace(cycle) {
+                    self.periods.sum += cycle - last;
+                    self.periods.n += 1;
+                }
+            }
+        }
+    }
 }
 
 /// The counters of a closed-loop run, beside `host run`'s summary.
@@ -157,6 +211,10 @@ pub struct LoopCounts {
     /// Periods whose forward speed from the pins differs from the world's
     /// by more than one motor command step.
     pub forward_mismatches: u64,
+    /// CPU cycles of the busy wait fast-forwarded rather than simulated
+    /// instruction by instruction (`Zumo::skip_waits`), summed over the
+    /// robots; part of `avr_cycles`.
+    pub cycles_skipped: u64,
 }
 
 /// What `in-the-loop --json` prints: `host run`'s summary and the loop's
@@ -199,6 +257,8 @@ pub struct CycleBudget {
     pub logging: f64,
     /// The rest: waiting for the next period.
     pub waiting: f64,
+    /// Of the waiting, the cycles fast-forwarded (not simulated).
+    pub waiting_skipped: f64,
 }
 
 /// N firmware instances driving the simulated world.
@@ -213,6 +273,8 @@ pub struct InTheLoop<'p> {
     fixed: Option<Stimulus>,
     /// Wall time spent stepping the world.
     world_seconds: f64,
+    /// Every log frame checked, with its robot's id, if recording.
+    recorded: Option<Vec<(u8, LogFrame)>>,
 }
 
 /// A stimulus held fixed: RC delays in CPU cycles and a camera frame.
@@ -244,6 +306,7 @@ impl<'p> InTheLoop<'p> {
             zumo.set_robot_id(id)?;
             zumo.run_ms(40);
             calibrate_and_drive(&mut zumo, model, latency_us);
+            zumo.skip_waits(true);
             let tick = zumo.decisions();
             robots.push(Firmware {
                 zumo,
@@ -252,6 +315,7 @@ impl<'p> InTheLoop<'p> {
                 check: DecisionCheck::new(policy),
                 pending: VecDeque::new(),
                 tick,
+                marks: MarkTally::default(),
             });
         }
         let mut run = InTheLoop {
@@ -263,6 +327,7 @@ impl<'p> InTheLoop<'p> {
             counts: LoopCounts::default(),
             fixed: None,
             world_seconds: 0.0,
+            recorded: None,
         };
         run.check_frames()?;
         Ok(run)
@@ -281,6 +346,26 @@ impl<'p> InTheLoop<'p> {
     /// The counters so far.
     pub fn counts(&self) -> &LoopCounts {
         &self.counts
+    }
+
+    /// Whether the firmwares' busy waits are fast-forwarded (the default;
+    /// `Zumo::skip_waits`) or simulated cycle by cycle.
+    pub fn skip_waits(&mut self, on: bool) {
+        for r in &mut self.robots {
+            r.zumo.skip_waits(on);
+        }
+    }
+
+    /// Keeps every log frame checked from now on, with its robot's id
+    /// ([`InTheLoop::recorded_frames`]).
+    pub fn record_frames(&mut self) {
+        self.recorded.get_or_insert_with(Vec::new);
+    }
+
+    /// The frames kept since [`InTheLoop::record_frames`], in the order
+    /// checked.
+    pub fn recorded_frames(&self) -> &[(u8, LogFrame)] {
+        self.recorded.as_deref().unwrap_or(&[])
     }
 
     /// Gives every robot `stimulus` from now on instead of what its
@@ -345,6 +430,7 @@ impl<'p> InTheLoop<'p> {
         self.check_frames()?;
         let seconds = start.elapsed().as_secs_f64();
         self.counts.avr_cycles = self.robots.iter().map(|r| r.zumo.cycles()).sum();
+        self.counts.cycles_skipped = self.robots.iter().map(|r| r.zumo.cycles_skipped()).sum();
         let cycles = self.cycle_budget();
         let c = &self.counts;
         let share = |n: u64| {
@@ -367,13 +453,15 @@ impl<'p> InTheLoop<'p> {
 
     /// Mean cycles per period over every robot's periods since boot.
     fn cycle_budget(&self) -> CycleBudget {
-        let (mut period, mut sensing, mut decision, mut logging) = (0.0, 0.0, 0.0, 0.0);
-        let mean = |v: Vec<u64>| v.iter().sum::<u64>() as f64 / v.len().max(1) as f64;
+        let (mut period, mut sensing, mut decision, mut logging, mut skipped) =
+            (0.0, 0.0, 0.0, 0.0, 0.0);
         for r in &self.robots {
-            period += mean(r.zumo.period_cycles());
-            sensing += mean(r.zumo.sensing_cycles());
-            decision += mean(r.zumo.decision_cycles());
-            logging += mean(r.zumo.logging_cycles());
+            let m = &r.marks;
+            period += m.periods.mean();
+            sensing += m.spans[0].mean();
+            decision += m.spans[1].mean();
+            logging += m.spans[2].mean();
+            skipped += r.zumo.cycles_skipped() as f64 / m.periods.n.max(1) as f64;
         }
         let n = self.robots.len().max(1) as f64;
         CycleBudget {
@@ -382,14 +470,23 @@ impl<'p> InTheLoop<'p> {
             decision: decision / n,
             logging: logging / n,
             waiting: (period - sensing - decision - logging) / n,
+            waiting_skipped: skipped / n,
         }
     }
 
-    /// Checks every log frame that arrived since the last call.
+    /// Checks every log frame that arrived since the last call, then drops
+    /// the checked serial bytes and tallies and drops the cycle markers (a
+    /// long run's memory stays bounded).
     fn check_frames(&mut self) -> Result<()> {
         for r in &mut self.robots {
-            for frame in r.zumo.frames() {
+            r.marks.feed(&r.zumo.take_marks());
+            let frames = r.zumo.frames();
+            r.zumo.forget_frames();
+            for frame in frames {
                 let f = frame.map_err(|e| anyhow::anyhow!("robot {}: a log frame: {e}", r.id))?;
+                if let Some(recorded) = &mut self.recorded {
+                    recorded.push((r.id, f));
+                }
                 let consistent = r.check.frame(0, &f).stages.is_empty();
                 while r.pending.front().is_some_and(|p| p.0 < f.tick) {
                     r.pending.pop_front();
@@ -404,6 +501,158 @@ impl<'p> InTheLoop<'p> {
         }
         Ok(())
     }
+}
+
+/// One published run (an element of `docs/in-the-loop-runs.json`'s
+/// array): the settings it ran with (`field`, `policy`, `seed`; the others
+/// are ignored here) and what `in-the-loop --json --compare` printed.
+#[derive(Clone, Debug, Deserialize)]
+pub struct PublishedRun {
+    /// `--field`.
+    pub field: String,
+    /// `--policy`.
+    pub policy: String,
+    /// `--seed`.
+    pub seed: u64,
+    /// Steps run.
+    pub steps: u64,
+    /// Formations in the loop.
+    pub formations: u64,
+    /// Periods played.
+    pub periods: u64,
+    /// Periods whose turn came from the pins.
+    pub periods_from_pins: u64,
+    /// Share of consistent decisions.
+    pub decisions_consistent: f64,
+    /// Share of states agreeing with the model's.
+    pub state_agreement: f64,
+    /// Wall-clock speed.
+    pub periods_per_second: f64,
+    /// CPU cycles simulated.
+    pub avr_cycles: u64,
+    /// CPU cycles fast-forwarded (absent: none).
+    #[serde(default)]
+    pub cycles_skipped: u64,
+    /// Where a period's cycles went.
+    pub cycles: CyclesOfRun,
+    /// `host run`'s summary of the same steps and seed (`None`: run
+    /// without `--compare`).
+    pub simulator: Option<SimulatorRun>,
+}
+
+/// A published run's [`CycleBudget`] (`waiting_skipped` absent: 0).
+#[derive(Clone, Debug, Deserialize)]
+pub struct CyclesOfRun {
+    /// Cycles of a period.
+    pub period: f64,
+    /// Sensing.
+    pub sensing: f64,
+    /// Deciding.
+    pub decision: f64,
+    /// Logging.
+    pub logging: f64,
+    /// Waiting.
+    pub waiting: f64,
+    /// Of the waiting, fast-forwarded.
+    #[serde(default)]
+    pub waiting_skipped: f64,
+}
+
+/// The part of `host run`'s summary a published run's table shows.
+#[derive(Clone, Debug, Deserialize)]
+pub struct SimulatorRun {
+    /// Formations.
+    pub formations: u64,
+}
+
+/// The tables `docs/in-the-loop.md` shows of the published runs (the
+/// JSON array of [`PublishedRun`]): each run's formations, checks and
+/// speed, a sum row per policy and field of more than one run, then each
+/// run's cycles.
+pub fn runs_tables(json: &str) -> Result<String> {
+    let runs: Vec<PublishedRun> =
+        serde_json::from_str(json).context("the published runs are not a JSON array of runs")?;
+    let k = crate::figures::thousands;
+    let stem = |p: &str| {
+        Path::new(p)
+            .file_stem()
+            .map_or(p.to_string(), |s| s.to_string_lossy().into_owned())
+    };
+    let mut out = vec![
+        "| policy | field | seed | steps | formations (loop) | formations (`host run`) | decisions consistent | state agreement | periods from the pins | periods per second |".to_string(),
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |".to_string(),
+    ];
+    // Per policy and field: runs, steps, formations in the loop and in
+    // `host run` (`None` once a run was not compared).
+    let mut groups: Vec<(String, String, u64, u64, u64, Option<u64>)> = Vec::new();
+    for r in &runs {
+        let host = r.simulator.as_ref().map(|s| s.formations);
+        out.push(format!(
+            "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} | {} of {} | {:.0} |",
+            stem(&r.policy),
+            r.field,
+            r.seed,
+            k(r.steps),
+            r.formations,
+            host.map_or(String::new(), |f| f.to_string()),
+            r.decisions_consistent,
+            r.state_agreement,
+            k(r.periods_from_pins),
+            k(r.periods),
+            r.periods_per_second
+        ));
+        let key = (stem(&r.policy), r.field.clone());
+        let i = match groups.iter().position(|g| (&g.0, &g.1) == (&key.0, &key.1)) {
+            Some(i) => i,
+            None => {
+                groups.push((key.0, key.1, 0, 0, 0, Some(0)));
+                groups.len() - 1
+            }
+        };
+        let g = &mut groups[i];
+        g.2 += 1;
+        g.3 += r.steps;
+        g.4 += r.formations;
+        g.5 = g.5.zip(host).map(|(a, b)| a + b);
+    }
+    let summed = groups.into_iter().filter(|g| g.2 > 1);
+    for (policy, field, runs, steps, loop_formations, host_formations) in summed {
+        let (host, ratio) = match host_formations {
+            Some(h) => (
+                h.to_string(),
+                format!("ratio {:.2}", loop_formations as f64 / h.max(1) as f64),
+            ),
+            None => (String::new(), String::new()),
+        };
+        out.push(format!(
+            "| {policy} | {field}: sum | {runs} runs | {} | {loop_formations} | {host} | | | | {ratio} |",
+            k(steps)
+        ));
+    }
+    out.push(String::new());
+    out.push("| policy | field | seed | AVR cycles | fast-forwarded | period | sensing | deciding | logging | waiting | of it fast-forwarded |".to_string());
+    out.push(
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |".to_string(),
+    );
+    for r in &runs {
+        let c = &r.cycles;
+        let n = |x: f64| k(x.round() as u64);
+        out.push(format!(
+            "| {} | {} | {} | {} | {:.0} % | {} | {} | {} | {} | {} | {} |",
+            stem(&r.policy),
+            r.field,
+            r.seed,
+            k(r.avr_cycles),
+            100.0 * r.cycles_skipped as f64 / r.avr_cycles.max(1) as f64,
+            n(c.period),
+            n(c.sensing),
+            n(c.decision),
+            n(c.logging),
+            n(c.waiting),
+            n(c.waiting_skipped)
+        ));
+    }
+    Ok(out.join("\n"))
 }
 
 /// Counts one played period's frame.

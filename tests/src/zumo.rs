@@ -14,6 +14,7 @@
 //! throwaway load, catches every later core's handle (see `load`).
 
 use avr_tester::{AvrTester, TwiPacket};
+use firmware::config::{PERIOD_TICKS, USB_QUIET_TICKS};
 use firmware::pins::{self, Pin, Port, PIXY_ADDRESS};
 use shared::{LogError, LogFrame, PixyBlock};
 use simavr_ffi as ffi;
@@ -53,6 +54,17 @@ const PORTD: usize = 0x2B;
 const PORTF: usize = 0x31;
 /// How long after a sensor pin becomes an input its pull-up must be off, cycles.
 const PULLUP_CHECK_CYCLES: u64 = 32;
+/// TCNT3L (then TCNT3H) in data memory: simavr writes the count there at
+/// each read (a cache of the last read; the timer's state is the cycle
+/// counter).
+const TCNT3_AT: usize = 0x94;
+/// Ticks before the earliest end of the wait's USB loop that a skip stops
+/// at (see [`Zumo::skip_waits`]).
+const SKIP_MARGIN_TICKS: u64 = 8;
+/// Instructions one iteration of an idle loop may take.
+const LOOP_MAX_INSTRUCTIONS: u32 = 4096;
+/// Tries to find an idle loop in one period's wait.
+const SKIP_TRIES: u32 = 256;
 
 /// Pixy (CMUcam5) protocol words (`../shared/docs/hardware.md` section 5):
 /// a normal block's sync, a colour-code block's sync, a sync read one
@@ -419,6 +431,10 @@ struct State {
     avr: *mut ffi::avr_t,
     uart: Vec<u8>,
     marks: Vec<(u8, u64)>,
+    /// The last marker written.
+    last_mark: u8,
+    /// The cycle of the last period-start marker (4).
+    period_start: Option<u64>,
     /// Decision-end markers seen.
     decisions: u64,
     /// The bootloader key (SRAM 0x0800) at each start-up that followed a
@@ -450,6 +466,10 @@ unsafe extern "C" fn on_gpior0(
         *(*avr).data.add(usize::from(addr)) = v;
         let state = &mut *(param as *mut State);
         state.marks.push((v, (*avr).cycle));
+        state.last_mark = v;
+        if v == 4 {
+            state.period_start = Some((*avr).cycle);
+        }
         state.decisions += u64::from(v == 2);
     }
 }
@@ -574,6 +594,15 @@ pub struct Zumo {
     /// What simavr's callbacks registered by other modules point to
     /// (`usb_host`'s background host), dropped after the core.
     kept: Vec<Box<dyn std::any::Any>>,
+    /// Whether [`Zumo::run_to_decision`] fast-forwards the period's wait.
+    skip_waits: bool,
+    /// The period (its start marker's cycle) whose wait was skipped or
+    /// given up on.
+    skipped_period: Option<u64>,
+    /// Cycles fast-forwarded.
+    cycles_skipped: u64,
+    /// The data space at the start of a candidate idle loop's iteration.
+    snapshot: Vec<u8>,
 }
 
 impl Zumo {
@@ -601,6 +630,8 @@ impl Zumo {
             avr,
             uart: Vec::new(),
             marks: Vec::new(),
+            last_mark: 0,
+            period_start: None,
             decisions: 0,
             watchdog_resets: Vec::new(),
             ddr: [0; 2],
@@ -706,6 +737,10 @@ impl Zumo {
             decoded: 0,
             pullup_on,
             kept: Vec::new(),
+            skip_waits: false,
+            skipped_period: None,
+            cycles_skipped: 0,
+            snapshot: Vec::new(),
         };
         zumo.tester
             .twi0()
@@ -920,7 +955,13 @@ impl Zumo {
         // SAFETY: the core is live while `self` is.
         let deadline = unsafe { (*self.state.avr).cycle } + CLOCK_HZ / 10;
         while self.state.decisions == before {
-            self.tester.run();
+            if self.skip_waits
+                && self.state.last_mark == 3
+                && self.skipped_period != self.state.period_start
+            {
+                self.skip_wait();
+            }
+            self.step();
             // SAFETY: as above.
             assert!(
                 unsafe { (*self.state.avr).cycle } < deadline,
@@ -928,6 +969,127 @@ impl Zumo {
             );
         }
         self.state.decisions
+    }
+
+    /// Runs one instruction, then the cycle timers and interrupts due, with
+    /// simavr's own stepping: what `AvrTester::run` does, without its
+    /// per-instruction bookkeeping (UART flushes and async components,
+    /// none of which a `Zumo` uses). Panics if the core stops running
+    /// (crashed, or asleep: nothing here wakes it).
+    fn step(&mut self) {
+        let avr = self.state.avr;
+        // SAFETY: the core is live; simavr steps it on this thread.
+        let state = unsafe {
+            ffi::avr_run(avr);
+            (*avr).state
+        };
+        assert!(
+            state == ffi::cpu_Running as c_int,
+            "the AVR stopped running (simavr state {state}: crashed or asleep)"
+        );
+    }
+
+    /// Makes [`Zumo::run_to_decision`] fast-forward the firmware's busy
+    /// wait for the next period instead of simulating it cycle by cycle,
+    /// without changing what the firmware computes. After a period's log
+    /// frame (marker 3), it looks for an idle loop: from some instruction,
+    /// one pass that comes back to it with the data space (registers, I/O,
+    /// SRAM) and the status flags as they were, but for the Timer3 count
+    /// simavr caches at each read. Each further pass would then do the
+    /// same as long as the count it reads does not end the wait and no
+    /// simavr cycle timer (the peripherals, the emulated sensors) fires
+    /// and no interrupt is pending; so the cycle counter is advanced by
+    /// whole passes, up to the earlier of the next cycle timer and
+    /// [`SKIP_MARGIN_TICKS`] before the earliest tick at which the wait's
+    /// USB loop can end (its period started at most two ticks before its
+    /// start marker, and the loop ends [`USB_QUIET_TICKS`] before the
+    /// period's [`PERIOD_TICKS`]). The rest of the wait runs as before.
+    pub fn skip_waits(&mut self, on: bool) {
+        self.skip_waits = on;
+    }
+
+    /// CPU cycles fast-forwarded by [`Zumo::skip_waits`] since boot.
+    pub fn cycles_skipped(&self) -> u64 {
+        self.cycles_skipped
+    }
+
+    /// The data space, compared for an idle loop's pass (the Timer3 count
+    /// cache aside).
+    fn data_space(&self) -> &[u8] {
+        // SAFETY: the core is live; its data space holds `RAM_END` bytes.
+        unsafe { std::slice::from_raw_parts((*self.state.avr).data, RAM_END) }
+    }
+
+    /// One fast-forward of the current period's wait (see [`Zumo::skip_waits`]).
+    fn skip_wait(&mut self) {
+        let avr = self.state.avr;
+        let period = self.state.period_start;
+        let Some(start) = period else {
+            self.skipped_period = period;
+            return;
+        };
+        let ticks = u64::from(PERIOD_TICKS - USB_QUIET_TICKS) - 2 - SKIP_MARGIN_TICKS;
+        let end = start + ticks * CYCLES_PER_TICK;
+        for _ in 0..SKIP_TRIES {
+            // SAFETY (this block's reads of the core): the core is live.
+            let (pc, sreg, from) = unsafe { ((*avr).pc, (*avr).sreg, (*avr).cycle) };
+            let mut snapshot = std::mem::take(&mut self.snapshot);
+            snapshot.clear();
+            snapshot.extend_from_slice(self.data_space());
+            let mut n = 0;
+            loop {
+                self.step();
+                n += 1;
+                // SAFETY: as above.
+                let back = unsafe { (*avr).pc } == pc;
+                if back || n == LOOP_MAX_INSTRUCTIONS || self.state.last_mark != 3 {
+                    break;
+                }
+            }
+            // SAFETY: as above.
+            let (now, same_flags, back) =
+                unsafe { ((*avr).cycle, (*avr).sreg == sreg, (*avr).pc == pc) };
+            let data = self.data_space();
+            let (low, high) = (TCNT3_AT, TCNT3_AT + 2);
+            let idle = back
+                && same_flags
+                && data[..low] == snapshot[..low]
+                && data[high..] == snapshot[high..];
+            self.snapshot = snapshot;
+            if self.state.last_mark != 3 {
+                break;
+            }
+            if !idle {
+                // Another instruction to start from: a register holding a
+                // dead value may differ at this one.
+                self.step();
+                continue;
+            }
+            // SAFETY: the core is live; the pool's head is its earliest timer.
+            let (next_timer, pending) = unsafe {
+                let head = (*avr).cycle_timers.timer;
+                let when = if head.is_null() {
+                    u64::MAX
+                } else {
+                    (*head).when
+                };
+                (when, ffi::avr_has_pending_interrupts(avr) != 0)
+            };
+            let pass = now - from;
+            let limit = end.min(next_timer.saturating_sub(1));
+            let passes = if pending {
+                0
+            } else {
+                limit.saturating_sub(now) / pass
+            };
+            if passes == 0 {
+                break;
+            }
+            // SAFETY: the core is live and between instructions.
+            unsafe { (*avr).cycle += passes * pass };
+            self.cycles_skipped += passes * pass;
+        }
+        self.skipped_period = period;
     }
 
     /// Decisions the firmware has ended since boot (the tick of its last
@@ -1045,10 +1207,25 @@ impl Zumo {
         None
     }
 
-    /// Every byte the firmware has sent on USART1 since boot: the raw
-    /// serial stream a host would receive (for the monitor and replay tests).
+    /// Every byte the firmware has sent on USART1 since boot (or since the
+    /// last [`Zumo::forget_frames`]): the raw serial stream a host would
+    /// receive (for the monitor and replay tests).
     pub fn uart_bytes(&self) -> &[u8] {
         &self.state.uart
+    }
+
+    /// Drops the serial bytes [`Zumo::frames`] has decoded, so that a
+    /// long run's stream does not grow without end.
+    pub fn forget_frames(&mut self) {
+        self.state.uart.drain(..self.decoded);
+        self.decoded = 0;
+    }
+
+    /// The cycle markers (GPIOR0 value, cycle) recorded since boot or the
+    /// last call, in order; the span methods ([`Zumo::period_cycles`] and
+    /// the others) see only markers recorded after it.
+    pub fn take_marks(&mut self) -> Vec<(u8, u64)> {
+        std::mem::take(&mut self.state.marks)
     }
 
     /// Log frames received since the last call, decoded with `shared`.

@@ -8,7 +8,9 @@
 //!   circles as the robot profile predicts;
 //! - a negative control: an ELF of another policy, checked against the
 //!   loop's policy, is inconsistent in most periods;
-//! - determinism per seed.
+//! - determinism per seed;
+//! - fast-forwarding the firmwares' busy waits changes nothing: the same
+//!   frames, counters and world as simulating every cycle.
 //!
 //! The ELFs come from `scripts/test`; a missing or stale one fails with
 //! the command that builds it.
@@ -19,11 +21,13 @@ use sim::sensors::robot::{RobotSensorConfig, RobotSensors};
 use tests::equivalence::{
     cycles_of_ticks, is_robust, read_policy, Expectation, Variant, EIGHT_BIT, ROLE,
 };
-use tests::in_the_loop::{InTheLoop, Stimulus, World};
+use tests::in_the_loop::{InTheLoop, LoopCounts, Stimulus, World};
 use tests::zumo::firmware_elf_in;
 
 /// Steps of the closed-loop episode.
 const EPISODE_STEPS: u64 = 600;
+/// Steps of the runs with and without the busy wait skipped.
+const SKIP_STEPS: u64 = 150;
 
 fn policy_of(v: &Variant) -> PolicyBlob {
     read_policy(v.policy).unwrap_or_else(|e| panic!("{e:#}")).1
@@ -192,3 +196,68 @@ fn a_closed_loop_run_is_determined_by_its_seed() {
     assert_eq!(a, b);
     assert_ne!(a.0, c.0);
 }
+
+#[test]
+fn skipping_the_busy_wait_changes_no_frame_counter_or_world() {
+    let policy = policy_of(&ROLE);
+    let elf = elf_of(&ROLE);
+    let scenario = annulus(3).scenario().unwrap();
+    let run_with = |skip: bool| {
+        let mut run = InTheLoop::new(&elf, &policy, &scenario).unwrap();
+        run.skip_waits(skip);
+        run.record_frames();
+        let s = run.run(SKIP_STEPS).unwrap();
+        let world = format!("{:?}", run.simulation().snapshot());
+        (s, run.recorded_frames().to_vec(), world)
+    };
+    let (skipped, skipped_frames, skipped_world) = run_with(true);
+    let (simulated, simulated_frames, simulated_world) = run_with(false);
+    println!(
+        "skipped {} of {} cycles; {:.0} against {:.0} periods per second",
+        skipped.counts.cycles_skipped,
+        skipped.counts.avr_cycles,
+        skipped.periods_per_second,
+        simulated.periods_per_second
+    );
+    assert_eq!(simulated.counts.cycles_skipped, 0);
+    assert!(
+        skipped.counts.cycles_skipped as f64
+            > 0.5 * skipped.cycles.period * skipped.counts.periods as f64,
+        "the wait is most of the cycles: {:?}",
+        skipped.counts
+    );
+    assert!(skipped_frames.len() as u64 >= 5 * SKIP_STEPS);
+    assert_eq!(skipped_frames, simulated_frames, "the same log frames");
+    assert_eq!(skipped_world, simulated_world, "the same world");
+    let unskipped = LoopCounts {
+        cycles_skipped: 0,
+        ..skipped.counts.clone()
+    };
+    assert_eq!(unskipped, simulated.counts, "the same counters and cycles");
+    assert_eq!(skipped.cycles.period, simulated.cycles.period);
+    assert_eq!(skipped.cycles.sensing, simulated.cycles.sensing);
+    assert_eq!(skipped.cycles.logging, simulated.cycles.logging);
+}
+
+#[test]
+fn the_docs_tables_of_the_runs_are_the_ones_the_runs_json_gives() {
+    let root = tests::figures::workspace();
+    let json = std::fs::read_to_string(root.join("docs/in-the-loop-runs.json")).unwrap();
+    let tables = tests::in_the_loop::runs_tables(&json).unwrap();
+    let doc = std::fs::read_to_string(root.join("docs/in-the-loop.md")).unwrap();
+    let (begin, end) = (RUNS_BEGIN, "<!-- in-the-loop-runs end -->");
+    let section = doc
+        .split_once(begin)
+        .and_then(|(_, rest)| rest.split_once(end))
+        .map(|(section, _)| section.trim())
+        .expect("docs/in-the-loop.md marks the runs' tables");
+    assert!(
+        section == tables,
+        "docs/in-the-loop.md's tables differ from docs/in-the-loop-runs.json's runs; between the \
+         markers it must read:\n{tables}"
+    );
+}
+
+/// The line before the runs' tables in `docs/in-the-loop.md`.
+const RUNS_BEGIN: &str = "<!-- in-the-loop-runs begin: generated from docs/in-the-loop-runs.json \
+                          by tests::in_the_loop::runs_tables (the test prints them); do not edit -->";

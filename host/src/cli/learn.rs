@@ -55,17 +55,17 @@ impl TrainArgs {
 /// `host search`'s options.
 #[derive(Clone, Debug, Args)]
 pub struct SearchArgs {
-    /// TOML file of a training config: the world searched in (docs/training.md);
-    /// flags override it.
+    /// TOML file of a training config: the world searched in (docs/training.md;
+    /// its missing keys a training config's defaults); flags override it.
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// The world's settings: a training config's fields but those only
-    /// training uses (the learner's hasher and actions, the field,
-    /// sensors, arena, counts, noise, seed, --out and --name).
-    #[command(flatten)]
+    /// the learner uses (the table's hasher, the field, sensors, arena,
+    /// counts, noise, seed, --out and --name).
+    #[command(flatten, next_help_heading = "The world searched in")]
     pub flags: FlagsOf<Search>,
     /// The search's settings.
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "The search")]
     pub search: SearchConfig,
 }
 
@@ -123,18 +123,55 @@ pub trait FlagUse {
     const HELPS: &'static [(&'static str, &'static str)];
 }
 
+/// The helps of `--sensors`, `--arena` and `--noise` where they default
+/// to the robot's on the TV at the default noise (`host search`, `host
+/// shape`).
+pub const ROBOT_WORLD_HELPS: [(&str, &str); 3] = [
+    (
+        "sensors",
+        "Sensor model: robot (the Zumo's photo-transistors and Pixy camera, through the firmware's arithmetic), robot:CONFIG.json, disc or disc-thesis (docs/robot-sensors.md) [default: robot]",
+    ),
+    (
+        "arena",
+        "The arena: tv75 (the thesis' 75\" TV lying flat), thesis (the reference model's square) or a FILE.toml of a screen arena [default: tv75]",
+    ),
+    (
+        "noise",
+        "Real-world noise in multiples of the default (0 none, 1 the default, 2 twice as much): the robots' motion and the robot senses' readings [default: 1]",
+    ),
+];
+
 /// `host search`: no training steps, checkpoints or policy selection.
 #[derive(Clone, Debug)]
 pub enum Search {}
 
 impl FlagUse for Search {
     const COMMAND: &'static str = "host search";
-    const UNUSED: &'static [&'static str] =
-        &["steps", "checkpoint_every", "select_every", "select_steps"];
-    const HELPS: &'static [(&'static str, &'static str)] = &[(
-        "out",
-        "Directory of <name>.policy and <name>.search.json [default: out]",
-    )];
+    // the learner's settings: the search learns no Q-values
+    const UNUSED: &'static [&'static str] = &[
+        "steps",
+        "checkpoint_every",
+        "select_every",
+        "select_steps",
+        "alpha",
+        "gamma",
+        "epsilon",
+        "initial_q",
+        "reward",
+        "tie_tolerance",
+        "updates",
+        "epsilon_decay",
+        "n_step",
+    ];
+    const HELPS: &'static [(&'static str, &'static str)] = &[
+        (
+            "out",
+            "Directory of <name>.policy and <name>.search.json [default: out]",
+        ),
+        ROBOT_WORLD_HELPS[0],
+        ROBOT_WORLD_HELPS[1],
+        ROBOT_WORLD_HELPS[2],
+    ];
 }
 
 /// `host policy gap`: writes no files, one run per --seeds.
@@ -191,11 +228,12 @@ impl<U> FromArgMatches for FlagsOf<U> {
     }
 }
 
-/// `host experiment`'s arguments: an experiment to run, or `merge` or `report`.
+/// `host experiment`'s arguments: an experiment to run, or `list`, `merge`
+/// or `report`.
 #[derive(Clone, Debug, Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct ExperimentArgs {
-    /// `merge` or `report` instead of a run.
+    /// `list`, `merge` or `report` instead of a run.
     #[command(subcommand)]
     pub action: Option<ExperimentAction>,
     /// The run.
@@ -216,11 +254,18 @@ pub enum ExperimentAction {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// From the published trials (<docs>/<document>/<name>/trials/): every
-    /// experiment's table.md, trials.csv and figures, and the documents
-    /// <docs>/reproduction.md and <docs>/robot-sensors.md from their
-    /// templates (<docs>/<document>/template.md). Run from the repository
-    /// root.
+    /// The built-in experiments, one a line: the name, the trials per arm
+    /// of its published run and its results page.
+    List {
+        /// Only the experiments of this results page (e.g. robot-sensors).
+        #[arg(long)]
+        page: Option<String>,
+    },
+    /// From the published trials (<docs>/<page>/<name>/trials/): every
+    /// experiment's table.md, trials.csv, figures and page
+    /// (<docs>/<page>/<name>.md), and each results page's index
+    /// (<docs>/<page>.md), from their templates (<docs>/<page>/template.md,
+    /// <docs>/<page>/<name>/template.md). Run from the repository root.
     Report {
         /// The docs directory.
         #[arg(long, default_value = "docs")]
@@ -232,7 +277,12 @@ pub enum ExperimentAction {
         /// quick run's page).
         #[arg(long, default_value_t = 1.0)]
         scale: f64,
-        /// Only these documents: reproduction, robot-sensors [default: both].
+        /// The experiments of the `*.toml` files in this directory (each
+        /// file's `page` key) instead of the built-in ones.
+        #[arg(long, value_name = "DIR")]
+        experiments: Option<PathBuf>,
+        /// Only these results pages (reproduction, robot-sensors)
+        /// [default: every one].
         documents: Vec<String>,
     },
 }
@@ -240,19 +290,18 @@ pub enum ExperimentAction {
 /// `host experiment NAME`'s options.
 #[derive(Clone, Debug, Args)]
 pub struct ExperimentRunArgs {
-    /// The thesis' (annulus, transfer, letters, letters-ablation,
-    /// letters-generated, state-bits, obstacle, collisions) or the robot's
-    /// senses' (robot-senses-ablation, robot-senses-sweep, robustness,
-    /// robustness-thesis, robot-senses-letter, wedge, wedge-sweep,
-    /// every-shape, t-noise, held-out-noise): the files of experiments/,
-    /// built in; or the path of a TOML file.
+    /// A built-in experiment (a file of experiments/ by its stem; `host
+    /// experiment list` names them) or the path of a TOML file (with
+    /// `[[stages]]`: a campaign, experiments/campaigns/,
+    /// docs/policy-search.md).
     #[arg(required = true)]
     pub experiment: Option<String>,
-    /// Trials per arm.
-    #[arg(long, default_value_t = 10)]
-    pub trials: usize,
+    /// Trials per arm [default: the file's `trials`, else 10].
+    #[arg(long)]
+    pub trials: Option<usize>,
     /// Fraction of the thesis' step counts, for quick runs (0.05: about a
-    /// minute for the annulus, long enough for its arms to form shapes).
+    /// minute for the annulus, long enough for its arms to form shapes); of
+    /// a campaign's step and generation counts.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
     /// Output directory [default: out/experiments/<name>, with --shard
@@ -273,6 +322,10 @@ pub struct ExperimentRunArgs {
     /// settings (config hash) are copied instead of run.
     #[arg(long, value_name = "DIR")]
     pub reuse: Vec<PathBuf>,
+    /// A campaign's stages to run (comma-separated), with the stages they
+    /// continue from that are not finished [default: every stage].
+    #[arg(long, value_delimiter = ',', value_name = "STAGES")]
+    pub stages: Vec<String>,
     /// Run the trials one at a time, each shown on the live view's page at
     /// this address, IP or IP:PORT (port 0: any free one; docs/view.md);
     /// the line "view: serving URL" names it.
@@ -281,10 +334,11 @@ pub struct ExperimentRunArgs {
 }
 
 impl ExperimentRunArgs {
-    /// The run options these arguments give.
-    pub fn options(&self) -> RunOptions {
+    /// The run options these arguments give, `file_trials` per arm unless
+    /// `--trials` says.
+    pub fn options(&self, file_trials: usize) -> RunOptions {
         RunOptions {
-            trials: self.trials,
+            trials: self.trials.unwrap_or(file_trials),
             scale: self.scale,
             out: self.out.clone(),
             seed: self.seed,

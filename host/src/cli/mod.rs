@@ -8,6 +8,7 @@ pub mod learn;
 pub mod robot;
 pub mod scenario;
 pub mod screen;
+pub mod shape;
 pub mod simulate;
 pub mod view;
 
@@ -51,6 +52,12 @@ pub enum Command {
     /// kept only if it forms more on validation worlds; writes
     /// <out>/<name>.policy and <out>/<name>.search.json.
     Search(SearchArgs),
+    /// From a picture to a flashable policy and its report card
+    /// (docs/shape.md): checks the image and its puck count, searches from
+    /// the better of the general table and orbital construction within a
+    /// time budget (resumable), and writes <out>/<name>.policy,
+    /// .report.json, .report.md and .png.
+    Shape(shape::ShapeArgs),
     /// Run one of the thesis' experiments (trials in parallel, resumable)
     /// and write CSV, JSON, a markdown table beside the thesis' numbers and
     /// PNG figures into --out.

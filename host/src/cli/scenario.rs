@@ -106,23 +106,39 @@ impl ScenarioArgs {
     /// The training config of the world flags given.
     fn config(&self) -> TrainConfig {
         let mut config = TrainConfig::default();
-        let m = &self.world;
-        if let Some(field) = m.get_one::<FieldSource>("field") {
-            config.field = field.clone();
-        }
-        if let Some(sensors) = m.get_one::<SensorChoice>("sensors") {
-            config.sensors = sensors.clone();
-        }
-        config.arena = m.get_one::<ArenaChoice>("arena").cloned();
-        config.robots = m.get_one::<usize>("robots").copied();
-        config.pucks = m.get_one::<usize>("pucks").copied();
-        if let Some(&seed) = m.get_one::<u64>("seed") {
-            config.seed = seed;
-        }
-        if let Some(&noise) = m.get_one::<f64>("noise") {
-            config.noise = noise;
-        }
-        config.walls = m.get_one::<Walls>("walls").copied();
+        apply_world_flags(&self.world, &mut config);
         config
+    }
+}
+
+/// Writes the world flags of [`WORLD_FLAGS`] that `m` holds into
+/// `config` (a command may take only some of them).
+pub(crate) fn apply_world_flags(m: &ArgMatches, config: &mut TrainConfig) {
+    fn given<T: Clone + Send + Sync + 'static>(m: &ArgMatches, id: &str) -> Option<T> {
+        m.try_get_one::<T>(id).ok().flatten().cloned()
+    }
+    if let Some(field) = given::<FieldSource>(m, "field") {
+        config.field = field;
+    }
+    if let Some(sensors) = given::<SensorChoice>(m, "sensors") {
+        config.sensors = sensors;
+    }
+    if let Some(arena) = given::<ArenaChoice>(m, "arena") {
+        config.arena = Some(arena);
+    }
+    if let Some(robots) = given::<usize>(m, "robots") {
+        config.robots = Some(robots);
+    }
+    if let Some(pucks) = given::<usize>(m, "pucks") {
+        config.pucks = Some(pucks);
+    }
+    if let Some(seed) = given::<u64>(m, "seed") {
+        config.seed = seed;
+    }
+    if let Some(noise) = given::<f64>(m, "noise") {
+        config.noise = noise;
+    }
+    if let Some(walls) = given::<Walls>(m, "walls") {
+        config.walls = Some(walls);
     }
 }

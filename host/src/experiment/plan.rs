@@ -7,7 +7,7 @@
 //! pre-training of trial `t` uses the arm name `pretrain`, so arms with the
 //! same pre-training settings (the transfer experiment's) share its table.
 
-use super::spec::{ArmController, ExperimentSpec};
+use super::spec::{ArmController, ArmSpec, ExperimentSpec};
 use crate::train::format1::TrainConfigV1;
 use crate::train::format2::TrainConfigV2;
 use crate::train::format3::TrainConfigV3;
@@ -54,6 +54,18 @@ pub struct TrialPlan {
     /// contents) and result format: a stored result with another hash is
     /// stale.
     pub hash: String,
+    /// The hash of the same run with its puck count left unset, when the
+    /// count is the screen arena's own (12 on the TV): how trials whose
+    /// file left the count to the arena were hashed. A stored result of
+    /// either hash is this trial's.
+    pub alias: Option<String>,
+}
+
+impl TrialPlan {
+    /// Whether a stored result of config hash `hash` is this trial's.
+    pub fn matches(&self, hash: &str) -> bool {
+        self.hash == hash || self.alias.as_deref() == Some(hash)
+    }
 }
 
 /// A pre-training run, scaled and seeded.
@@ -184,7 +196,7 @@ pub fn same_run(a: &TrainConfig, b: &TrainConfig) -> bool {
 }
 
 /// CRC-64 (XZ) of a value's JSON, as 16 hex digits.
-fn hash(value: &impl Serialize) -> String {
+pub(crate) fn hash(value: &impl Serialize) -> String {
     let json = serde_json::to_vec(value).unwrap_or_default();
     format!("{:016x}", Crc::<u64>::new(&CRC_64_XZ).checksum(&json))
 }
@@ -211,32 +223,15 @@ pub fn plans_of_format(
             config.steps = scaled(config.steps, scale);
             config.seed = trial_seed(seed, &arm.name, trial);
             config.output = OutputConfig::default();
-            let pretrain = arm.pretrain.as_ref().map(|p| {
-                let mut pre = arm.config.clone();
-                pre.robots = p.robots.or(pre.robots);
-                pre.steps = scaled(p.steps, scale);
-                pre.seed = trial_seed(seed, "pretrain", trial);
-                pre.output = OutputConfig::default();
-                PretrainPlan {
-                    hash: hash(&(format, hashed(&pre))),
-                    config: pre,
-                }
-            });
-            let trial_hash = match &arm.policy {
-                // an unreadable file hashes as none: its trials fail naming it
-                Some(path) => {
-                    let blob = ranges::read_file(path, &ranges::POLICY_FILE)
-                        .map(|b| hash(&b))
-                        .ok();
-                    hash(&(format, arm.controller, hashed(&config), blob))
-                }
-                None => hash(&(
-                    format,
-                    arm.controller,
-                    hashed(&config),
-                    pretrain.as_ref().map(|p| &p.hash),
-                )),
+            let (pretrain, trial_hash) = hashes(arm, &config, trial, scale, seed, format);
+            // the same run with the count left to the arena, as trials
+            // before the puck rule were hashed
+            let unset = TrainConfig {
+                pucks: None,
+                ..config.clone()
             };
+            let alias = (config.pucks.is_some() && config.pucks == arena_pucks(&config))
+                .then(|| hashes(arm, &unset, trial, scale, seed, format).1);
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),
@@ -246,10 +241,57 @@ pub fn plans_of_format(
                 pretrain,
                 policy: arm.policy.clone(),
                 hash: trial_hash,
+                alias,
             });
         }
     }
     out
+}
+
+/// The pre-training plan of trial `trial` of `arm` run as `config`, and the
+/// trial's hash.
+fn hashes(
+    arm: &ArmSpec,
+    config: &TrainConfig,
+    trial: usize,
+    scale: f64,
+    seed: u64,
+    format: u32,
+) -> (Option<PretrainPlan>, String) {
+    let pretrain = arm.pretrain.as_ref().map(|p| {
+        let mut pre = config.clone();
+        pre.robots = p.robots.or(arm.config.robots);
+        pre.steps = scaled(p.steps, scale);
+        pre.seed = trial_seed(seed, "pretrain", trial);
+        PretrainPlan {
+            hash: hash(&(format, hashed(&pre))),
+            config: pre,
+        }
+    });
+    let trial_hash = match &arm.policy {
+        // an unreadable file hashes as none: its trials fail naming it
+        Some(path) => {
+            let blob = ranges::read_file(path, &ranges::POLICY_FILE)
+                .map(|b| hash(&b))
+                .ok();
+            hash(&(format, arm.controller, hashed(config), blob))
+        }
+        None => hash(&(
+            format,
+            arm.controller,
+            hashed(config),
+            pretrain.as_ref().map(|p| &p.hash),
+        )),
+    };
+    (pretrain, trial_hash)
+}
+
+/// The puck count of the run's screen arena, if it is on a screen.
+fn arena_pucks(config: &TrainConfig) -> Option<usize> {
+    match config.arena_choice().arena() {
+        Ok(Arena::Screen(spec)) => Some(spec.pucks),
+        Ok(Arena::Square(_)) | Err(_) => None,
+    }
 }
 
 #[cfg(test)]

@@ -67,7 +67,10 @@ pub fn load(spec: &ExperimentSpec, dir: &Path, scale: f64, seed: u64) -> Result<
     let mut found: Vec<TrialResult> = Vec::new();
     for (file, name, r) in read {
         let current = plans.iter().any(|p| {
-            p.arm == r.arm && p.trial == r.trial && p.hash == r.config_hash && slug(&p.arm) == name
+            p.arm == r.arm
+                && p.trial == r.trial
+                && p.matches(&r.config_hash)
+                && slug(&p.arm) == name
         });
         if current {
             found.push(r);

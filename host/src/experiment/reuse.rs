@@ -56,7 +56,9 @@ impl ReusableTrials {
     /// (`experiment`, the plan's arm and trial), if one has its hash, seed
     /// and step count.
     pub fn result_for(&self, plan: &TrialPlan) -> Option<TrialResult> {
-        let stored = self.by_hash.get(&plan.hash)?;
+        let stored = std::iter::once(&plan.hash)
+            .chain(&plan.alias)
+            .find_map(|h| self.by_hash.get(h))?;
         let same = stored.seed == plan.config.seed && stored.steps == plan.config.steps;
         same.then(|| TrialResult {
             experiment: plan.experiment.clone(),

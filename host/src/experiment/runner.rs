@@ -461,5 +461,5 @@ pub fn trial_path(dir: &Path, plan: &TrialPlan) -> PathBuf {
 
 /// The stored result of a trial, if it exists and its hash matches.
 pub fn finished(dir: &Path, plan: &TrialPlan) -> Option<TrialResult> {
-    TrialResult::read_current(&trial_path(dir, plan)).filter(|r| r.config_hash == plan.hash)
+    TrialResult::read_current(&trial_path(dir, plan)).filter(|r| plan.matches(&r.config_hash))
 }

@@ -4,80 +4,28 @@
 //! An arm is a [`TrainConfig`]: the file's `[defaults]` table with the
 //! arm's own keys merged over it (nested tables such as `learn` key by
 //! key), plus the arm-only keys `name`, `row`, `column`, `controller`,
-//! `pretrain` and `thesis`. See docs/training.md for the format.
+//! `pretrain`, `policy`, `thesis`, `author` and `pucks_reason`. On a screen
+//! arena an arm's puck count is the puck rule's
+//! ([`sim::scenario::puck_rule`]) unless it sets `pucks` and
+//! `pucks_reason`. The file's `page` names the results page of its
+//! published trials and `trials` the trials per arm of a run that does not
+//! say. The built-in experiments are the `*.toml` files directly in
+//! `experiments/` ([`BUILT_IN`], listed by `host/build.rs`). See
+//! docs/training.md for the format.
 
 use super::metric::Metric;
 use crate::train::TrainConfig;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 use sim::base::ranges;
+use sim::scenario::puck_rule::rule_pucks;
+use sim::scenario::Arena;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The experiments shipped in `experiments/`, built into the binary so that
-/// `host experiment NAME` works from any directory.
-pub const BUILT_IN: [(&str, &str); 18] = [
-    ("annulus", include_str!("../../../experiments/annulus.toml")),
-    (
-        "transfer",
-        include_str!("../../../experiments/transfer.toml"),
-    ),
-    ("letters", include_str!("../../../experiments/letters.toml")),
-    (
-        "letters-ablation",
-        include_str!("../../../experiments/letters-ablation.toml"),
-    ),
-    (
-        "letters-generated",
-        include_str!("../../../experiments/letters-generated.toml"),
-    ),
-    (
-        "state-bits",
-        include_str!("../../../experiments/state-bits.toml"),
-    ),
-    (
-        "obstacle",
-        include_str!("../../../experiments/obstacle.toml"),
-    ),
-    (
-        "collisions",
-        include_str!("../../../experiments/collisions.toml"),
-    ),
-    (
-        "robot-senses-ablation",
-        include_str!("../../../experiments/robot-senses-ablation.toml"),
-    ),
-    (
-        "robot-senses-sweep",
-        include_str!("../../../experiments/robot-senses-sweep.toml"),
-    ),
-    (
-        "robustness",
-        include_str!("../../../experiments/robustness.toml"),
-    ),
-    (
-        "robustness-thesis",
-        include_str!("../../../experiments/robustness-thesis.toml"),
-    ),
-    (
-        "robot-senses-letter",
-        include_str!("../../../experiments/robot-senses-letter.toml"),
-    ),
-    ("wedge", include_str!("../../../experiments/wedge.toml")),
-    (
-        "wedge-sweep",
-        include_str!("../../../experiments/wedge-sweep.toml"),
-    ),
-    (
-        "every-shape",
-        include_str!("../../../experiments/every-shape.toml"),
-    ),
-    ("t-noise", include_str!("../../../experiments/t-noise.toml")),
-    (
-        "held-out-noise",
-        include_str!("../../../experiments/held-out-noise.toml"),
-    ),
-];
+// The experiments shipped in `experiments/`, built into the binary so
+// that `host experiment NAME` works from any directory: `BUILT_IN`.
+include!(concat!(env!("OUT_DIR"), "/built_in.rs"));
 
 /// A parsed experiment file.
 #[derive(Clone, Debug, PartialEq)]
@@ -90,6 +38,12 @@ pub struct ExperimentSpec {
     pub thesis: String,
     /// The experiment seed every trial seed derives from.
     pub seed: u64,
+    /// Trials per arm of a run that does not say (`--trials`): the
+    /// published run's.
+    pub trials: usize,
+    /// The results page (`docs/PAGE.md`, `host experiment report PAGE`)
+    /// that shows its published trials, if any.
+    pub page: Option<String>,
     /// Points of the formations-over-time curves.
     pub sample_points: usize,
     /// The results table.
@@ -192,6 +146,8 @@ pub struct ArmSpec {
     /// (its published result files), by metric: the side-by-side that
     /// `docs/reproduction.md` tests ours against.
     pub author: BTreeMap<Metric, Vec<f64>>,
+    /// Why the arm's puck count is not the puck rule's, if it sets one.
+    pub pucks_reason: Option<String>,
 }
 
 /// What a chart shows.
@@ -269,6 +225,9 @@ struct ExperimentFile {
     thesis: String,
     #[serde(default = "default_seed")]
     seed: u64,
+    #[serde(default = "default_trials")]
+    trials: usize,
+    page: Option<String>,
     #[serde(default = "default_sample_points")]
     sample_points: usize,
     #[serde(default)]
@@ -282,6 +241,10 @@ struct ExperimentFile {
 
 fn default_seed() -> u64 {
     1
+}
+
+fn default_trials() -> usize {
+    10
 }
 
 fn default_sample_points() -> usize {
@@ -304,13 +267,14 @@ struct ArmKeys {
     thesis: BTreeMap<Metric, f64>,
     #[serde(default)]
     author: BTreeMap<Metric, Vec<f64>>,
+    pucks_reason: Option<String>,
 }
 
 fn default_controller() -> ArmController {
     ArmController::Learn
 }
 
-const ARM_KEYS: [&str; 8] = [
+const ARM_KEYS: [&str; 9] = [
     "name",
     "row",
     "column",
@@ -319,6 +283,7 @@ const ARM_KEYS: [&str; 8] = [
     "policy",
     "thesis",
     "author",
+    "pucks_reason",
 ];
 
 impl ExperimentSpec {
@@ -352,6 +317,7 @@ impl ExperimentSpec {
         if file.arms.is_empty() {
             bail!("no [[arms]]");
         }
+        ranges::TRIALS.check_count("trials", file.trials as u64)?;
         if file.defaults.contains_key("output") {
             bail!("[defaults]: output settings are chosen by the experiment runner");
         }
@@ -421,6 +387,8 @@ impl ExperimentSpec {
             title: file.title,
             thesis: file.thesis,
             seed: file.seed,
+            trials: file.trials,
+            page: file.page,
             sample_points: file.sample_points.max(2),
             table: file.table,
             arms,
@@ -463,10 +431,11 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     }
     let mut merged = defaults.clone();
     merge(&mut merged, table);
-    let config: TrainConfig = toml::Value::Table(merged)
+    let mut config: TrainConfig = toml::Value::Table(merged)
         .try_into()
         .with_context(context)?;
     config.validate().with_context(context)?;
+    config.pucks = effective_pucks(&config, keys.pucks_reason.as_deref()).with_context(context)?;
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
     }
@@ -490,11 +459,32 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
         policy: keys.policy,
         thesis: keys.thesis,
         author: keys.author,
+        pucks_reason: keys.pucks_reason,
     })
 }
 
+/// The arm's puck count: on a screen arena the puck rule's
+/// ([`sim::scenario::puck_rule`]) unless the arm sets another and says why
+/// (`pucks_reason`); elsewhere the count set, if any. An arena file that
+/// cannot be read leaves the count as set: the run fails naming the file.
+fn effective_pucks(config: &TrainConfig, reason: Option<&str>) -> Result<Option<usize>> {
+    let rule = match config.arena_choice().arena() {
+        Ok(arena @ Arena::Screen(_)) => Some(rule_pucks(&config.field, &arena)?),
+        Ok(Arena::Square(_)) => None,
+        Err(_) => return Ok(config.pucks),
+    };
+    match (config.pucks, rule, reason) {
+        (Some(n), Some(r), None) if n != r => bail!(
+            "pucks = {n}: the puck rule gives {} {r}; give the reason for another count as pucks_reason",
+            config.field
+        ),
+        (None, _, Some(_)) => bail!("pucks_reason without pucks: the count is the puck rule's"),
+        (pucks, rule, _) => Ok(pucks.or(rule)),
+    }
+}
+
 /// Writes `over` into `base`, merging nested tables key by key.
-fn merge(base: &mut toml::Table, over: toml::Table) {
+pub(crate) fn merge(base: &mut toml::Table, over: toml::Table) {
     for (key, value) in over {
         match (base.get_mut(&key), value) {
             (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),

@@ -1,5 +1,6 @@
-//! The template of `docs/reproduction.md`: markdown with `{{ ... }}`
-//! expressions, each rendered from an experiment's published trials, so
+//! The templates of the results pages (`docs/reproduction.md`,
+//! `docs/robot-sensors.md` and their experiments' pages): markdown with
+//! `{{ ... }}` expressions, each rendered from an experiment's published trials, so
 //! that every figure the document states comes from the trials (or is
 //! checked against them).
 //!
@@ -10,7 +11,7 @@
 //!   versions, `plan::RESULT_FORMAT`), e.g. `2`;
 //! - `{{EXP trials}}`, `{{EXP runs}}` (trials and the pre-trainings they
 //!   started from), `{{EXP steps}}` (steps simulated, pre-trainings
-//!   included), `{{EXP wall}}` (the last sitting's wall time in its
+//!   included), `{{EXP wall}}` (the last run's wall time in its
 //!   `wall-time.txt`);
 //! - `{{EXP | ARM | QUANTITY | STAT}}`: a statistic over an arm's trials of
 //!   a per-trial QUANTITY: `formations`, `stuck`, `first_formation`,
@@ -211,7 +212,7 @@ fn whole(experiments: &[&Source], what: &str) -> Result<String> {
             Ok(format!("{} million", prose((steps as f64 / 1e6).round())))
         }
         "wall" => {
-            let seconds: Option<u64> = experiments.iter().map(|s| last_sitting(s)).sum();
+            let seconds: Option<u64> = experiments.iter().map(|s| last_run(s)).sum();
             Ok(seconds.map_or_else(
                 || "(not recorded)".to_string(),
                 |s| {
@@ -254,7 +255,7 @@ fn pretrainings(experiments: &[&Source]) -> BTreeSet<(String, u64)> {
 
 /// Seconds of the last line of the experiment's `wall-time.txt`
 /// (`NAME: S s wall time ...`).
-fn last_sitting(s: &Source) -> Option<u64> {
+fn last_run(s: &Source) -> Option<u64> {
     let text = std::fs::read_to_string(s.dir.join("wall-time.txt")).ok()?;
     let line = text.lines().rev().find(|l| !l.trim().is_empty())?;
     line.split_once(": ")?

@@ -12,19 +12,18 @@
 //! table on the validation worlds. Scores: [`Score`].
 
 use super::cem::{random_table, Categorical};
-use super::config::{SearchConfig, Start, DEFAULT_DISTIL_STEPS};
+use super::config::{default_world, SearchConfig, Start, DEFAULT_DISTIL_STEPS};
 use super::fitness::{fitness_seeds, validation_seeds, Score, Scorer};
 use crate::experiment::plan::mix;
 use crate::train::command::seed_table;
 use crate::train::config::field_label;
 use crate::train::distil::distil_orbital;
 use crate::train::{TrainConfig, TrainFlags};
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
 use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
 use sim::base::rng::SimRng;
-use sim::scenario::shape_pucks::tv_pucks;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -36,7 +35,9 @@ const RANDOM_START_STREAM: u64 = 0x4A4D_0000_0000_0001;
 /// What `host search` is asked to do.
 #[derive(Clone, Debug)]
 pub struct SearchRequest {
-    /// TOML file of a training config: the world searched in; the flags win.
+    /// TOML file of a training config: the world searched in (its missing
+    /// keys a training config's defaults); the flags win. Without it the
+    /// world is [`default_world`]'s.
     pub config: Option<PathBuf>,
     /// The world's settings given one by one.
     pub flags: TrainFlags,
@@ -143,22 +144,96 @@ impl std::fmt::Display for SearchReport {
     }
 }
 
+/// A search's progress on stderr: in a terminal one line rewritten after
+/// each generation, otherwise (a pipe, a file) one line per generation;
+/// each says the generation, the result's validation score so far and the
+/// time left at the pace of the generations run so far.
+pub struct Progress {
+    total: u64,
+    resumed: u64,
+    started: Instant,
+    terminal: bool,
+    live: bool,
+}
+
+impl Progress {
+    /// Progress of `total` generations, the first `resumed` of them run
+    /// earlier.
+    pub fn new(total: u64, resumed: u64) -> Progress {
+        use std::io::IsTerminal;
+        Progress {
+            total,
+            resumed,
+            started: Instant::now(),
+            terminal: std::io::stderr().is_terminal(),
+            live: false,
+        }
+    }
+
+    /// The line after generation `g`.
+    pub fn line(&self, g: &Generation) -> String {
+        let run = (g.generation + 1).saturating_sub(self.resumed).max(1);
+        let left = self.total.saturating_sub(g.generation + 1);
+        let pace = self.started.elapsed().as_secs_f64() / run as f64;
+        let secs = (pace * left as f64).round() as u64;
+        format!(
+            "generation {}/{}  best {} formations (mean Eval {:.4}) on the validation worlds  time left {}m{:02}s",
+            g.generation + 1,
+            self.total,
+            g.result_validation.formations,
+            g.result_validation.eval,
+            secs / 60,
+            secs % 60
+        )
+    }
+
+    /// Shows generation `g`.
+    pub fn generation(&mut self, g: &Generation) {
+        let line = self.line(g);
+        if self.terminal {
+            eprint!("\r\x1b[K{line}");
+            self.live = true;
+        } else {
+            eprintln!("{line}");
+        }
+    }
+
+    /// Ends the live line in a terminal.
+    pub fn done(&mut self) {
+        if std::mem::take(&mut self.live) {
+            eprintln!();
+        }
+    }
+}
+
 /// The worlds' settings: the file, then the flags, on the run's field and
 /// then on each `--also-field`, each at the run's noise and then at each
-/// `--also-noise`; on a screen each shape's puck count ([`tv_pucks`])
-/// unless `--pucks` is given. The first is the run's own world.
+/// `--also-noise`; on a screen each shape's puck count by the puck rule
+/// ([`sim::scenario::puck_rule`]) unless `--pucks` is given. The first is the run's own world.
+#[cfg(test)]
 fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
+    worlds_from(base_world(request)?, &request.search)
+}
+
+/// The run's own world: the file's (or [`default_world`]), the flags
+/// applied.
+fn base_world(request: &SearchRequest) -> Result<TrainConfig> {
     let mut base = match &request.config {
         Some(path) => TrainConfig::from_file(path)?,
-        None => TrainConfig::default(),
+        None => default_world(),
     };
     request.flags.apply(&mut base)?;
-    for &noise in &request.search.also_noise {
+    Ok(base)
+}
+
+/// [`worlds`] from the run's own world `base`.
+fn worlds_from(base: TrainConfig, settings: &SearchConfig) -> Result<Vec<TrainConfig>> {
+    for &noise in &settings.also_noise {
         sim::base::ranges::NOISE.check_as("also-noise", noise)?;
     }
-    let fields = std::iter::once(base.field.clone()).chain(request.search.also_field.clone());
+    let fields = std::iter::once(base.field.clone()).chain(settings.also_field.clone());
     let noises: Vec<f64> = std::iter::once(base.noise)
-        .chain(request.search.also_noise.iter().copied())
+        .chain(settings.also_noise.iter().copied())
         .collect();
     fields
         .flat_map(|field| noises.iter().map(move |&noise| (field.clone(), noise)))
@@ -168,9 +243,7 @@ fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
                 noise,
                 ..base.clone()
             };
-            if base.pucks.is_none() && config.arena_choice().screen().is_ok() {
-                config.pucks = tv_pucks(&config.field);
-            }
+            config.pucks = config.world().pucks()?;
             config.validate()?;
             Ok(config)
         })
@@ -178,7 +251,7 @@ fn worlds(request: &SearchRequest) -> Result<Vec<TrainConfig>> {
 }
 
 /// The start table and the steps distilled for it.
-fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, u64)> {
+pub fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, u64)> {
     let (hasher, actions) = (config.learn.hasher.0, config.learn.actions.len());
     Ok(match start {
         Start::Orbital => {
@@ -193,14 +266,18 @@ fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, u64)
     })
 }
 
-/// Runs `host search`.
-pub fn search(request: &SearchRequest) -> Result<SearchReport> {
-    let configs = worlds(request)?;
+/// The run's own world (the first of [`worlds`]) and a scorer of every
+/// world of the request, the settings checked.
+pub fn scorer(request: &SearchRequest) -> Result<(TrainConfig, Scorer)> {
+    scorer_of(base_world(request)?, &request.search)
+}
+
+/// [`scorer`] of the run's own world `base` (its field, noise and counts
+/// as given) and `settings`.
+pub fn scorer_of(base: TrainConfig, settings: &SearchConfig) -> Result<(TrainConfig, Scorer)> {
+    let configs = worlds_from(base, settings)?;
     let config = configs[0].clone();
-    let settings = &request.search;
-    let actions_count = config.learn.actions.len();
-    settings.validate(actions_count)?;
-    crate::atomic::check_writable(&config.output.dir)?;
+    settings.validate(config.learn.actions.len())?;
     let prepared = configs
         .iter()
         .map(TrainConfig::prepare)
@@ -209,24 +286,21 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
     let actions = ActionTable::new(&config.learn.actions, forward)
         .context("the run's actions are not a valid action table")?;
     let scorer = Scorer::new(prepared, actions, settings.threads)?;
+    Ok((config, scorer))
+}
+
+/// Runs `host search`, calling `each` after every generation.
+pub fn search(request: &SearchRequest, each: &mut Each<'_>) -> Result<SearchReport> {
+    let (config, scorer) = scorer(request)?;
+    let settings = &request.search;
+    crate::atomic::check_writable(&config.output.dir)?;
     let (start, distil_steps) = start_table(&config, &settings.start)?;
     let started = Instant::now();
-    let log = run(&config, settings, &scorer, start, distil_steps)?;
+    let log = run_from(&config, settings, &scorer, start, distil_steps, &[], each)?;
     let elapsed = started.elapsed();
     let machine = std::thread::available_parallelism().map_or(1, usize::from);
     let cores = scorer.threads().min(machine);
-    let name = config.name();
-    let policy = config.output.dir.join(format!("{name}.policy"));
-    let log_file = config.output.dir.join(format!("{name}.search.json"));
-    let table = PolicyTable::from_packed(config.learn.hasher.0, &log.result)
-        .context("the result does not fit the run's hasher")?;
-    let provenance = Provenance::new(&field_label(&config.field), &name, log.steps, config.seed)?;
-    // the blob says which senses and arena it was searched for, so that
-    // `host flash` refuses a table searched with the discs' senses
-    let blob = PolicyBlob::new(actions, table, provenance)?.with_trained_for(config.trained_for());
-    crate::policy_file::write(&policy, &blob)?;
-    let json = serde_json::to_vec_pretty(&log).context("cannot encode the search log")?;
-    crate::atomic::write(&log_file, &json)?;
+    let (policy, log_file) = write_result(&config, &scorer, &log)?;
     Ok(SearchReport {
         log,
         policy,
@@ -236,6 +310,34 @@ pub fn search(request: &SearchRequest) -> Result<SearchReport> {
     })
 }
 
+/// Writes a search's result into the run's output directory:
+/// `<name>.policy` (the blob records the senses and arena it was searched
+/// for, so that `host flash` refuses a table searched with the discs'
+/// senses) and `<name>.search.json` (the log), both atomically; returns
+/// their paths.
+pub fn write_result(
+    config: &TrainConfig,
+    scorer: &Scorer,
+    log: &SearchLog,
+) -> Result<(PathBuf, PathBuf)> {
+    let name = config.name();
+    let policy = config.output.dir.join(format!("{name}.policy"));
+    let log_file = config.output.dir.join(format!("{name}.search.json"));
+    let table = PolicyTable::from_packed(config.learn.hasher.0, &log.result)
+        .context("the result does not fit the run's hasher")?;
+    let provenance = Provenance::new(&field_label(&config.field), &name, log.steps, config.seed)?;
+    let blob = PolicyBlob::new(scorer.actions(), table, provenance)?
+        .with_trained_for(config.trained_for());
+    crate::policy_file::write(&policy, &blob)?;
+    let json = serde_json::to_vec_pretty(&log).context("cannot encode the search log")?;
+    crate::atomic::write(&log_file, &json)?;
+    Ok((policy, log_file))
+}
+
+/// Called after each generation with it (a resumed run's earlier
+/// generations are not passed again).
+pub type Each<'a> = dyn FnMut(&Generation) -> Result<()> + 'a;
+
 /// The search from `start`: every generation, then the log.
 pub fn run(
     config: &TrainConfig,
@@ -243,6 +345,31 @@ pub fn run(
     scorer: &Scorer,
     start: PolicyTable,
     distil_steps: u64,
+) -> Result<SearchLog> {
+    run_from(
+        config,
+        settings,
+        scorer,
+        start,
+        distil_steps,
+        &[],
+        &mut |_| Ok(()),
+    )
+}
+
+/// The search from `start`, continuing after the generations `done` of an
+/// earlier run of the same settings (replayed from their logged scores
+/// without simulating: each draws the same candidates and moves the
+/// distribution as it did, so a resumed search ends where an unbroken one
+/// does), calling `each` after every new generation.
+pub fn run_from(
+    config: &TrainConfig,
+    settings: &SearchConfig,
+    scorer: &Scorer,
+    start: PolicyTable,
+    distil_steps: u64,
+    done: &[Generation],
+    each: &mut Each<'_>,
 ) -> Result<SearchLog> {
     let actions = config.learn.actions.len();
     let validation = validation_seeds(config.seed, settings.validation_seeds);
@@ -258,15 +385,29 @@ pub fn run(
     let mut steps = validation_cost;
     let mut distribution = Categorical::around(&start, actions, settings.keep);
     let (mut result, mut result_validation) = (start, start_validation);
-    let mut generations = Vec::new();
+    let mut generations: Vec<Generation> = Vec::new();
     for g in 0..settings.generations {
         let mut rng = SimRng::seed_from_u64(mix(mix(config.seed ^ SAMPLE_STREAM) ^ g));
         let candidates: Vec<PolicyTable> = std::iter::once(result.clone())
             .chain((1..settings.population).map(|_| distribution.sample(&mut rng)))
             .collect();
         let seeds = fitness_seeds(config.seed, g, settings.fitness_seeds);
-        let fitness = scorer.score(&candidates, &seeds, settings.fitness_steps)?;
-        steps += fitness_cost * candidates.len() as u64;
+        let earlier = done.get(g as usize);
+        if let Some(earlier) = earlier {
+            if earlier.generation != g
+                || earlier.fitness_seeds != seeds
+                || earlier.fitness.len() != candidates.len()
+            {
+                bail!("generation {g} of the earlier run is not one of these settings");
+            }
+        }
+        let fitness = match earlier {
+            Some(earlier) => earlier.fitness.clone(),
+            None => {
+                steps += fitness_cost * candidates.len() as u64;
+                scorer.score(&candidates, &seeds, settings.fitness_steps)?
+            }
+        };
         // best first; equal scores keep the candidates' order
         let mut ranked: Vec<usize> = (0..candidates.len()).collect();
         ranked.sort_by(|&a, &b| Score::best_first(&fitness[a], &fitness[b]));
@@ -276,18 +417,23 @@ pub fn run(
             .collect();
         distribution.update(&elites, settings.rate, settings.floor);
         let challenger = ranked.iter().copied().find(|&i| i != 0).unwrap_or(1);
-        let challenger_validation = scorer.score(
-            std::slice::from_ref(&candidates[challenger]),
-            &validation,
-            settings.validation_steps,
-        )?[0];
-        steps += validation_cost;
+        let challenger_validation = match earlier {
+            Some(earlier) => earlier.challenger_validation,
+            None => {
+                steps += validation_cost;
+                scorer.score(
+                    std::slice::from_ref(&candidates[challenger]),
+                    &validation,
+                    settings.validation_steps,
+                )?[0]
+            }
+        };
         let replaced = challenger_validation.beats(&result_validation);
         if replaced {
             result = candidates[challenger].clone();
             result_validation = challenger_validation;
         }
-        generations.push(Generation {
+        let generation = Generation {
             generation: g,
             fitness,
             fitness_seeds: seeds,
@@ -296,8 +442,17 @@ pub fn run(
             result_validation,
             replaced,
             entropy: distribution.mean_entropy(),
-            steps,
-        });
+            steps: earlier.map_or(steps, |e| e.steps),
+        };
+        if let Some(earlier) = earlier {
+            if *earlier != generation {
+                bail!("generation {g} of the earlier run is not one of these settings");
+            }
+            steps = earlier.steps;
+        } else {
+            each(&generation)?;
+        }
+        generations.push(generation);
     }
     Ok(SearchLog {
         world: config.clone(),
@@ -444,6 +599,55 @@ mod tests {
         );
         let error = worlds(&search(vec![-1.0])).unwrap_err().to_string();
         assert!(error.contains("also-noise"), "{error}");
+    }
+
+    #[test]
+    fn a_search_resumed_after_its_first_generation_ends_as_an_unbroken_one() {
+        let unbroken = small(2, Start::Random);
+        let settings = small_settings(2, Start::Random);
+        let flags = TrainFlags::parse([
+            "--sensors",
+            "robot",
+            "--noise",
+            "1",
+            "--seed",
+            "3",
+            "--distil-oc",
+            "20000",
+        ])
+        .unwrap();
+        let request = SearchRequest {
+            config: None,
+            flags,
+            search: settings.clone(),
+        };
+        let (config, scorer) = scorer(&request).unwrap();
+        let (start, _) = start_table(&config, &settings.start).unwrap();
+        let mut new = Vec::new();
+        let resumed = run_from(
+            &config,
+            &settings,
+            &scorer,
+            start.clone(),
+            0,
+            &unbroken.generations[..1],
+            &mut |g| {
+                new.push(g.generation);
+                Ok(())
+            },
+        )
+        .unwrap();
+        assert_eq!(new, [1, 2], "only the generations not run before");
+        assert_eq!(resumed, unbroken);
+        // a generation of other settings is not resumed from
+        let mut other = unbroken.generations[0].clone();
+        other.fitness_seeds[0] ^= 2;
+        let e = run_from(&config, &settings, &scorer, start, 0, &[other], &mut |_| {
+            Ok(())
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("generation 0 of the earlier run"), "{e}");
     }
 
     #[test]

@@ -1,11 +1,27 @@
 //! The search's own settings (`host search`); the world it searches in is
 //! a training config's ([`crate::train::TrainConfig`]: field, sensors,
-//! arena, counts, noise, hasher, seed, output).
+//! arena, counts, noise, hasher, seed, output), by default the robot's on
+//! the TV ([`default_world`]).
 
+use crate::train::TrainConfig;
 use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use sim::fields::source::FieldSource;
+use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::sensor_choice::SensorChoice;
 use std::path::PathBuf;
+
+/// The world a search runs in unless a `--config` file says otherwise: the
+/// robot's senses (`robot`) on the 75" TV (`tv75`) at the default noise
+/// (1); every other setting a training config's default.
+pub fn default_world() -> TrainConfig {
+    TrainConfig {
+        sensors: SensorChoice::Robot(None),
+        arena: Some(ArenaChoice::Named("tv75".into())),
+        noise: 1.0,
+        ..TrainConfig::default()
+    }
+}
 
 /// Where the search starts.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]

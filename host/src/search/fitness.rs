@@ -108,6 +108,11 @@ impl Scorer {
         self.pool.current_num_threads()
     }
 
+    /// The actions the tables' action ids stand for.
+    pub fn actions(&self) -> ActionTable {
+        self.actions
+    }
+
     /// Fields each table is scored on.
     pub fn fields(&self) -> usize {
         self.prepared.len()

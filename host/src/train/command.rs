@@ -92,6 +92,8 @@ pub struct TrainReport {
     /// Earlier results this run would have replaced, and where they are
     /// kept.
     pub kept: Vec<(PathBuf, PathBuf)>,
+    /// What it trained for: the field, the sensors and the arena.
+    pub trained_for: String,
 }
 
 impl fmt::Display for TrainReport {
@@ -152,6 +154,11 @@ impl fmt::Display for TrainReport {
                 kept.display()
             )?;
         }
+        writeln!(f, "trained for          {}", self.trained_for)?;
+        writeln!(
+            f,
+            "for the robot        `host shape IMAGE --out DIR`: a policy for a shape of your own on the robots' senses on the TV, flashable (docs/shape.md)"
+        )?;
         writeln!(f, "policy               {}", self.policy.display())?;
         write!(f, "checkpoint           {}", self.checkpoint.display())?;
         if self.interrupted {
@@ -420,6 +427,15 @@ fn run(
         policy: policy_path,
         checkpoint: checkpoint_path,
         kept: Vec::new(),
+        trained_for: {
+            let c = trainer.config();
+            format!(
+                "{}, sensors {}, arena {}",
+                c.field,
+                c.sensors,
+                c.arena_choice()
+            )
+        },
     })
 }
 

@@ -21,8 +21,7 @@ pub fn render(results: &serde_json::Value) -> String {
     let base = rows.first().map(|r| median(&rate(r))).unwrap_or(f64::NAN);
     let mut lines = vec![
         format!(
-            "Measured {} (commit {}) on {}, release build, `host train --steps {} --seed 1` (annulus, disc senses); {} rounds, each running the configurations one after another in a rotated order; medians.",
-            results["date"].as_str().unwrap_or(""),
+            "Measured at commit {} on {}, release build, `host train --steps {} --seed 1` (annulus, disc senses); {} rounds, each running the configurations one after another in a rotated order; medians.",
             results["commit"].as_str().unwrap_or(""),
             results["machine"].as_str().unwrap_or(""),
             results["steps"],

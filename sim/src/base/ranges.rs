@@ -630,6 +630,15 @@ pub const GENERATIONS: Range = Range::closed(
     "20 by default; each scores every candidate on every fitness world",
 );
 
+/// The minutes `host shape` may take.
+pub const SHAPE_BUDGET: Range = Range::closed(
+    &["host shape --budget-minutes"],
+    0.1,
+    10_080.0,
+    "minutes",
+    "20 by default, on two cores; a week at most",
+);
+
 /// Candidates per generation and elites of the policy search.
 pub const CANDIDATES: Range = Range::closed(
     &["--population", "--elites"],
@@ -1025,6 +1034,7 @@ pub const SECTIONS: &[(&str, &[&Range])] = &[
             &N_STEP,
             &INNIES,
             &GENERATIONS,
+            &SHAPE_BUDGET,
             &CANDIDATES,
             &SEARCH_WORLDS,
             &SEARCH_PROBABILITY,

@@ -1,14 +1,17 @@
 //! The world's settings as a user names them (`--field`, `--sensors`,
 //! `--arena`, `--robots`, `--pucks`, `--seed`, `--noise`, `--walls`): what
 //! `host run`, training and the live view (`view`) turn into a [`Scenario`]:
-//! [`WorldChoices`], with a controller [`ScenarioChoices`].
+//! [`WorldChoices`], with a controller [`ScenarioChoices`]. On a screen
+//! arena the puck count left unset is the shape's by the puck rule
+//! ([`rule_pucks`]).
 
 use crate::base::ranges::{self, RangeError};
 use crate::config::{BroadPhase, Walls};
 use crate::fields::source::FieldSource;
 use crate::scenario::arena_choice::ArenaChoice;
+use crate::scenario::puck_rule::rule_pucks;
 use crate::scenario::sensor_choice::SensorChoice;
-use crate::scenario::{ControllerChoice, Scenario, ScenarioError};
+use crate::scenario::{Arena, ControllerChoice, Scenario, ScenarioError};
 use serde::Serialize;
 
 /// A world's settings by name; `None` takes the arena's own. The settings
@@ -59,6 +62,20 @@ impl WorldChoices {
             .clone()
             .unwrap_or_else(|| ArenaChoice::default_for(self.sensors.is_robot()))
     }
+
+    /// The puck count: the one given, else on a screen arena the field's
+    /// by the puck rule, else `None` (the arena's own).
+    pub fn pucks(&self) -> Result<Option<usize>, ScenarioError> {
+        self.pucks_in(&self.arena_choice().arena()?)
+    }
+
+    /// [`pucks`](Self::pucks) in `arena`, the arena this choice names.
+    fn pucks_in(&self, arena: &Arena) -> Result<Option<usize>, ScenarioError> {
+        match (self.pucks, arena) {
+            (None, Arena::Screen(_)) => Ok(Some(rule_pucks(&self.field, arena)?)),
+            (pucks, _) => Ok(pucks),
+        }
+    }
 }
 
 /// A world's settings and its controller by name.
@@ -72,17 +89,19 @@ pub struct ScenarioChoices {
 
 impl ScenarioChoices {
     /// The scenario, arena and sensor files read and checked (the counts,
-    /// noise and settings are checked when it is prepared or built).
+    /// noise and settings are checked when it is prepared or built); on a
+    /// screen arena the puck count left unset is the puck rule's.
     pub fn scenario(&self) -> Result<Scenario, ScenarioError> {
         let w = &self.world;
+        let arena = w.arena_choice().arena()?;
         Ok(Scenario {
             field: w.field.clone(),
             controller: self.controller.clone(),
             robots: w.robots,
-            pucks: w.pucks,
+            pucks: w.pucks_in(&arena)?,
             seed: w.seed,
             broad_phase: BroadPhase::Grid,
-            arena: w.arena_choice().arena()?,
+            arena,
             sensors: w.sensors.setup()?,
             noise: w.noise,
             walls: w.walls,

@@ -9,9 +9,9 @@ pub mod arena_choice;
 pub mod choices;
 pub mod flat_field;
 pub mod panel;
+pub mod puck_rule;
 pub mod sensor_choice;
 pub mod sensor_setup;
-pub mod shape_pucks;
 pub mod trained_for;
 
 use crate::config::actuation::ActuationNoise;
@@ -26,6 +26,7 @@ use crate::control::Controller;
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::ScalarField;
 use crate::scenario::arena::ArenaSpec;
+use crate::scenario::puck_rule::PuckRuleError;
 use crate::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::sensors::robot_noise::RobotNoise;
 use crate::simulation::Simulation;
@@ -370,6 +371,8 @@ pub enum ScenarioError {
     UnknownArena(String),
     /// A screen arena is needed where this arena (the thesis' square) was given.
     NotAScreen(String),
+    /// The field has no puck count by the puck rule.
+    PuckRule(Box<PuckRuleError>),
 }
 
 impl fmt::Display for ScenarioError {
@@ -393,6 +396,7 @@ impl fmt::Display for ScenarioError {
                 "--arena {arena}: a screen arena is needed ({} or a FILE.toml), not the thesis' square",
                 ArenaSpec::NAMES
             ),
+            ScenarioError::PuckRule(e) => e.fmt(f),
         }
     }
 }
@@ -402,6 +406,12 @@ impl std::error::Error for ScenarioError {}
 impl From<ConfigError> for ScenarioError {
     fn from(e: ConfigError) -> ScenarioError {
         ScenarioError::Config(e)
+    }
+}
+
+impl From<PuckRuleError> for ScenarioError {
+    fn from(e: PuckRuleError) -> ScenarioError {
+        ScenarioError::PuckRule(Box::new(e))
     }
 }
 

@@ -12,7 +12,9 @@
 //! table). Prints `host run`'s summary with the loop's counters, as text
 //! or one JSON object; with `--compare`, also `host run`'s own summary of
 //! the same scenario driven by the simulator's policy controller (as
-//! `simulator`).
+//! `simulator`). The firmware's busy wait for the next period is
+//! fast-forwarded (`Zumo::skip_waits`: the same frames, counters and
+//! world) unless `--simulate-waits` is given.
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -61,11 +63,21 @@ struct Args {
     /// Also run the same scenario with the simulator's policy controller.
     #[arg(long)]
     compare: bool,
+    /// Simulate the firmware's busy wait for the next period cycle by
+    /// cycle instead of fast-forwarding it (the same results, slower).
+    #[arg(long)]
+    simulate_waits: bool,
 }
 
-/// What `--json` prints.
+/// What `--json` prints: the settings, the loop's summary, `host run`'s.
 #[derive(Serialize)]
 struct Output {
+    field: String,
+    policy: PathBuf,
+    elf: PathBuf,
+    seed: u64,
+    robots: Option<usize>,
+    noise: f64,
     #[serde(flatten)]
     run: LoopSummary,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -87,7 +99,7 @@ fn run(args: Args) -> Result<()> {
         .with_context(|| format!("reading the policy {}", args.policy.display()))?;
     tests::equivalence::check_elf_embeds(&args.elf, &policy, "scripts/build-firmware")?;
     let scenario = World {
-        field: args.field,
+        field: args.field.clone(),
         arena: args.arena,
         robots: args.robots,
         pucks: args.pucks,
@@ -103,8 +115,15 @@ fn run(args: Args) -> Result<()> {
     };
     let mut in_the_loop = InTheLoop::new(&args.elf, &policy, &scenario)
         .with_context(|| format!("starting the firmware {}", args.elf.display()))?;
+    in_the_loop.skip_waits(!args.simulate_waits);
     let summary = in_the_loop.run(args.steps)?;
     let output = Output {
+        field: args.field.to_string(),
+        policy: args.policy,
+        elf: args.elf,
+        seed: args.seed,
+        robots: args.robots,
+        noise: args.noise,
         run: summary,
         simulator,
     };

@@ -8,8 +8,7 @@
 pub fn render(results: &serde_json::Value) -> String {
     let mut lines = vec![
         format!(
-            "Measured {} (commit {}) on {}, {} build of the view, headless Chromium; {} rounds alternating the configurations, {} s each; medians.",
-            results["date"].as_str().unwrap_or(""),
+            "Measured at commit {} on {}, {} build of the view, headless Chromium; {} rounds alternating the configurations, {} s each; medians.",
             results["commit"].as_str().unwrap_or(""),
             results["machine"].as_str().unwrap_or(""),
             results["profile"].as_str().unwrap_or(""),
