@@ -98,7 +98,7 @@ pub fn measure_learner(label: &str, config: &TrainConfig, window: u64) -> Result
     trainer.run(window);
     let learning = trainer.totals().formations - before;
     let q = trainer.learner().table().clone();
-    let frozen = FrozenLearner::new(q, config.learn.actions.clone(), config.rules.tie_tolerance);
+    let frozen = FrozenLearner::new(q, config.learn.actions.clone(), config.learn.tie_tolerance);
     let frozen = formations(config, None, Box::new(frozen), window)?;
     let blob = trainer.policy()?;
     let lowest = trainer.greedy_policy()?;

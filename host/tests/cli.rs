@@ -56,7 +56,7 @@ fn bad_inputs_are_rejected_with_the_offending_value() {
     let e = fails(&["run", "--steps", "10", "--field", "/no/such/field.png"]);
     assert!(e.contains("/no/such/field.png"), "{e}");
     assert!(fails(&["run", "--field", "letter:Q"]).contains("\"Q\""));
-    assert!(fails(&["run", "--robots", "0"]).contains("world.robots = 0"));
+    assert!(fails(&["run", "--robots", "0"]).contains("robots = 0: outside"));
     assert!(fails(&["run", "--pucks", "100000"]).contains("100008 bodies"));
     assert!(fails(&["run", "--controller", "bogus"]).contains("bogus"));
     let e = fails(&["run", "--controller", "policy:/no/such.policy"]);

@@ -30,31 +30,47 @@ fn trainer(config: TrainConfig) -> Trainer<sim::scenario::sensor_setup::Selected
 
 /// Trains `config` for `steps` straight, and for `first` steps, through a
 /// checkpoint file, then the rest; both runs must end in the same state.
-/// Returns the checkpoint's format version.
+/// The checkpoint is written both in the current format and in the oldest
+/// earlier format that holds the state (as earlier builds wrote it), and
+/// the run resumes exactly from each. Returns that earlier format's
+/// version, or the current one when none holds the state.
 fn resumes_exactly(config: TrainConfig, first: u64, steps: u64) -> u16 {
     let mut straight = trainer(config.clone());
     straight.run(steps);
     let mut head = trainer(config.clone());
     head.run(first);
-    let mut bytes = Vec::new();
-    checkpoint::write_to(&mut bytes, &head.state()).unwrap();
+    let mut current = Vec::new();
+    checkpoint::write_to(&mut current, &head.state()).unwrap();
+    let mut earlier = Vec::new();
+    let version = checkpoint::write_earlier_format(&mut earlier, &head.state())
+        .unwrap()
+        .unwrap_or(checkpoint::VERSION);
     drop(head);
-    let state = checkpoint::decode(&bytes).unwrap();
-    assert_eq!(
-        state.config.scenario().unwrap(),
-        config.scenario().unwrap(),
-        "the checkpoint keeps the run's settings"
-    );
-    let mut resumed = Trainer::restart(state).unwrap();
-    resumed.run(steps - first);
-    assert_eq!(resumed.learner().table(), straight.learner().table());
-    assert_eq!(resumed.totals(), straight.totals());
-    assert!(
-        evolving(&resumed.state()) == evolving(&straight.state()),
-        "world, generators or counters differ"
-    );
-    assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
-    u16::from_le_bytes([bytes[8], bytes[9]])
+    for bytes in [current, earlier].iter().filter(|b| !b.is_empty()) {
+        let state = checkpoint::decode(bytes).unwrap();
+        if u16::from(bytes[8]) == checkpoint::VERSION {
+            assert_eq!(state.config, config, "the checkpoint keeps the settings");
+        } else {
+            // an earlier format may name a default (the arena) outright
+            assert_eq!(
+                state.config.scenario().unwrap(),
+                config.scenario().unwrap(),
+                "the checkpoint of format {} keeps the run's settings",
+                bytes[8]
+            );
+        }
+        let mut resumed = Trainer::restart(state).unwrap();
+        resumed.run(steps - first);
+        assert_eq!(resumed.learner().table(), straight.learner().table());
+        assert_eq!(resumed.totals(), straight.totals());
+        assert!(
+            evolving(&resumed.state()) == evolving(&straight.state()),
+            "world, generators or counters differ after format {}",
+            bytes[8]
+        );
+        assert_eq!(resumed.policy().unwrap(), straight.policy().unwrap());
+    }
+    version
 }
 
 /// Everything that evolves: Q-values, visits, counters, world, generators.
@@ -156,9 +172,10 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
 {
     let rules = TrainConfig {
         walls: Some(sim::config::Walls::Clamp),
-        rules: host::learn::LearnerRules {
+        learn: host::learn::LearnConfig {
             tie_tolerance: 0.001,
             updates: host::learn::Updates::Batched,
+            ..Default::default()
         },
         stuck_limit: Some(800),
         ..small(13)
@@ -176,21 +193,21 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
             ..small(13)
         },
         TrainConfig {
-            rules: host::learn::LearnerRules {
+            learn: host::learn::LearnConfig {
                 tie_tolerance: 0.05,
                 ..Default::default()
             },
             ..small(13)
         },
         TrainConfig {
-            rules: host::learn::LearnerRules {
+            learn: host::learn::LearnConfig {
                 updates: host::learn::Updates::Batched,
                 ..Default::default()
             },
             ..small(13)
         },
     ] {
-        let what = format!("walls {:?}, rules {:?}", changed.walls, changed.rules);
+        let what = format!("walls {:?}, learner {:?}", changed.walls, changed.learn);
         let mut t = trainer(changed);
         t.run(10_000);
         assert_ne!(t.learner().table(), &base, "{what} changed nothing");
@@ -254,7 +271,7 @@ fn the_rewards_for_deep_learners_resume_exactly_from_a_format_6_checkpoint_and_c
 fn n_step_returns_are_the_same_per_seed_resume_exactly_with_steps_waiting_and_change_the_run() {
     let n_step = |n: Option<u32>, updates: host::learn::Updates| TrainConfig {
         n_step: n,
-        rules: host::learn::LearnerRules {
+        learn: host::learn::LearnConfig {
             updates,
             ..Default::default()
         },
@@ -288,7 +305,7 @@ fn n_step_returns_are_the_same_per_seed_resume_exactly_with_steps_waiting_and_ch
     }
     let mut bad = n_step(Some(65), host::learn::Updates::Sequential);
     let e = Trainer::start(bad.clone(), None).err().unwrap().to_string();
-    assert!(e.contains("n_step = 65") && e.contains("1 to 64"), "{e}");
+    assert!(e.contains("n_step = 65") && e.contains("[1, 64]"), "{e}");
     bad.n_step = Some(0);
     assert!(Trainer::start(bad, None).is_err());
 }
@@ -322,7 +339,8 @@ fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5
 }
 
 #[test]
-fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_byte() {
+fn published_checkpoints_of_earlier_builds_load_and_are_written_again_in_their_format_byte_for_byte(
+) {
     // the published pre-trained tables of docs/reproduction were written by
     // earlier builds; tests/checkpoints keeps one of format 1 (a table the
     // annulus' RL2 started from until its rerun with the clamping border)
@@ -359,9 +377,128 @@ fn published_checkpoints_of_earlier_builds_load_and_are_written_again_byte_for_b
         );
         let state = checkpoint::decode(bytes).unwrap();
         let mut again = Vec::new();
-        checkpoint::write_to(&mut again, &state).unwrap();
+        let written = checkpoint::write_earlier_format(&mut again, &state).unwrap();
+        assert_eq!(written, Some(*version), "{}", path.display());
         assert!(&again == bytes, "{} is written differently", path.display());
+        // and in the current format, the same state
+        let mut current = Vec::new();
+        checkpoint::write_to(&mut current, &state).unwrap();
+        let back = checkpoint::decode(&current).unwrap();
+        assert_eq!(back.config, state.config, "{}", path.display());
+        assert!(
+            evolving(&back) == evolving(&state),
+            "{}: the current format changed the state",
+            path.display()
+        );
     }
+}
+
+/// A checkpoint of the current format whose body, as a CBOR value, was
+/// changed by `edit`, framed (header and CRC) as a checkpoint again.
+fn edited_checkpoint(state: &TrainingState, edit: impl FnOnce(&mut ciborium::Value)) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, state).unwrap();
+    let mut value: ciborium::Value = ciborium::from_reader(&bytes[18..bytes.len() - 4]).unwrap();
+    edit(&mut value);
+    let mut body = Vec::new();
+    ciborium::into_writer(&value, &mut body).unwrap();
+    let mut framed = bytes[..10].to_vec();
+    framed.extend((body.len() as u64).to_le_bytes());
+    framed.extend(&body);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC).checksum(&framed);
+    framed.extend(crc.to_le_bytes());
+    framed
+}
+
+/// The field `key` of a struct's map in CBOR.
+fn field<'a>(value: &'a mut ciborium::Value, key: &str) -> &'a mut ciborium::Value {
+    let (_, inner) = value
+        .as_map_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|(k, _)| k.as_text() == Some(key))
+        .unwrap();
+    inner
+}
+
+/// The map entries of `value`'s field `key` (a struct's map in CBOR).
+fn entries<'a>(
+    value: &'a mut ciborium::Value,
+    key: &str,
+) -> &'a mut Vec<(ciborium::Value, ciborium::Value)> {
+    field(value, key).as_map_mut().unwrap()
+}
+
+#[test]
+fn a_setting_a_checkpoint_lacks_takes_its_default() {
+    let config = TrainConfig {
+        n_step: Some(3),
+        epsilon_decay: Some(5000),
+        learn: host::learn::LearnConfig {
+            tie_tolerance: 0.25,
+            ..Default::default()
+        },
+        ..small(31)
+    };
+    let mut t = trainer(config.clone());
+    t.run(200);
+    let bytes = edited_checkpoint(&t.state(), |body| {
+        let settings = field(body, "config");
+        entries(settings, "learn").retain(|(k, _)| k.as_text() != Some("tie_tolerance"));
+        settings
+            .as_map_mut()
+            .unwrap()
+            .retain(|(k, _)| !matches!(k.as_text(), Some("n_step" | "epsilon_decay")));
+    });
+    let state = checkpoint::decode(&bytes).unwrap();
+    assert_eq!(
+        (state.config.n_step, state.config.epsilon_decay),
+        (None, None),
+        "absent settings take their defaults"
+    );
+    assert_eq!(state.config.learn.tie_tolerance, 0.0);
+    assert_eq!(
+        TrainConfig {
+            n_step: Some(3),
+            epsilon_decay: Some(5000),
+            learn: host::learn::LearnConfig {
+                tie_tolerance: 0.25,
+                ..state.config.learn.clone()
+            },
+            ..state.config.clone()
+        },
+        config,
+        "the settings present are kept"
+    );
+}
+
+#[test]
+fn a_checkpoint_with_an_unknown_or_mistyped_setting_is_refused_naming_the_file_and_the_setting() {
+    let mut t = trainer(small(37));
+    t.run(100);
+    let dir = tempfile::tempdir().unwrap();
+    // the refusal of a file `name` holding `bytes`
+    let refusal = |name: &str, bytes: Vec<u8>| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        format!("{:#}", checkpoint::load(&path).unwrap_err())
+    };
+    let unknown = edited_checkpoint(&t.state(), |body| {
+        entries(body, "config").push(("pucks_per_robot".into(), 3.into()));
+    });
+    let e = refusal("unknown.ckpt", unknown);
+    assert!(
+        e.contains("unknown.ckpt") && e.contains("pucks_per_robot"),
+        "{e}"
+    );
+    let mistyped = edited_checkpoint(&t.state(), |body| {
+        *field(field(body, "config"), "steps") = "many".into();
+    });
+    let e = refusal("mistyped.ckpt", mistyped);
+    assert!(
+        e.contains("mistyped.ckpt") && e.contains("setting steps: invalid type"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -27,7 +27,7 @@ use crate::base::rng::SimRng;
 use crate::config::validate::ConfigError;
 use crate::config::{SimConfig, SuccessSignal};
 use crate::control::{Controller, Perception};
-use crate::episodes::eval::{eval, eval_prime, EvalPrime, EvalTracker, PuckChange};
+use crate::episodes::eval::{eval, eval_prime_of, EvalPrime, EvalTracker, PuckChange};
 use crate::episodes::{EpisodeEnd, EpisodeStart, StepOutcome};
 use crate::fields::ScalarField;
 use crate::sensors::disc::DiscSensors;
@@ -376,12 +376,5 @@ fn success_signal(world: &World, field: &ScalarField, config: &SimConfig, eval: 
         SuccessSignal::EvalPrime => EvalPrime::AsWritten,
         SuccessSignal::EvalPrimeSpread => EvalPrime::Spread,
     };
-    eval_prime(
-        world,
-        field,
-        &config.thresholds,
-        variant,
-        config.episode.phi,
-        config.episode.nu,
-    )
+    eval_prime_of(world, field, config, variant)
 }

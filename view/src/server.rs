@@ -783,10 +783,9 @@ impl Shared {
                     })
                     .transpose()?;
                 rebuilt = Some(self.rebuild(|now| {
-                    Ok(ViewSettings {
-                        seed: seed.unwrap_or(now.seed),
-                        ..now.clone()
-                    })
+                    let mut next = now.clone();
+                    next.world.seed = seed.unwrap_or(now.world.seed);
+                    Ok(next)
                 })?);
             }
             Some(other) => {

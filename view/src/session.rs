@@ -176,7 +176,8 @@ impl Session {
         let path = policy.as_ref().map(|p| p.path.clone());
         let choices = settings.choices(path);
         let warning = policy.as_ref().and_then(|p| {
-            let here = trained_for::trained_for(&choices.sensors, &choices.arena_choice());
+            let here =
+                trained_for::trained_for(&choices.world.sensors, &choices.world.arena_choice());
             trained_for::mismatch(p.blob.trained_for(), &here)
                 .map(|why| format!("policy {}: {why}", p.path.display()))
         });
@@ -359,15 +360,14 @@ fn boundary(outline: &Outline) -> Vec<[f64; 2]> {
 mod tests {
     use super::*;
     use sim::config::robot_shape::RobotShape;
+    use sim::scenario::choices::WorldChoices;
 
     #[test]
     fn a_sessions_frames_follow_host_runs_simulation_step_for_step() {
-        let settings = ViewSettings {
-            robots: Some(3),
-            pucks: Some(20),
-            seed: 5,
-            ..ViewSettings::default()
-        };
+        let mut settings = ViewSettings::default();
+        settings.world.robots = Some(3);
+        settings.world.pucks = Some(20);
+        settings.world.seed = 5;
         let mut session = Session::build(settings.clone(), None).unwrap();
         let (mut sim, mut controller) = settings.choices(None).scenario().unwrap().build().unwrap();
         for _ in 0..300 {
@@ -417,7 +417,10 @@ mod tests {
         // the robot's senses: the photo-transistors and the camera's floor
         let robot = Session::build(
             ViewSettings {
-                sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
+                world: WorldChoices {
+                    sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
+                    ..WorldChoices::default()
+                },
                 ..ViewSettings::default()
             },
             None,
@@ -437,8 +440,11 @@ mod tests {
     fn the_plot_keeps_a_bounded_number_of_points() {
         let mut session = Session::build(
             ViewSettings {
-                robots: Some(2),
-                pucks: Some(5),
+                world: WorldChoices {
+                    robots: Some(2),
+                    pucks: Some(5),
+                    ..WorldChoices::default()
+                },
                 ..ViewSettings::default()
             },
             None,

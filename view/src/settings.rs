@@ -7,7 +7,7 @@
 
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
-use sim::scenario::choices::ScenarioChoices;
+use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::ControllerChoice;
 use std::fmt;
@@ -79,31 +79,24 @@ pub fn valid_name(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
 }
 
-/// The view's world settings.
+/// The view's world settings: the controller, and the world's settings as
+/// every front end names them ([`WorldChoices`]; the view offers all but
+/// the border, `walls`, which keeps the server's).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ViewSettings {
     /// The controller.
     pub controller: ViewController,
-    /// The field.
-    pub field: FieldSource,
-    /// The arena; `None` for the sensor model's default.
-    pub arena: Option<ArenaChoice>,
-    /// The sensor model.
-    pub sensors: SensorChoice,
-    /// Noise, times the default.
-    pub noise: f64,
-    /// Robots; `None` for the arena's.
-    pub robots: Option<usize>,
-    /// Pucks; `None` for the arena's.
-    pub pucks: Option<usize>,
-    /// Seed.
-    pub seed: u64,
+    /// The world.
+    pub world: WorldChoices,
 }
 
 impl Default for ViewSettings {
     /// The thesis' standard run.
     fn default() -> ViewSettings {
-        ViewSettings::from_choices(&ScenarioChoices::default(), ViewController::Orbital)
+        ViewSettings {
+            controller: ViewController::Orbital,
+            world: WorldChoices::default(),
+        }
     }
 }
 
@@ -135,13 +128,7 @@ impl ViewSettings {
     pub fn from_choices(choices: &ScenarioChoices, controller: ViewController) -> ViewSettings {
         ViewSettings {
             controller,
-            field: choices.field.clone(),
-            arena: choices.arena.clone(),
-            sensors: choices.sensors.clone(),
-            noise: choices.noise,
-            robots: choices.robots,
-            pucks: choices.pucks,
-            seed: choices.seed,
+            world: choices.world.clone(),
         }
     }
 
@@ -155,15 +142,8 @@ impl ViewSettings {
             (other, None) => ControllerChoice::Policy(PathBuf::from(other.to_string())),
         };
         ScenarioChoices {
-            field: self.field.clone(),
             controller,
-            sensors: self.sensors.clone(),
-            arena: self.arena.clone(),
-            robots: self.robots,
-            pucks: self.pucks,
-            seed: self.seed,
-            noise: self.noise,
-            walls: None,
+            world: self.world.clone(),
         }
     }
 
@@ -172,19 +152,20 @@ impl ViewSettings {
         let or_own = |v: Option<usize>| v.map(|n| n.to_string()).unwrap_or_default();
         vec![
             ("controller", self.controller.to_string()),
-            ("field", self.field.to_string()),
+            ("field", self.world.field.to_string()),
             (
                 "arena",
-                self.arena
+                self.world
+                    .arena
                     .as_ref()
                     .map(|a| a.to_string())
                     .unwrap_or_default(),
             ),
-            ("sensors", self.sensors.to_string()),
-            ("noise", self.noise.to_string()),
-            ("robots", or_own(self.robots)),
-            ("pucks", or_own(self.pucks)),
-            ("seed", self.seed.to_string()),
+            ("sensors", self.world.sensors.to_string()),
+            ("noise", self.world.noise.to_string()),
+            ("robots", or_own(self.world.robots)),
+            ("pucks", or_own(self.world.pucks)),
+            ("seed", self.world.seed.to_string()),
         ]
     }
 
@@ -211,20 +192,20 @@ impl ViewSettings {
             };
             match key.as_str() {
                 "controller" => s.controller = value.parse().map_err(bad)?,
-                "field" => s.field = field(&value, allowed).map_err(bad)?,
-                "arena" => s.arena = arena(&value, allowed).map_err(bad)?,
-                "sensors" => s.sensors = sensors(&value, allowed).map_err(bad)?,
+                "field" => s.world.field = field(&value, allowed).map_err(bad)?,
+                "arena" => s.world.arena = arena(&value, allowed).map_err(bad)?,
+                "sensors" => s.world.sensors = sensors(&value, allowed).map_err(bad)?,
                 "noise" => {
-                    s.noise = value
+                    s.world.noise = value
                         .parse::<f64>()
                         .ok()
                         .filter(|v| v.is_finite())
                         .ok_or_else(|| bad("not a number".into()))?
                 }
-                "robots" => s.robots = count(&value)?,
-                "pucks" => s.pucks = count(&value)?,
+                "robots" => s.world.robots = count(&value)?,
+                "pucks" => s.world.pucks = count(&value)?,
                 "seed" => {
-                    s.seed = value
+                    s.world.seed = value
                         .parse()
                         .map_err(|_| bad("not a whole number from 0 to 2^64 - 1".into()))?
                 }
@@ -353,9 +334,9 @@ mod tests {
                 &[],
             )
             .unwrap();
-        assert_eq!(s.robots, Some(5));
-        assert_eq!(s.pucks, None);
-        assert_eq!(s.field.to_string(), "letter:T");
+        assert_eq!(s.world.robots, Some(5));
+        assert_eq!(s.world.pucks, None);
+        assert_eq!(s.world.field.to_string(), "letter:T");
         let again = ViewSettings::default()
             .with_query(&encode_query(&s.pairs()), &Allowed::default(), &[])
             .unwrap();

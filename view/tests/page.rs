@@ -115,10 +115,8 @@ fn reset_with_a_seed_reproduces_the_same_frames() {
 
 #[test]
 fn the_sensors_and_the_camera_view_are_drawn_on_request_and_kept_in_the_address() {
-    let settings = view::ViewSettings {
-        sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
-        ..view::ViewSettings::default()
-    };
+    let mut settings = view::ViewSettings::default();
+    settings.world.sensors = sim::scenario::sensor_choice::SensorChoice::Robot(None);
     let address = serve(settings, true, Speed::Real);
     let mut page = Browser::open(&format!("http://{address}/"), SIZE);
     page.wait_for("document.documentElement.dataset.ready === 'true'", 60);

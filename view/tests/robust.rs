@@ -51,11 +51,9 @@ fn timed_step(address: SocketAddr) -> (u64, Duration) {
 
 #[test]
 fn requests_are_answered_while_a_million_steps_run_on_a_large_world_and_a_pause_stops_them() {
-    let settings = view::ViewSettings {
-        robots: Some(1000),
-        pucks: Some(700),
-        ..small(11)
-    };
+    let mut settings = small(11);
+    settings.world.robots = Some(1000);
+    settings.world.pucks = Some(700);
     let address = serve(settings, true, Speed::Real);
     let (status, body) = request(address, "POST", "/control?action=step&steps=1000000", b"");
     assert_eq!(status, 200, "{body}");

@@ -54,7 +54,7 @@ fn controls_step_exactly_and_refused_settings_change_nothing() {
     assert_eq!(status, 200);
     let at = wait_for_step(address, 250);
     for (path, says) in [
-        ("/settings?robots=0", "world.robots = 0"),
+        ("/settings?robots=0", "robots = 0: outside"),
         ("/settings?noise=-1", "noise"),
         ("/settings?field=/etc/passwd", "field=/etc/passwd"),
         ("/settings?controller=policy:none.policy", "none.policy"),
@@ -102,10 +102,8 @@ fn a_shipped_policy_file_drives_the_robots_after_a_settings_change() {
 
 #[test]
 fn a_viewer_that_stops_reading_is_dropped_and_the_others_go_on() {
-    let settings = view::ViewSettings {
-        pucks: Some(600),
-        ..small(4)
-    };
+    let mut settings = small(4);
+    settings.world.pucks = Some(600);
     let address = serve(settings, false, Speed::Max);
     let idle = viewer(address);
     let mut reader = viewer(address);

@@ -60,7 +60,7 @@ impl ViewArgs {
     /// tv75 when no arena is given (the robots' screen).
     pub fn log_scenario(&self) -> Result<Scenario> {
         let mut scenario = self.scenario.clone().scenario()?;
-        if self.scenario.choices().arena.is_none() {
+        if self.scenario.choices().world.arena.is_none() {
             scenario.arena = Arena::Screen(Box::new(ArenaSpec::tv75()));
         }
         Ok(scenario)
@@ -95,13 +95,13 @@ impl ViewArgs {
             arena_files: self.arena_files,
             ..Allowed::default()
         };
-        if let Some(ArenaChoice::File(path)) = &choices.arena {
+        if let Some(ArenaChoice::File(path)) = &choices.world.arena {
             allowed.arena_files.push(path.clone());
         }
-        if let FieldSource::Image(path) = &choices.field {
+        if let FieldSource::Image(path) = &choices.world.field {
             allowed.field_file = Some(path.clone());
         }
-        sensor_files(&choices.sensors, &mut allowed.sensor_files);
+        sensor_files(&choices.world.sensors, &mut allowed.sensor_files);
         Ok(ViewOptions {
             bind,
             settings: ViewSettings::from_choices(&choices, controller),

@@ -13,6 +13,7 @@ use crate::train::format2::TrainConfigV2;
 use crate::train::format3::TrainConfigV3;
 use crate::train::format4::TrainConfigV4;
 use crate::train::format6::TrainConfigV6;
+use crate::train::format7::TrainConfigV7;
 use crate::train::{OutputConfig, TrainConfig};
 use crc::{Crc, CRC_64_XZ};
 use serde::Serialize;
@@ -103,9 +104,12 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to the field's
 /// default counts as unset (the same run either way), and settings that use
-/// nothing newer than format 1, 2, 3, 4 or 6 are hashed in its layout
-/// ([`TrainConfigV1`] to [`TrainConfigV6`]), so that trials
-/// run before the newer settings existed keep their hashes. (Those formats'
+/// nothing newer than checkpoint format 1, 2, 3, 4, 6 or 7 are hashed in its
+/// layout ([`TrainConfigV1`] to [`TrainConfigV7`]), so that trials run
+/// before the newer settings existed keep their hashes; settings with one
+/// added since format 7 away from its default hash as the JSON of the
+/// whole [`TrainConfig`] (so a new setting keeps every earlier hash and
+/// needs no rule here). (Those formats'
 /// runs had wall segments: a run in the thesis' square that clamps at its
 /// border, the default since, is of the newest layout and hashes anew.) Settings with the robot's
 /// senses also hash their model's version
@@ -119,6 +123,7 @@ enum Hashed {
     V3(TrainConfigV3),
     V4(TrainConfigV4),
     V6(TrainConfigV6),
+    V7(TrainConfigV7),
     Current(TrainConfig),
     /// Settings with the robot's senses, and the version of their model.
     RobotSenses {
@@ -139,20 +144,25 @@ fn hashed(config: &TrainConfig) -> Hashed {
         c.innies = None;
     }
     let robot_senses = c.sensors.is_robot();
-    let settings = if TrainConfigV6::of(&c).is_none() {
-        Hashed::Current(c)
-    } else if let Some(v1) = TrainConfigV1::of(&c) {
-        Hashed::V1(v1)
-    } else if let Some(v2) = TrainConfigV2::of(&c) {
-        Hashed::V2(v2)
-    } else if let Some(v3) = TrainConfigV3::of(&c) {
-        Hashed::V3(v3)
-    } else if let Some(v4) = TrainConfigV4::of(&c) {
-        Hashed::V4(v4)
-    } else if let Some(v6) = TrainConfigV6::of(&c) {
-        Hashed::V6(v6)
-    } else {
-        Hashed::Current(c)
+    let settings = match TrainConfigV7::of(&c) {
+        None => Hashed::Current(c),
+        Some(v7) => {
+            if TrainConfigV6::of(&v7).is_none() {
+                Hashed::V7(v7)
+            } else if let Some(v1) = TrainConfigV1::of(&v7) {
+                Hashed::V1(v1)
+            } else if let Some(v2) = TrainConfigV2::of(&v7) {
+                Hashed::V2(v2)
+            } else if let Some(v3) = TrainConfigV3::of(&v7) {
+                Hashed::V3(v3)
+            } else if let Some(v4) = TrainConfigV4::of(&v7) {
+                Hashed::V4(v4)
+            } else if let Some(v6) = TrainConfigV6::of(&v7) {
+                Hashed::V6(v6)
+            } else {
+                Hashed::V7(v7)
+            }
+        }
     };
     let settings = if robot_senses {
         Hashed::RobotSenses {

@@ -39,17 +39,6 @@ pub struct LearnConfig {
     /// shaping on Eval with --gamma) [default: reference].
     #[arg(long, required = false)]
     pub reward: Reward,
-}
-
-/// How the learner chooses among near-best actions and applies a step's
-/// updates: settings of the ablations of `docs/reproduction.md` whose
-/// defaults are the thesis author's program (exact ties, robot-order
-/// updates each seeing the ones before). Kept beside [`LearnConfig`], not in
-/// it, so that the checkpoint formats that hold a `LearnConfig` keep their
-/// layout.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, clap::Args)]
-#[serde(default, deny_unknown_fields)]
-pub struct LearnerRules {
     /// Greedy choice among every action within this of the best value,
     /// uniformly at random (0: exact ties only, the author's program; its
     /// unused `m_diffThresh` would be 0.001) [default: 0].
@@ -63,25 +52,7 @@ pub struct LearnerRules {
     pub updates: Updates,
 }
 
-impl Default for LearnerRules {
-    /// The thesis author's program: exact ties, sequential updates.
-    fn default() -> LearnerRules {
-        LearnerRules {
-            tie_tolerance: 0.0,
-            updates: Updates::Sequential,
-        }
-    }
-}
-
-impl LearnerRules {
-    /// Checks ranges before a run; errors name the setting.
-    pub fn validate(&self) -> Result<()> {
-        sim::base::ranges::TIE_TOLERANCE.check(self.tie_tolerance)?;
-        Ok(())
-    }
-}
-
-/// How one step's Q-updates are applied ([`LearnerRules::updates`]).
+/// How one step's Q-updates are applied ([`LearnConfig::updates`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Updates {
@@ -140,7 +111,8 @@ impl std::str::FromStr for StateHasherName {
 
 impl Default for LearnConfig {
     /// The thesis' Table 1: Original hasher, alpha 0.2, gamma 0.9, epsilon
-    /// 0, initial Q 1.0, the four default actions, the reference reward.
+    /// 0, initial Q 1.0, the four default actions, the reference reward;
+    /// the thesis author's program's exact ties and sequential updates.
     fn default() -> LearnConfig {
         let params = QParams::default();
         LearnConfig {
@@ -151,6 +123,8 @@ impl Default for LearnConfig {
             epsilon: 0.0,
             initial_q: 1.0,
             reward: Reward::Reference,
+            tie_tolerance: 0.0,
+            updates: Updates::Sequential,
         }
     }
 }
@@ -166,10 +140,9 @@ impl LearnConfig {
             ("learn.gamma", self.gamma),
             ("learn.epsilon", self.epsilon),
         ] {
-            if !(0.0..=1.0).contains(&value) {
-                bail!("{name} = {value}: must be in [0, 1]");
-            }
+            sim::base::ranges::FRACTION.check_as(name, value)?;
         }
+        sim::base::ranges::TIE_TOLERANCE.check(self.tie_tolerance)?;
         if !self.initial_q.is_finite() {
             bail!(
                 "learn.initial_q = {}: must be a finite number",
@@ -203,11 +176,6 @@ pub struct QLearner {
     /// The reward signal (Eval or Eval') of the world before the step in
     /// flight; set at every episode start.
     last_signal: f64,
-    /// The rules: a run's setting, given again on every start and resume
-    /// ([`QLearner::with_rules`]), so not part of the learner's layout in a
-    /// checkpoint.
-    #[serde(skip)]
-    rules: LearnerRules,
     /// Batched updates' TD errors of the step in flight.
     #[serde(skip)]
     errors: Vec<f64>,
@@ -244,20 +212,7 @@ impl QLearner {
     pub fn new(config: LearnConfig) -> Result<QLearner> {
         config.validate()?;
         let q = QTable::new(config.hasher.0, config.actions.len(), config.initial_q);
-        Ok(QLearner {
-            config,
-            q,
-            chosen: Vec::new(),
-            last_signal: 0.0,
-            rules: LearnerRules::default(),
-            errors: Vec::new(),
-            rewards: Vec::new(),
-            touching: Vec::new(),
-            exploration: None,
-            n_step: 1,
-            pending: PendingSteps::default(),
-            due: Vec::new(),
-        })
+        Ok(QLearner::saved(config, q, 0.0))
     }
 
     /// A learner that starts from another run's table (the thesis' RL2 and
@@ -276,12 +231,6 @@ impl QLearner {
         }
         learner.q = q;
         Ok(learner)
-    }
-
-    /// This learner with `rules`.
-    pub fn with_rules(mut self, rules: LearnerRules) -> QLearner {
-        self.rules = rules;
-        self
     }
 
     /// This learner with n-step returns of `n` rewards (1: one-step
@@ -310,11 +259,6 @@ impl QLearner {
         self.exploration.unwrap_or(self.config.epsilon)
     }
 
-    /// The rules.
-    pub fn rules(&self) -> LearnerRules {
-        self.rules
-    }
-
     /// The Q-table.
     pub fn table(&self) -> &QTable {
         &self.q
@@ -330,6 +274,24 @@ impl QLearner {
     pub fn signal(&self) -> f64 {
         self.last_signal
     }
+
+    /// The learner a checkpoint of an earlier layout saved: its settings,
+    /// table and the reward signal of the world after its last step.
+    pub fn saved(config: LearnConfig, q: QTable, last_signal: f64) -> QLearner {
+        QLearner {
+            config,
+            q,
+            chosen: Vec::new(),
+            last_signal,
+            errors: Vec::new(),
+            rewards: Vec::new(),
+            touching: Vec::new(),
+            exploration: None,
+            n_step: 1,
+            pending: PendingSteps::default(),
+            due: Vec::new(),
+        }
+    }
 }
 
 impl Controller for QLearner {
@@ -344,7 +306,9 @@ impl Controller for QLearner {
             .zip(perception.robots)
         {
             let state = hasher.hash_as(reading, robot.kind.role());
-            let action = self.q.select(state, epsilon, self.rules.tie_tolerance, rng);
+            let action = self
+                .q
+                .select(state, epsilon, self.config.tie_tolerance, rng);
             *turn = self.config.actions[action.index()];
             self.chosen.push((state, action));
         }
@@ -397,7 +361,7 @@ impl Controller for QLearner {
             self.last_signal = signal;
             return;
         }
-        match self.rules.updates {
+        match self.config.updates {
             Updates::Sequential => {
                 for ((&(s, a), s2), &r) in self.chosen.iter().zip(next).zip(&self.rewards) {
                     self.q.update(s, a, r, s2, params);
@@ -424,7 +388,7 @@ impl QLearner {
     /// seeing the ones before, or with batched rules all from the table
     /// before the step.
     fn update_n_step(&mut self, next: impl Iterator<Item = State>, ended: bool, params: QParams) {
-        let batched = self.rules.updates == Updates::Batched;
+        let batched = self.config.updates == Updates::Batched;
         self.due.clear();
         for (robot, ((&(state, action), next), &reward)) in
             self.chosen.iter().zip(next).zip(&self.rewards).enumerate()
@@ -468,7 +432,7 @@ mod tests {
     /// Two robots in the same state with action 0 greedy (Q 2, the other
     /// actions 1), one step with no pucks (the reference reward is -1):
     /// the turns they chose and the learner after the step.
-    fn two_robots_one_step(rules: LearnerRules) -> ([f32; 2], QLearner, State) {
+    fn two_robots_one_step(updates: Updates) -> ([f32; 2], QLearner, State) {
         let config = SimConfig::default();
         let robots = [
             (Vec2::new(100.0, 100.0), 0.0, RobotKind::Outie),
@@ -483,10 +447,12 @@ mod tests {
         };
         let s = StateHasher::Original.hash(&reading);
         policy.set(s, ActionId(0));
+        let learn = LearnConfig {
+            updates,
+            ..LearnConfig::default()
+        };
         let mut learner =
-            QLearner::with_table(LearnConfig::default(), QTable::from_policy(&policy, 4, 1.0))
-                .unwrap()
-                .with_rules(rules);
+            QLearner::with_table(learn, QTable::from_policy(&policy, 4, 1.0)).unwrap();
         // no pucks: Eval stays 1, so the reference reward is 0 - 1 = -1
         learner.episode_start(&EpisodeStart {
             world: &world,
@@ -519,7 +485,7 @@ mod tests {
     /// same state: the second update sees the first.
     #[test]
     fn updates_are_applied_in_robot_order_each_seeing_the_last() {
-        let (turns, learner, s) = two_robots_one_step(LearnerRules::default());
+        let (turns, learner, s) = two_robots_one_step(Updates::Sequential);
         assert_eq!(turns, [LearnConfig::default().actions[0]; 2]);
         // first: 2 + 0.2 (-1 + 0.9 x 2 - 2) = 1.76; second sees it:
         // 1.76 + 0.2 (-1 + 0.9 x 1.76 - 1.76) = 1.5248
@@ -537,11 +503,7 @@ mod tests {
     /// before the step.
     #[test]
     fn batched_updates_take_every_td_error_from_the_table_before_the_step() {
-        let rules = LearnerRules {
-            updates: Updates::Batched,
-            ..LearnerRules::default()
-        };
-        let (_, learner, s) = two_robots_one_step(rules);
+        let (_, learner, s) = two_robots_one_step(Updates::Batched);
         // each error -1 + 0.9 x 2 - 2 = -1.2; 2 + 0.2 (-1.2) x 2 = 1.52
         let q = learner.table().value(s, ActionId(0));
         assert!((q - 1.52).abs() < 1e-12, "{q}");

@@ -9,6 +9,6 @@ pub mod qtable;
 pub mod returns;
 
 pub use frozen::FrozenLearner;
-pub use learner::{LearnConfig, LearnerRules, QLearner, StateHasherName, Updates};
+pub use learner::{LearnConfig, QLearner, StateHasherName, Updates};
 pub use qtable::{QParams, QTable, TableSummary};
 pub use returns::{PendingSteps, MAX_N_STEP};

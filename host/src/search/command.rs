@@ -243,7 +243,7 @@ fn worlds_from(base: TrainConfig, settings: &SearchConfig) -> Result<Vec<TrainCo
                 noise,
                 ..base.clone()
             };
-            config.pucks = config.choices().pucks()?;
+            config.pucks = config.world().pucks()?;
             config.validate()?;
             Ok(config)
         })

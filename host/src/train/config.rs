@@ -4,7 +4,7 @@
 //! the file key's documentation and the flag's help.
 
 use super::selection::SelectConfig;
-use crate::learn::{LearnConfig, LearnerRules, MAX_N_STEP};
+use crate::learn::LearnConfig;
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use shared::blob::name_prefix;
 use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
-use sim::scenario::choices::ScenarioChoices;
+use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{
@@ -119,9 +119,6 @@ pub struct TrainConfig {
     /// on a screen].
     #[arg(long)]
     pub walls: Option<Walls>,
-    /// The learner's rules (docs/training.md, "Learner rules and the border").
-    #[command(flatten)]
-    pub rules: LearnerRules,
     /// Decaying exploration: the exploration probability falls linearly
     /// from --epsilon at step 0 to 0 at this step (in steps of
     /// 1,000) and stays 0 [default: none, --epsilon throughout].
@@ -225,7 +222,6 @@ impl Default for TrainConfig {
             select: None,
             distil_oc: None,
             walls: None,
-            rules: LearnerRules::default(),
             epsilon_decay: None,
             n_step: None,
         }
@@ -260,7 +256,7 @@ impl TrainConfig {
 
     /// The arena the run uses.
     pub fn arena_choice(&self) -> ArenaChoice {
-        self.choices().arena_choice()
+        self.world().arena_choice()
     }
 
     /// The sensor model and arena the run trains for, as its policy blob
@@ -278,8 +274,15 @@ impl TrainConfig {
     /// The world's settings by name, the controller random.
     pub fn choices(&self) -> ScenarioChoices {
         ScenarioChoices {
-            field: self.field.clone(),
             controller: ControllerChoice::Random,
+            world: self.world(),
+        }
+    }
+
+    /// The world's settings by name.
+    pub fn world(&self) -> WorldChoices {
+        WorldChoices {
+            field: self.field.clone(),
             sensors: self.sensors.clone(),
             arena: self.arena.clone(),
             robots: self.robots,
@@ -365,13 +368,7 @@ impl TrainConfig {
     /// the setting.
     pub fn validate(&self) -> Result<()> {
         ranges::STEPS.check_count("steps", self.steps)?;
-        if let Some(robots) = self.robots {
-            ranges::ROBOTS.check_count("robots", robots as u64)?;
-        }
-        if let Some(pucks) = self.pucks {
-            ranges::PUCKS.check_count("pucks", pucks as u64)?;
-        }
-        ranges::NOISE.check(self.noise)?;
+        sim::scenario::choices::check_world_ranges(self.robots, self.pucks, self.noise)?;
         if let Some(limit) = self.stuck_limit {
             ranges::STUCK_LIMIT.check_count("stuck_limit", limit)?;
         }
@@ -380,7 +377,6 @@ impl TrainConfig {
             ranges::DISC_RADIUS.check_as("obstacle_discs.radius", discs.radius)?;
         }
         self.learn.validate()?;
-        self.rules.validate()?;
         ranges::INITIAL_Q.check(self.learn.initial_q)?;
         for a in &self.learn.actions {
             ranges::ANGULAR_SPEED.check(f64::from(*a))?;
@@ -395,8 +391,8 @@ impl TrainConfig {
         if let Some(steps) = self.epsilon_decay {
             ranges::STEPS.check_count("epsilon_decay", steps)?;
         }
-        if let Some(n) = self.n_step.filter(|n| !(1..=MAX_N_STEP).contains(n)) {
-            bail!("n_step = {n}: must be 1 to {MAX_N_STEP} rewards per update");
+        if let Some(n) = self.n_step {
+            ranges::N_STEP.check_count("n_step", u64::from(n))?;
         }
         ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
         if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {

@@ -2,21 +2,21 @@
 //! the settings of the thesis author's runs existed (formation checks every
 //! N steps on a stale Eval, the success signal, innies, obstacle discs; the
 //! simulation's stale signal) and before rectangular and screen arenas
-//! (a square arena's side only). Settings and states that use none of them
-//! keep this layout: a checkpoint is byte for byte what earlier builds
-//! wrote (format-1 files keep loading), and an experiment trial's hash is
-//! the one earlier builds gave it (`experiment::plan`).
+//! (a square arena's side only). Format-1 files are read into format 7's
+//! layout ([`super::format7`]); settings and states that use none of the
+//! newer settings convert to this layout again, byte for byte what earlier
+//! builds wrote (`checkpoint::write_earlier_format`), and an experiment
+//! trial's settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 1 in
 //! their order, the types they share with the newer formats unchanged.
 //! Format 1 is format 2 ([`super::format2`]) with fewer settings, so these
 //! convert to and from format 2's layout.
 
-use super::config::{FormationCheck, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, OutputConfig};
 use super::format2::{SimConfigV2, SimulationV2, StateV2, TrainConfigV2, WorldConfigV2, WorldV2};
 use super::format3::PhysicsConfigV3;
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, QLearner};
+use super::format7::{LearnConfigV7, QLearnerV7, StateV7, TrainConfigV7};
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::{EpisodeConfig, SuccessSignal, Thresholds, WorldConfig};
@@ -33,10 +33,10 @@ pub struct StateV1 {
     config: TrainConfigV1,
     field_crc: u32,
     sim: SimulationV1,
-    learner: QLearner,
+    learner: QLearnerV7,
 }
 
-/// A [`TrainConfig`] without the settings added since format 1.
+/// A [`TrainConfigV7`] without the settings added since format 1.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV1 {
     field: FieldSource,
@@ -46,7 +46,7 @@ pub struct TrainConfigV1 {
     steps: u64,
     seed: u64,
     stuck_limit: Option<u64>,
-    learn: LearnConfig,
+    learn: LearnConfigV7,
     output: OutputConfig,
 }
 
@@ -146,7 +146,7 @@ struct EpisodeV1 {
 
 impl TrainConfigV1 {
     /// The settings in format 1, if they use nothing format 1 cannot hold.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV1> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV1> {
         TrainConfigV2::of(c).and_then(|c| TrainConfigV1::of_v2(&c))
     }
 
@@ -170,7 +170,7 @@ impl TrainConfigV1 {
 
     /// The settings with every one format 1 lacks at its default.
     fn into_v2(self) -> TrainConfigV2 {
-        let d = TrainConfig::default();
+        let d = TrainConfigV7::default();
         TrainConfigV2 {
             field: self.field,
             sensors: self.sensors,
@@ -191,7 +191,7 @@ impl TrainConfigV1 {
 
 impl StateV1 {
     /// The state in format 1, if it uses nothing format 1 cannot hold.
-    pub fn of(state: &TrainingState) -> Option<StateV1> {
+    pub fn of(state: &StateV7) -> Option<StateV1> {
         let v2 = StateV2::of(state)?;
         let (s, e) = (&v2.sim, &v2.sim.config.episode);
         let plain_sim =
@@ -233,7 +233,7 @@ impl StateV1 {
     }
 
     /// The state, with every setting format 1 lacks at its default.
-    pub fn into_state(self) -> TrainingState {
+    pub fn into_v7(self) -> StateV7 {
         let s = self.sim;
         let e = s.config.episode;
         let w = s.world;
@@ -271,6 +271,6 @@ impl StateV1 {
             },
             learner: self.learner,
         }
-        .into_state()
+        .into_v7()
     }
 }

@@ -2,20 +2,21 @@
 //! the noise models (the robots' motion, the robot senses' noise and
 //! latency) and before a run's arena and noise were settings: the thesis'
 //! square or a rectangular arena of fixed settings, every count given.
-//! Settings and states that use nothing newer, but something format 1
-//! lacks, keep this layout: a checkpoint is byte for byte what earlier
-//! builds wrote, and an experiment trial's hash the one they gave it
-//! (`experiment::plan`).
+//! Format-2 files are read into format 7's layout ([`super::format7`]);
+//! settings and states that use nothing newer, but something format 1
+//! lacks, convert to this layout again, byte for byte what earlier builds
+//! wrote (`checkpoint::write_earlier_format`), and an experiment trial's
+//! settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 2 in
 //! their order, the types they share with the newest format unchanged.
 //! The world's seed and episode count are derived on reading, as for
 //! format 1 ([`super::format1`]).
 
-use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig};
 use super::format3::PhysicsConfigV3;
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
+use super::format7::{LearnConfigV7, LearnerRules, QLearnerV7, StateV7, TrainConfigV7};
+use crate::learn::PendingSteps;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
@@ -37,10 +38,10 @@ pub struct StateV2 {
     pub(super) config: TrainConfigV2,
     pub(super) field_crc: u32,
     pub(super) sim: SimulationV2,
-    pub(super) learner: QLearner,
+    pub(super) learner: QLearnerV7,
 }
 
-/// A [`TrainConfig`] without the settings added since format 2: the
+/// A [`TrainConfigV7`] without the settings added since format 2: the
 /// thesis' square, no noise, the counts resolved.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV2 {
@@ -51,7 +52,7 @@ pub struct TrainConfigV2 {
     pub(super) steps: u64,
     pub(super) seed: u64,
     pub(super) stuck_limit: Option<u64>,
-    pub(super) learn: LearnConfig,
+    pub(super) learn: LearnConfigV7,
     pub(super) output: OutputConfig,
     pub(super) formation_check: FormationCheck,
     pub(super) success: SuccessSignal,
@@ -62,7 +63,7 @@ pub struct TrainConfigV2 {
 impl TrainConfigV2 {
     /// The settings in format 2, if they run in the thesis' square
     /// without noise, policy selection or distillation.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV2> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV2> {
         let plain = c.arena_choice() == ArenaChoice::Thesis
             && c.walls_in_effect() == Walls::Segments
             && c.rules == LearnerRules::default()
@@ -88,11 +89,11 @@ impl TrainConfigV2 {
     }
 }
 
-impl From<TrainConfigV2> for TrainConfig {
+impl From<TrainConfigV2> for TrainConfigV7 {
     /// The settings in the thesis' square, without noise, with wall
     /// segments.
-    fn from(c: TrainConfigV2) -> TrainConfig {
-        let mut config = TrainConfig {
+    fn from(c: TrainConfigV2) -> TrainConfigV7 {
+        let mut config = TrainConfigV7 {
             field: c.field,
             sensors: c.sensors,
             arena: Some(ArenaChoice::Thesis),
@@ -220,7 +221,7 @@ impl StateV2 {
     /// The state in format 2, if it uses nothing newer: the config of
     /// [`TrainConfigV2::of`], no motion noise, no sensor memory, the world
     /// seeded with the run's seed and one episode begun per episode ended.
-    pub fn of(state: &TrainingState) -> Option<StateV2> {
+    pub fn of(state: &StateV7) -> Option<StateV2> {
         let s = &state.sim;
         let w = s.world.state();
         let config = TrainConfigV2::of(&state.config)?;
@@ -261,11 +262,11 @@ impl StateV2 {
 
     /// The state, with what format 2 lacks derived as [`StateV2::of`]
     /// requires it.
-    pub fn into_state(self) -> TrainingState {
+    pub fn into_v7(self) -> StateV7 {
         let (c, s) = (self.config, self.sim);
         let (seed, episode) = (c.seed, episodes(&s.totals));
         let w = s.world;
-        TrainingState {
+        StateV7 {
             config: c.into(),
             field_crc: self.field_crc,
             sim: SimulationState {

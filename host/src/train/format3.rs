@@ -1,21 +1,22 @@
 //! Format 3: the training settings and state as they were laid out before
 //! the arena's border became a setting (`physics.walls`, the run's
 //! `walls`) and before the learner's rules (`rules`: tie tolerance,
-//! batched updates). Every format-3 run's border was wall segments; states
-//! that use segments and the default rules keep this layout, so a
-//! checkpoint is byte for byte what earlier builds wrote and an experiment
-//! trial's hash the one they gave it (`experiment::plan`).
+//! batched updates). Every format-3 run's border was wall segments. Files
+//! are read into format 7's layout ([`super::format7`]); states that use
+//! segments and the default rules convert to this layout again, byte for
+//! byte what earlier builds wrote (`checkpoint::write_earlier_format`), and
+//! an experiment trial's settings that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list format 3's fields in their
 //! order, the types they share with the newest format unchanged.
 //! [`PhysicsConfigV3`] is also the physics layout of formats 1 and 2; the
 //! world's is format 4's ([`WorldConfigV4`]: discs).
 
-use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig};
 use super::format4::WorldConfigV4;
+use super::format7::{LearnConfigV7, LearnerRules, QLearnerV7, StateV7, TrainConfigV7};
 use super::selection::{SelectConfig, Selected};
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
+use crate::learn::PendingSteps;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::base::rng::SimRng;
@@ -35,11 +36,11 @@ pub struct StateV3 {
     config: TrainConfigV3,
     field_crc: u32,
     sim: SimulationV3,
-    learner: QLearner,
+    learner: QLearnerV7,
     selected: Option<Selected>,
 }
 
-/// A [`TrainConfig`] without `walls` and `rules`.
+/// A [`TrainConfigV7`] without `walls` and `rules`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV3 {
     field: FieldSource,
@@ -51,7 +52,7 @@ pub struct TrainConfigV3 {
     steps: u64,
     seed: u64,
     stuck_limit: Option<u64>,
-    learn: LearnConfig,
+    learn: LearnConfigV7,
     output: OutputConfig,
     formation_check: FormationCheck,
     success: SuccessSignal,
@@ -64,7 +65,7 @@ pub struct TrainConfigV3 {
 impl TrainConfigV3 {
     /// The settings in format 3, if the run's border is wall segments and
     /// its learner keeps the default rules.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV3> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV3> {
         let plain = c.walls_in_effect() == Walls::Segments
             && c.rules == LearnerRules::default()
             && c.epsilon_decay.is_none();
@@ -90,11 +91,11 @@ impl TrainConfigV3 {
     }
 }
 
-impl From<TrainConfigV3> for TrainConfig {
+impl From<TrainConfigV3> for TrainConfigV7 {
     /// The settings with wall segments (said outright where the arena's
     /// own border would be another) and the default rules.
-    fn from(c: TrainConfigV3) -> TrainConfig {
-        let mut config = TrainConfig {
+    fn from(c: TrainConfigV3) -> TrainConfigV7 {
+        let mut config = TrainConfigV7 {
             field: c.field,
             sensors: c.sensors,
             arena: c.arena,
@@ -194,7 +195,7 @@ struct SimulationV3 {
 impl StateV3 {
     /// The state in format 3, if it uses nothing newer: the settings of
     /// [`TrainConfigV3::of`] and wall segments in the simulation.
-    pub fn of(state: &TrainingState) -> Option<StateV3> {
+    pub fn of(state: &StateV7) -> Option<StateV3> {
         let s = &state.sim;
         let w = s.world.state();
         Some(StateV3 {
@@ -232,7 +233,7 @@ impl StateV3 {
     }
 
     /// The state, with wall segments and the default rules.
-    pub fn into_state(self) -> TrainingState {
+    pub fn into_v7(self) -> StateV7 {
         let s = self.sim;
         let w = s.world;
         let world = World::from_state(WorldState {
@@ -246,7 +247,7 @@ impl StateV3 {
             episode: w.episode,
             last_turns: w.last_turns,
         });
-        TrainingState {
+        StateV7 {
             config: self.config.into(),
             field_crc: self.field_crc,
             sim: SimulationState {

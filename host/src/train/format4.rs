@@ -1,19 +1,20 @@
 //! Format 4: the training state as it was laid out before the robots'
 //! outline ([`sim::config::robot_shape::RobotShape`]) was a world setting
-//! and before decaying exploration (`epsilon_decay`). A state whose robots
-//! are discs and whose exploration does not decay keeps this layout (or an
-//! older one), so its checkpoint is byte for byte what earlier builds wrote
-//! and an experiment trial's hash the one they gave it; format 5 (the
-//! current layout) holds the rest.
+//! and before decaying exploration (`epsilon_decay`). Files are read into
+//! format 7's layout ([`super::format7`]); a state whose robots are discs
+//! and whose exploration does not decay converts to this layout (or an
+//! older one) again, byte for byte what earlier builds wrote
+//! (`checkpoint::write_earlier_format`), and an experiment trial's settings
+//! that do hash in it (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of format 4 in
 //! their order, the types they share with the newest format unchanged.
 //! [`WorldConfigV4`] is also the world layout of format 4.
 
-use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig};
+use super::format7::{LearnConfigV7, LearnerRules, QLearnerV7, StateV7, TrainConfigV7};
 use super::selection::{SelectConfig, Selected};
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
+use crate::learn::PendingSteps;
 use serde::{Deserialize, Serialize};
 use shared::SensorReading;
 use sim::config::actuation::ActuationNoise;
@@ -38,11 +39,11 @@ pub struct StateV4 {
     config: TrainConfigV4,
     field_crc: u32,
     sim: SimulationV4,
-    learner: QLearner,
+    learner: QLearnerV7,
     selected: Option<Selected>,
 }
 
-/// A [`TrainConfig`] without `epsilon_decay`.
+/// A [`TrainConfigV7`] without `epsilon_decay`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV4 {
     field: FieldSource,
@@ -54,7 +55,7 @@ pub struct TrainConfigV4 {
     steps: u64,
     seed: u64,
     stuck_limit: Option<u64>,
-    learn: LearnConfig,
+    learn: LearnConfigV7,
     output: OutputConfig,
     formation_check: FormationCheck,
     success: SuccessSignal,
@@ -68,7 +69,7 @@ pub struct TrainConfigV4 {
 
 impl TrainConfigV4 {
     /// The settings in format 4, if the run's exploration does not decay.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV4> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV4> {
         c.epsilon_decay.is_none().then(|| TrainConfigV4 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),
@@ -93,10 +94,10 @@ impl TrainConfigV4 {
     }
 }
 
-impl From<TrainConfigV4> for TrainConfig {
+impl From<TrainConfigV4> for TrainConfigV7 {
     /// The settings, exploration constant.
-    fn from(c: TrainConfigV4) -> TrainConfig {
-        TrainConfig {
+    fn from(c: TrainConfigV4) -> TrainConfigV7 {
+        TrainConfigV7 {
             field: c.field,
             sensors: c.sensors,
             arena: c.arena,
@@ -222,7 +223,7 @@ struct WorldV4 {
 impl StateV4 {
     /// The state in format 4, if its robots are discs and its
     /// exploration does not decay.
-    pub fn of(state: &TrainingState) -> Option<StateV4> {
+    pub fn of(state: &StateV7) -> Option<StateV4> {
         let s = &state.sim;
         let w = s.world.state();
         Some(StateV4 {
@@ -260,10 +261,10 @@ impl StateV4 {
     }
 
     /// The state, its robots discs, its exploration constant.
-    pub fn into_state(self) -> TrainingState {
+    pub fn into_v7(self) -> StateV7 {
         let s = self.sim;
         let w = s.world;
-        TrainingState {
+        StateV7 {
             config: self.config.into(),
             field_crc: self.field_crc,
             sim: SimulationState {

@@ -1,19 +1,20 @@
 //! Formats 5 and 6: the training state as it was laid out before n-step
 //! returns (`n_step`, and the robots' waiting steps beside the learner).
-//! A state of one-step returns keeps this layout (or an older one), so
-//! its checkpoint is byte for byte what earlier builds wrote and an
-//! experiment trial's hash the one they gave it; format 7 (the current
-//! layout) holds the rest.
+//! Files are read into format 7's layout ([`super::format7`]); a state of
+//! one-step returns converts to this layout (or an older one) again, byte
+//! for byte what earlier builds wrote (`checkpoint::write_earlier_format`),
+//! and an experiment trial's settings that do hash in it
+//! (`experiment::plan`).
 //!
 //! postcard is positional: these structs list the fields of formats 5 and
 //! 6 in their order, the types they share with the newest format
 //! unchanged (the two formats differ only in the rewards format 5's
 //! readers know).
 
-use super::config::{FormationCheck, ObstacleDiscs, OutputConfig, TrainConfig};
+use super::config::{FormationCheck, ObstacleDiscs, OutputConfig};
+use super::format7::{LearnConfigV7, LearnerRules, QLearnerV7, StateV7, TrainConfigV7};
 use super::selection::{SelectConfig, Selected};
-use super::trainer::TrainingState;
-use crate::learn::{LearnConfig, LearnerRules, PendingSteps, QLearner};
+use crate::learn::PendingSteps;
 use serde::{Deserialize, Serialize};
 use sim::config::{SuccessSignal, Walls};
 use sim::fields::source::FieldSource;
@@ -27,11 +28,11 @@ pub struct StateV6 {
     config: TrainConfigV6,
     field_crc: u32,
     sim: SimulationState,
-    learner: QLearner,
+    learner: QLearnerV7,
     selected: Option<Selected>,
 }
 
-/// A [`TrainConfig`] without `n_step`.
+/// A [`TrainConfigV7`] without `n_step`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfigV6 {
     field: FieldSource,
@@ -43,7 +44,7 @@ pub struct TrainConfigV6 {
     steps: u64,
     seed: u64,
     stuck_limit: Option<u64>,
-    learn: LearnConfig,
+    learn: LearnConfigV7,
     output: OutputConfig,
     formation_check: FormationCheck,
     success: SuccessSignal,
@@ -58,7 +59,7 @@ pub struct TrainConfigV6 {
 
 impl TrainConfigV6 {
     /// The settings in this layout, if the run's returns are one-step.
-    pub fn of(c: &TrainConfig) -> Option<TrainConfigV6> {
+    pub fn of(c: &TrainConfigV7) -> Option<TrainConfigV6> {
         c.n_step.is_none().then(|| TrainConfigV6 {
             field: c.field.clone(),
             sensors: c.sensors.clone(),
@@ -84,10 +85,10 @@ impl TrainConfigV6 {
     }
 }
 
-impl From<TrainConfigV6> for TrainConfig {
+impl From<TrainConfigV6> for TrainConfigV7 {
     /// The settings, returns one-step.
-    fn from(c: TrainConfigV6) -> TrainConfig {
-        TrainConfig {
+    fn from(c: TrainConfigV6) -> TrainConfigV7 {
+        TrainConfigV7 {
             field: c.field,
             sensors: c.sensors,
             arena: c.arena,
@@ -116,7 +117,7 @@ impl From<TrainConfigV6> for TrainConfig {
 impl StateV6 {
     /// The state in this layout, if its returns are one-step (so no robot
     /// has a step waiting).
-    pub fn of(state: &TrainingState) -> Option<StateV6> {
+    pub fn of(state: &StateV7) -> Option<StateV6> {
         if !state.pending.is_empty() {
             return None;
         }
@@ -130,8 +131,8 @@ impl StateV6 {
     }
 
     /// The state, its returns one-step.
-    pub fn into_state(self) -> TrainingState {
-        TrainingState {
+    pub fn into_v7(self) -> StateV7 {
+        StateV7 {
             config: self.config.into(),
             field_crc: self.field_crc,
             sim: self.sim,

@@ -1,7 +1,7 @@
 //! Training: a run's settings ([`config`]), the learning loop over any
 //! sensor model ([`trainer`]), its checkpoint file ([`checkpoint`]; the
-//! layouts of formats 1 to 6: [`format1`], [`format2`], [`format3`],
-//! [`format4`], [`format6`]) and the `host train` command
+//! layouts of the earlier formats 1 to 7: [`format1`], [`format2`],
+//! [`format3`], [`format4`], [`format6`], [`format7`]) and the `host train` command
 //! ([`command`]), shown live with `--view` ([`watch`]).
 
 pub mod checkpoint;
@@ -13,6 +13,7 @@ pub mod format2;
 pub mod format3;
 pub mod format4;
 pub mod format6;
+pub mod format7;
 pub mod selection;
 pub mod trainer;
 pub mod watch;

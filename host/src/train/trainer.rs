@@ -96,7 +96,6 @@ impl<S: SensorModel> Trainer<S> {
             Some(q) => QLearner::with_table(config.learn.clone(), q)?,
             None => QLearner::new(config.learn.clone())?,
         }
-        .with_rules(config.rules)
         .with_n_step(config.rewards_per_update(), PendingSteps::default());
         let field_crc = field_fingerprint(sim.field());
         let evaluation = evaluation_of(&config)?;
@@ -130,7 +129,6 @@ impl<S: SensorModel> Trainer<S> {
         let evaluation = evaluation_of(&state.config)?;
         let learner = state
             .learner
-            .with_rules(state.config.rules)
             .with_n_step(state.config.rewards_per_update(), state.pending);
         let (config, field_crc, selected) = (state.config, state.field_crc, state.selected);
         let trainer = Trainer {
@@ -269,7 +267,7 @@ impl<S: SensorModel> Trainer<S> {
                 let sets = self
                     .learner
                     .table()
-                    .best_sets(self.config.rules.tie_tolerance);
+                    .best_sets(self.config.learn.tie_tolerance);
                 let (actions, provenance) = self.blob_parts(self.totals().steps)?;
                 PolicyBlob::with_sets(actions, sets, provenance)
                     .context("cannot export the policy")?

@@ -584,7 +584,7 @@ pub const INITIAL_Q: Range = Range::closed(
 
 /// How close to the best Q-value an action ties with it.
 pub const TIE_TOLERANCE: Range = Range::closed(
-    &["rules.tie_tolerance", "--tie-tolerance"],
+    &["learn.tie_tolerance", "--tie-tolerance"],
     0.0,
     1e6,
     "",

@@ -9,7 +9,7 @@
 
 use crate::base::rounding::round_half_away;
 use crate::base::vec2::Vec2;
-use crate::config::Thresholds;
+use crate::config::{SimConfig, Thresholds};
 use crate::fields::{FieldLayout, FieldSampling, ScalarField};
 use crate::world::World;
 use serde::{Deserialize, Serialize};
@@ -227,6 +227,24 @@ pub enum EvalPrime {
     /// between robot pairs / arena diagonal)`, growing as robots spread out.
     /// One robot: 0.
     Spread,
+}
+
+/// Eval' of the given variant with a simulation's thresholds and weights
+/// (`episode.phi`, `episode.nu`).
+pub fn eval_prime_of(
+    world: &World,
+    field: &ScalarField,
+    config: &SimConfig,
+    variant: EvalPrime,
+) -> f64 {
+    eval_prime(
+        world,
+        field,
+        &config.thresholds,
+        variant,
+        config.episode.phi,
+        config.episode.nu,
+    )
 }
 
 /// Eval' of the given variant with weights `phi` and `nu`.

@@ -3,7 +3,7 @@
 //! reward, and for `per-robot` each robot's credit.
 
 use crate::config::SimConfig;
-use crate::episodes::eval::{self, eval_prime, EvalPrime, PuckChange};
+use crate::episodes::eval::{self, eval_prime_of, EvalPrime, PuckChange};
 use crate::fields::ScalarField;
 use crate::physics::Contact;
 use crate::world::World;
@@ -118,14 +118,7 @@ impl Reward {
             Reward::Collision => EvalPrime::AsWritten,
             Reward::CollisionSpread => EvalPrime::Spread,
         };
-        eval_prime(
-            world,
-            field,
-            &config.thresholds,
-            variant,
-            config.episode.phi,
-            config.episode.nu,
-        )
+        eval_prime_of(world, field, config, variant)
     }
 
     /// The world's reward for a step; `gamma` is the learner's discount,

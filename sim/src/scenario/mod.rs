@@ -14,7 +14,6 @@ pub mod sensor_choice;
 pub mod sensor_setup;
 pub mod trained_for;
 
-use crate::base::ranges;
 use crate::config::actuation::ActuationNoise;
 use crate::config::validate::ConfigError;
 use crate::config::BroadPhase;
@@ -277,17 +276,8 @@ impl Scenario {
         if let Arena::Screen(spec) = &self.arena {
             spec.validate()?;
         }
-        ranges::NOISE.check(self.noise).map_err(ConfigError::from)?;
-        if let Some(robots) = self.robots {
-            ranges::ROBOTS
-                .check_count("world.robots", robots as u64)
-                .map_err(ConfigError::from)?;
-        }
-        if let Some(pucks) = self.pucks {
-            ranges::PUCKS
-                .check_count("world.pucks", pucks as u64)
-                .map_err(ConfigError::from)?;
-        }
+        choices::check_world_ranges(self.robots, self.pucks, self.noise)
+            .map_err(ConfigError::from)?;
         let sensors = if self.noise > 0.0 {
             self.sensors
                 .with_noise(&RobotNoise::randomised().scaled(self.noise))

@@ -21,12 +21,11 @@ pub fn serve(settings: ViewSettings, paused: bool, speed: Speed) -> SocketAddr {
 
 /// A small world: 5 robots, 40 pucks.
 pub fn small(seed: u64) -> ViewSettings {
-    ViewSettings {
-        robots: Some(5),
-        pucks: Some(40),
-        seed,
-        ..ViewSettings::default()
-    }
+    let mut settings = ViewSettings::default();
+    settings.world.robots = Some(5);
+    settings.world.pucks = Some(40);
+    settings.world.seed = seed;
+    settings
 }
 
 /// One request; the status and body.
