@@ -2,7 +2,7 @@
 //! one runs end to end and resumes; the shipped campaign names the shipped
 //! tables; bad keys are named.
 
-use host::experiment::campaign::{Campaign, Work};
+use host::experiment::campaign::file::{Campaign, Work};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

@@ -5,8 +5,9 @@
 
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
-use sim::scenario::puck_rule::{rule_pucks, Placement, PuckRuleError, LEAST_PUCKS};
+use sim::scenario::puck_rule::{rule_pucks, Placement, LEAST_PUCKS};
 use sim::scenario::Arena;
+use sim::scenario::ScenarioError;
 
 /// The counts the published trials and tables were run with, by shape: the
 /// TV's report (the annulus, the thesis' T, L, V, X and Z, our I), our T,
@@ -83,7 +84,7 @@ fn a_shape_too_small_for_six_pucks_is_refused_naming_the_field() {
     img.save(&path).unwrap();
     let field = FieldSource::Image(path);
     let e = rule_pucks(&field, &tv()).unwrap_err();
-    assert!(matches!(e, PuckRuleError::TooFew { most, .. } if most < LEAST_PUCKS));
+    assert!(matches!(e, ScenarioError::TooFewPucks { most, .. } if most < LEAST_PUCKS));
     assert!(e.to_string().contains("dot.png"), "{e}");
 }
 

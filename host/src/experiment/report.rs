@@ -21,14 +21,11 @@ use super::outputs;
 use super::published::{self, Published};
 use super::side_by_side::SideBySide;
 use super::spec::{ExperimentSpec, BUILT_IN};
-use super::template::{self, Source};
+use super::template::{self, Source, REPORT_COMMAND};
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// The command that regenerates the documents, as errors tell it.
-pub const COMMAND: &str = "cargo run --release -p host -- experiment report";
 
 /// A page group rendered from the published trials of its experiments.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -259,7 +256,7 @@ pub fn check(docs: &Path, documents: &[Document], log: &dyn Fn(&str)) -> Result<
                     .position(|(a, b)| a != b)
                     .unwrap_or_else(|| committed.lines().count().min(rendered.lines().count()));
                 bail!(
-                "{} is not what the published trials and its template under docs/{}/ give (first difference at line {}); regenerate it with `{COMMAND}`",
+                "{} is not what the published trials and its template under docs/{}/ give (first difference at line {}); regenerate it with `{REPORT_COMMAND}`",
                 path.display(),
                 document.dir,
                 line + 1

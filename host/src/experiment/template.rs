@@ -67,6 +67,9 @@ use anyhow::{anyhow, bail, Context, Result};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
+/// The command that renders the results pages again, as errors tell it.
+pub const REPORT_COMMAND: &str = "cargo run --release -p host -- experiment report";
+
 /// One experiment as the template sees it.
 pub struct Source {
     /// The experiment file.

@@ -29,6 +29,7 @@
 //! rename): a run killed at any moment leaves the old checkpoint or the
 //! new one.
 
+use super::config::TrainConfig;
 use super::format1::StateV1;
 use super::format2::StateV2;
 use super::format3::StateV3;
@@ -36,7 +37,6 @@ use super::format4::StateV4;
 use super::format6::StateV6;
 use super::format7::StateV7;
 use super::trainer::TrainingState;
-use super::TrainConfig;
 use anyhow::{Context, Result};
 use crc::{Crc, CRC_32_ISO_HDLC};
 use sim::base::ranges;

@@ -26,7 +26,6 @@ use crate::control::Controller;
 use crate::fields::source::{FieldError, FieldSource};
 use crate::fields::ScalarField;
 use crate::scenario::arena::ArenaSpec;
-use crate::scenario::puck_rule::PuckRuleError;
 use crate::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use crate::sensors::robot_noise::RobotNoise;
 use crate::simulation::Simulation;
@@ -371,8 +370,17 @@ pub enum ScenarioError {
     UnknownArena(String),
     /// A screen arena is needed where this arena (the thesis' square) was given.
     NotAScreen(String),
-    /// The field has no puck count by the puck rule.
-    PuckRule(Box<PuckRuleError>),
+    /// The field has no puck count by the puck rule
+    /// ([`puck_rule`](crate::scenario::puck_rule)): too few pucks placed on
+    /// the shape reach success.
+    TooFewPucks {
+        /// The field.
+        field: FieldSource,
+        /// The most pucks on the shape that reach success (0 for none).
+        most: usize,
+        /// The fewest a shape needs.
+        least: usize,
+    },
 }
 
 impl fmt::Display for ScenarioError {
@@ -396,7 +404,11 @@ impl fmt::Display for ScenarioError {
                 "--arena {arena}: a screen arena is needed ({} or a FILE.toml), not the thesis' square",
                 ArenaSpec::NAMES
             ),
-            ScenarioError::PuckRule(e) => e.fmt(f),
+            ScenarioError::TooFewPucks { field, most, least } => write!(
+                f,
+                "field {field}: {most} pucks placed on the shape reach the success Eval, \
+                 fewer than the {least} a shape needs (give the count with --pucks)"
+            ),
         }
     }
 }
@@ -406,12 +418,6 @@ impl std::error::Error for ScenarioError {}
 impl From<ConfigError> for ScenarioError {
     fn from(e: ConfigError) -> ScenarioError {
         ScenarioError::Config(e)
-    }
-}
-
-impl From<PuckRuleError> for ScenarioError {
-    fn from(e: PuckRuleError) -> ScenarioError {
-        ScenarioError::PuckRule(Box::new(e))
     }
 }
 

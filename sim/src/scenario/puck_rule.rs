@@ -2,7 +2,7 @@
 //! the most, up to the arena's own count (12 on the TV, `tv75`), for which
 //! a hand placement with every puck's centre on the shape reaches the
 //! success Eval; a shape on which fewer than [`LEAST_PUCKS`] do has no
-//! count ([`PuckRuleError`]). Fixed before any training, the same for
+//! count ([`ScenarioError::TooFewPucks`]). Fixed before any training, the same for
 //! orbital construction and every policy.
 //!
 //! The placement: the candidate centres of a grid of [`GRID_STEP`] units
@@ -22,7 +22,6 @@ use crate::fields::source::FieldSource;
 use crate::scenario::{Arena, PreparedScenario, Scenario, ScenarioError};
 use crate::world::World;
 use std::collections::BTreeMap;
-use std::fmt;
 use std::sync::Mutex;
 
 /// The fewest pucks a shape may take: a shape on which fewer reach success
@@ -35,56 +34,12 @@ pub const ON_A_SHAPE: f32 = 0.8;
 /// The spacing of the candidate centres, in world units.
 pub const GRID_STEP: f64 = 0.5;
 
-/// Why a field has no puck count in an arena.
-#[derive(Debug)]
-pub enum PuckRuleError {
-    /// Fewer than [`LEAST_PUCKS`] pucks on the shape reach success.
-    TooFew {
-        /// The field.
-        field: FieldSource,
-        /// The most pucks that fit on the shape and reach success (0 for
-        /// none).
-        most: usize,
-    },
-    /// The field or arena cannot be loaded.
-    Scenario {
-        /// The field.
-        field: FieldSource,
-        /// Why.
-        source: Box<ScenarioError>,
-    },
-}
-
-impl fmt::Display for PuckRuleError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            PuckRuleError::TooFew { field, most } => write!(
-                f,
-                "field {field}: {most} pucks placed on the shape reach the success Eval, \
-                 fewer than the {LEAST_PUCKS} a shape needs (give the count with --pucks)"
-            ),
-            PuckRuleError::Scenario { field, source } => {
-                write!(f, "field {field}: no puck count: {source}")
-            }
-        }
-    }
-}
-
-impl std::error::Error for PuckRuleError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            PuckRuleError::TooFew { .. } => None,
-            PuckRuleError::Scenario { source, .. } => Some(source.as_ref()),
-        }
-    }
-}
-
 /// The counts computed in this process, by field and arena.
 static COUNTS: Mutex<BTreeMap<String, usize>> = Mutex::new(BTreeMap::new());
 
 /// The puck count of `field` in `arena` by the rule (see the module docs),
 /// computed once per field and arena in a process.
-pub fn rule_pucks(field: &FieldSource, arena: &Arena) -> Result<usize, PuckRuleError> {
+pub fn rule_pucks(field: &FieldSource, arena: &Arena) -> Result<usize, ScenarioError> {
     let key = format!("{field} {arena:?}");
     let cached = COUNTS.lock().ok().and_then(|c| c.get(&key).copied());
     if let Some(n) = cached {
@@ -96,9 +51,10 @@ pub fn rule_pucks(field: &FieldSource, arena: &Arena) -> Result<usize, PuckRuleE
         .find(|&n| placement.reaches_success(n))
         .unwrap_or(0);
     if most < LEAST_PUCKS {
-        return Err(PuckRuleError::TooFew {
+        return Err(ScenarioError::TooFewPucks {
             field: field.clone(),
             most,
+            least: LEAST_PUCKS,
         });
     }
     if let Ok(mut counts) = COUNTS.lock() {
@@ -119,17 +75,13 @@ pub struct Placement {
 
 impl Placement {
     /// Places up to the arena's own count of pucks on `field`.
-    pub fn new(field: &FieldSource, arena: &Arena) -> Result<Placement, PuckRuleError> {
+    pub fn new(field: &FieldSource, arena: &Arena) -> Result<Placement, ScenarioError> {
         let scenario = Scenario {
             field: field.clone(),
             arena: arena.clone(),
             ..Scenario::default()
         }
-        .prepare()
-        .map_err(|e| PuckRuleError::Scenario {
-            field: field.clone(),
-            source: Box::new(e),
-        })?;
+        .prepare()?;
         let c = scenario.config();
         let (layout, shape, t) = (c.world.field_layout(), scenario.field(), &c.thresholds);
         let r = c.world.puck_radius;

@@ -14,9 +14,8 @@
 //! `<!-- results:begin -->` and `<!-- results:end -->`; `host experiment
 //! report` renders them (and `--check` fails when they differ).
 
-use super::{Campaign, Stage, Work};
+use super::file::{Campaign, Publication, Stage, Work};
 use anyhow::{bail, Context, Result};
-use serde::Deserialize;
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 
@@ -29,79 +28,7 @@ const OC: &str = "orbital construction";
 /// Where campaign files are, beside the docs directory.
 const CAMPAIGNS: &str = "experiments/campaigns";
 
-/// What a publish stage writes and how its targets are judged.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Publication {
-    /// Under the docs directory: `<dir>/runs/`, `<dir>/results.json`, and
-    /// the page `<dir>.md`.
-    pub dir: PathBuf,
-    /// The evaluate stages: at the default noise, then at twice it.
-    pub evaluations: Vec<String>,
-    /// The fields the report judges, in its order.
-    pub report_fields: Vec<String>,
-    /// The general tables: the stages searched on several fields.
-    pub general: Vec<String>,
-    /// The targets.
-    pub targets: Targets,
-}
-
-/// The targets table's rules (a publish stage's `targets`).
-#[derive(Clone, Debug, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Targets {
-    /// The field whose best learned table is judged as a multiple of OC's.
-    pub ratio_field: String,
-    /// That multiple.
-    pub ratio: f64,
-    /// Any other report field's best own table: at least this many per
-    /// million steps ...
-    pub least: f64,
-    /// ... and OC's count where OC forms at least this many ...
-    pub oc_at_least: f64,
-    /// ... and these multiples of OC's count, by field.
-    #[serde(default)]
-    pub times_oc: std::collections::BTreeMap<String, f64>,
-}
-
 impl Publication {
-    /// A publish stage's settings; `earlier` are the stages before it.
-    pub fn new(
-        dir: Option<PathBuf>,
-        evaluations: Vec<String>,
-        report_fields: Vec<String>,
-        targets: Option<toml::Value>,
-        earlier: &[Stage],
-    ) -> Result<Publication> {
-        let dir = dir.context("dir: a publish stage names its directory under the docs")?;
-        if evaluations.is_empty() || evaluations.len() > 2 {
-            bail!("evaluations: one or two evaluate stages (the default noise, then twice it)");
-        }
-        for e in &evaluations {
-            if !earlier
-                .iter()
-                .any(|s| &s.name == e && matches!(s.work, Work::Evaluate(_)))
-            {
-                bail!("evaluations: {e:?} is no earlier evaluate stage");
-            }
-        }
-        let targets: Targets = targets
-            .context("targets: a publish stage states its targets")?
-            .try_into()
-            .context("targets")?;
-        let general = earlier
-            .iter()
-            .filter(|s| super::run::fields_of(s).len() > 1)
-            .map(|s| s.name.clone())
-            .collect();
-        Ok(Publication {
-            dir,
-            evaluations,
-            report_fields,
-            general,
-            targets,
-        })
-    }
-
     /// Copies the campaign's outputs in `out` into `docs/<dir>/runs/` and
     /// writes `docs/<dir>/results.json` and the page's tables; returns the
     /// files written.
@@ -697,7 +624,7 @@ pub fn check_pages(docs: &Path) -> Result<Vec<PathBuf>> {
                 path.display(),
                 docs.join(&p.dir).display(),
                 line + 1,
-                super::super::report::COMMAND
+                super::super::template::REPORT_COMMAND
             );
         }
         checked.push(path);

@@ -2,7 +2,7 @@
 //! and its settings' hash (`<stage>.done`) are there, so that a killed run
 //! resumes at the stage it was in.
 
-use super::{Campaign, Evaluation, Stage, Work};
+use super::file::{Campaign, Evaluation, Stage, Work};
 use crate::experiment::plan::hash;
 use crate::search::{SearchConfig, SearchRequest, Start};
 use crate::train::{TrainConfig, TrainFlags, TrainRequest};
@@ -324,18 +324,6 @@ fn write_world(stage: &Stage, world: &TrainConfig, out: &Path) -> Result<PathBuf
     Ok(path)
 }
 
-/// The fields a stage's table was made on.
-pub(super) fn fields_of(stage: &Stage) -> Vec<String> {
-    match &stage.work {
-        Work::Search { world, search } => std::iter::once(&world.field)
-            .chain(&search.also_field)
-            .map(|f| f.to_string())
-            .collect(),
-        Work::Train { world } => vec![world.field.to_string()],
-        Work::Evaluate(_) | Work::Publish(_) => Vec::new(),
-    }
-}
-
 /// The evaluation's JSON lines: per field, each controller that runs
 /// there, per seed.
 fn evaluate(campaign: &Campaign, e: &Evaluation, options: &CampaignOptions) -> Result<Vec<String>> {
@@ -350,7 +338,7 @@ fn evaluate(campaign: &Campaign, e: &Evaluation, options: &CampaignOptions) -> R
                 let stage = campaign
                     .stage(c)
                     .with_context(|| format!("controllers: no stage {c:?}"))?;
-                let made_on = fields_of(stage);
+                let made_on = stage.fields();
                 if made_on.len() == 1 && made_on[0] != label {
                     continue;
                 }
