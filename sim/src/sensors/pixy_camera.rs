@@ -665,12 +665,9 @@ impl PixyCamera {
     }
 
     /// The clipped pixel box of a wedge-fronted robot, candidate `c`,
-    /// facing `facing`: the prism on its outline, `c.height` tall, seen
-    /// through the pinhole as a cylinder is (the bounding box of its
-    /// points at the bottom and the top, `wedge`'s). `None` if it is out
-    /// of the image or reaches behind the image plane. A robot or two a
-    /// frame: each point's place ahead of and beside the lens is found
-    /// once for both rims, and the lanes keep to fixed-size arrays.
+    /// facing `facing` ([`outline_box`], or [`outline_box_avx2`] on
+    /// processors with AVX2).
+    #[inline(always)]
     fn outline_silhouette(
         &self,
         c: &Candidate,
@@ -678,35 +675,12 @@ impl PixyCamera {
         facing: Vec2,
         wedge: &WedgePoints,
     ) -> Option<Rect> {
-        let right = Vec2::new(-facing.y, facing.x);
-        let offset = |k: usize| facing * wedge.ahead[k] + right * wedge.right[k];
-        let pf: [f64; WEDGE_POINTS] = std::array::from_fn(|k| c.ahead + offset(k).dot(lens.ahead));
-        let ps: [f64; WEDGE_POINTS] = std::array::from_fn(|k| c.side + offset(k).dot(lens.right));
-        let across = ps.map(|ps| self.fx * ps);
-        let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
-        for (rim, z) in [0.0, c.height].into_iter().enumerate() {
-            let up = z - self.height;
-            let depth = pf.map(|pf| pf * self.cos_tilt - up * self.sin_tilt);
-            // the least depth (the one row, twice)
-            if halving_16(&[depth, depth], |a, b| if a < b { a } else { b }) < self.near {
-                return None;
-            }
-            let down = pf.map(|pf| -pf * self.sin_tilt - up * self.cos_tilt);
-            x[rim] = std::array::from_fn(|k| across[k] / depth[k]);
-            y[rim] = std::array::from_fn(|k| self.fy * down[k] / depth[k]);
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only when the processor has AVX2.
+            return unsafe { outline_box_avx2(self, c, lens, facing, wedge) };
         }
-        let least = |v| halving_16(v, |a, b| if a < b { a } else { b });
-        let greatest = |v| halving_16(v, |a, b| if a > b { a } else { b });
-        let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
-        // A zero's sign may differ from the point by point minimum; the
-        // pixel is the same for both.
-        let rect = Rect {
-            left: first_pixel(cx + least(&x), IMAGE_WIDTH),
-            right: last_pixel(cx + greatest(&x), IMAGE_WIDTH),
-            top: first_pixel(cy + least(&y), IMAGE_HEIGHT),
-            bottom: last_pixel(cy + greatest(&y), IMAGE_HEIGHT),
-        };
-        (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
+        outline_box(self, c, lens, facing, wedge)
     }
 
     /// Stage 2: each body's still visible part after the nearer ones'
@@ -964,6 +938,78 @@ projection!(#[inline(always)] ; project);
 
 #[cfg(target_arch = "x86_64")]
 projection!(#[target_feature(enable = "avx2")] #[inline(never)] unsafe ; project_avx2);
+
+/// The clipped pixel box of a wedge-fronted robot, candidate `c`,
+/// facing `facing`: the prism on its outline, `c.height` tall, seen
+/// through the pinhole as a cylinder is (the bounding box of its
+/// points at the bottom and the top, `wedge`'s). `None` if it is out
+/// of the image or reaches behind the image plane. A robot or two a
+/// frame: each point's place ahead of and beside the lens is found
+/// once for both rims, and the lanes keep to fixed-size arrays.
+/// Compiled a second time for AVX2 ([`outline_box_avx2`]), as
+/// [`project`] is.
+#[inline(always)]
+fn outline_box(
+    camera: &PixyCamera,
+    c: &Candidate,
+    lens: &Lens,
+    facing: Vec2,
+    wedge: &WedgePoints,
+) -> Option<Rect> {
+    let right = Vec2::new(-facing.y, facing.x);
+    // Plain loops over the lanes: `array::from_fn`'s closures are not
+    // inlined into the AVX2 copy.
+    let (mut pf, mut across) = ([0.0; WEDGE_POINTS], [0.0; WEDGE_POINTS]);
+    for k in 0..WEDGE_POINTS {
+        let offset = facing * wedge.ahead[k] + right * wedge.right[k];
+        pf[k] = c.ahead + offset.dot(lens.ahead);
+        across[k] = camera.fx * (c.side + offset.dot(lens.right));
+    }
+    let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
+    for (rim, z) in [0.0, c.height].into_iter().enumerate() {
+        let up = z - camera.height;
+        let mut depth = [0.0; WEDGE_POINTS];
+        for k in 0..WEDGE_POINTS {
+            depth[k] = pf[k] * camera.cos_tilt - up * camera.sin_tilt;
+        }
+        // the least depth (the one row, twice)
+        if halving_16(&[depth, depth], |a, b| if a < b { a } else { b }) < camera.near {
+            return None;
+        }
+        for k in 0..WEDGE_POINTS {
+            let down = -pf[k] * camera.sin_tilt - up * camera.cos_tilt;
+            x[rim][k] = across[k] / depth[k];
+            y[rim][k] = camera.fy * down / depth[k];
+        }
+    }
+    let least = |v| halving_16(v, |a, b| if a < b { a } else { b });
+    let greatest = |v| halving_16(v, |a, b| if a > b { a } else { b });
+    let (cx, cy) = (f64::from(IMAGE_WIDTH) / 2.0, f64::from(IMAGE_HEIGHT) / 2.0);
+    // A zero's sign may differ from the point by point minimum; the
+    // pixel is the same for both.
+    let rect = Rect {
+        left: first_pixel(cx + least(&x), IMAGE_WIDTH),
+        right: last_pixel(cx + greatest(&x), IMAGE_WIDTH),
+        top: first_pixel(cy + least(&y), IMAGE_HEIGHT),
+        bottom: last_pixel(cy + greatest(&y), IMAGE_HEIGHT),
+    };
+    (rect.left <= rect.right && rect.top <= rect.bottom).then_some(rect)
+}
+
+/// [`outline_box`] compiled for AVX2: four lanes instead of two, every
+/// operation rounding as in the other (no FMA).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline(never)]
+unsafe fn outline_box_avx2(
+    camera: &PixyCamera,
+    c: &Candidate,
+    lens: &Lens,
+    facing: Vec2,
+    wedge: &WedgePoints,
+) -> Option<Rect> {
+    outline_box(camera, c, lens, facing, wedge)
+}
 
 /// Whether the processor has AVX2.
 fn has_avx2() -> bool {
