@@ -108,10 +108,12 @@ impl GainGrid {
 
     /// The gain at `p` of a rectangle of `size`.
     pub fn at(&self, p: Vec2, size: Vec2) -> f64 {
+        // A side is at most the gains' length, so the conversions through
+        // `i64` are exact (one instruction each, where `usize` takes several).
         let split = |t: f64, n: usize| {
-            let t = (t * n as f64 - 0.5).clamp(0.0, (n - 1) as f64);
-            let i = (t as usize).min(n - 2);
-            (i, t - i as f64)
+            let t = (t * n as i64 as f64 - 0.5).clamp(0.0, (n - 1) as i64 as f64);
+            let i = (t as i64 as usize).min(n - 2);
+            (i, t - i as i64 as f64)
         };
         let cols = self.columns;
         let (i, tx) = split(p.x / size.x, cols);

@@ -20,7 +20,6 @@ pub mod letters;
 pub mod source;
 pub mod turn;
 
-use crate::base::rounding::floor;
 use crate::base::vec2::Vec2;
 use serde::{Deserialize, Serialize};
 use shared::FieldValue;
@@ -267,9 +266,12 @@ impl ScalarField {
     /// The bilinear interpolation at `p` between pixel centres (0 outside
     /// the frame; the edge pixels extend to its border).
     pub fn bilinear(&self, p: Vec2, frame: &FieldFrame) -> f64 {
-        let u = self.width as f64 * (p.x - frame.x) / frame.width;
-        let v = self.height as f64 * (p.y - frame.y) / frame.height;
-        if !((0.0..=self.width as f64).contains(&u) && (0.0..=self.height as f64).contains(&v)) {
+        // A side is at most the values' length, so it converts through
+        // `i64` exactly (one instruction, where `usize` takes several).
+        let (width, height) = (self.width as i64 as f64, self.height as i64 as f64);
+        let u = width * (p.x - frame.x) / frame.width;
+        let v = height * (p.y - frame.y) / frame.height;
+        if !((0.0..=width).contains(&u) && (0.0..=height).contains(&v)) {
             return 0.0;
         }
         let (i0, tx) = split(u - 0.5, self.width);
@@ -288,11 +290,13 @@ fn split(t: f64, n: usize) -> (usize, f64) {
     if t <= 0.0 {
         return (0, 0.0);
     }
-    let i = floor(t);
-    if i as usize >= n - 1 {
+    // `t` is positive and below `n` here (no NaN): its truncation is its
+    // floor, exactly.
+    let i = t as i64 as usize;
+    if i >= n - 1 {
         return (n - 1, 0.0);
     }
-    (i as usize, t - i)
+    (i, t - i as i64 as f64)
 }
 
 /// `round_half_away(t)` if it lies in `0..n`, else `None`. It is at least 0

@@ -28,8 +28,8 @@
 //! identical inputs identically.
 
 use crate::base::gain_grid::GainGrid;
+use crate::base::noise::Stream;
 use crate::base::ranges;
-use crate::base::rng::SimRng;
 use crate::base::rounding;
 use crate::base::vec2::Vec2;
 use crate::config::robot_shape::RobotShape;
@@ -88,7 +88,7 @@ pub(crate) struct PhotoNoise<'a> {
     /// The arena's size, over which the gains lie.
     pub arena: Vec2,
     /// The generator of this reading's jitter.
-    pub rng: &'a mut SimRng,
+    pub rng: &'a mut Stream,
 }
 
 /// Geometry and response of the three field sensors (left, mid, right).

@@ -170,14 +170,20 @@ impl RobotSensors {
 
         let mut capture = std::mem::take(&mut self.capture);
         self.camera.frame(world, robot, &mut capture);
-        let mut rng = noise::stream(seed, Purpose::Camera, step, robot as u64);
         let classify = *self.camera.classify();
-        self.noise.perturb_frame(
-            &mut capture,
-            classify.puck_signature,
-            classify.robot_signature,
-            &mut rng,
-        );
+        // What reaches the robot now: the camera sends nothing when it sees
+        // nothing, and a dropped frame does not arrive. Without noise there
+        // is nothing to draw (the noise draws none at zero amounts).
+        let arrives = self.noise == RobotNoise::NONE || {
+            let mut rng = noise::stream(seed, Purpose::Camera, step, robot as u64);
+            self.noise.perturb_frame(
+                &mut capture,
+                classify.puck_signature,
+                classify.robot_signature,
+                &mut rng,
+            );
+            !noise::chance(&mut rng, self.noise.frame_drop)
+        };
         let link = &mut self.links[robot];
         if link.episode != episode {
             *link = CameraMemory {
@@ -188,9 +194,6 @@ impl RobotSensors {
         if self.latency_frames > 0 {
             std::mem::swap(&mut link.captured, &mut capture);
         }
-        // What reaches the robot now: the camera sends nothing when it sees
-        // nothing, and a dropped frame does not arrive.
-        let arrives = !noise::chance(&mut rng, self.noise.frame_drop);
         let delivered: &[PixyBlock] = if arrives { &capture } else { &[] };
         let held = link.period(delivered);
         let out = &mut self.observations[robot];

@@ -7,9 +7,8 @@
 //! and the robot.
 
 use crate::base::gain_grid::GainGrid;
-use crate::base::noise::{self, Purpose};
+use crate::base::noise::{self, Purpose, Stream};
 use crate::base::ranges;
-use crate::base::rng::SimRng;
 use crate::base::rounding::round_half_away;
 use crate::config::validate::ConfigError;
 use serde::{Deserialize, Serialize};
@@ -119,7 +118,7 @@ impl RobotNoise {
     }
 
     /// A discharge time with its jitter.
-    pub(crate) fn jitter_discharge(&self, us: f64, rng: &mut SimRng) -> f64 {
+    pub(crate) fn jitter_discharge(&self, us: f64, rng: &mut Stream) -> f64 {
         if self.rc_jitter == 0.0 {
             us
         } else {
@@ -135,13 +134,13 @@ impl RobotNoise {
         frame: &mut Vec<PixyBlock>,
         puck: u16,
         robot: u16,
-        rng: &mut SimRng,
+        rng: &mut Stream,
     ) {
         if self.block_miss > 0.0 {
             frame.retain(|_| !noise::chance(rng, self.block_miss));
         }
         if self.block_jitter_px > 0.0 {
-            let jitter = |v: u16, limit: u16, rng: &mut SimRng| {
+            let jitter = |v: u16, limit: u16, rng: &mut Stream| {
                 let moved = f64::from(v) + self.block_jitter_px * noise::normal(rng);
                 round_half_away(moved).clamp(0, i64::from(limit)) as u16
             };
@@ -172,7 +171,7 @@ impl RobotNoise {
     }
 }
 
-fn rng_unit(rng: &mut SimRng) -> f64 {
+fn rng_unit(rng: &mut Stream) -> f64 {
     noise::symmetric(rng, 0.5) + 0.5
 }
 
