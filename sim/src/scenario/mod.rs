@@ -378,10 +378,13 @@ pub enum ScenarioError {
         field: FieldSource,
         /// The most pucks on the shape that reach success (0 for none).
         most: usize,
-        /// The fewest a shape needs.
-        least: usize,
     },
 }
+
+/// The fewest pucks a shape may take by the puck rule
+/// ([`puck_rule`](crate::scenario::puck_rule)): a shape on which fewer
+/// reach success is refused.
+pub const LEAST_PUCKS: usize = 6;
 
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -404,10 +407,10 @@ impl fmt::Display for ScenarioError {
                 "--arena {arena}: a screen arena is needed ({} or a FILE.toml), not the thesis' square",
                 ArenaSpec::NAMES
             ),
-            ScenarioError::TooFewPucks { field, most, least } => write!(
+            ScenarioError::TooFewPucks { field, most } => write!(
                 f,
                 "field {field}: {most} pucks placed on the shape reach the success Eval, \
-                 fewer than the {least} a shape needs (give the count with --pucks)"
+                 fewer than the {LEAST_PUCKS} a shape needs (give the count with --pucks)"
             ),
         }
     }

@@ -24,9 +24,7 @@ use crate::world::World;
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 
-/// The fewest pucks a shape may take: a shape on which fewer reach success
-/// is refused.
-pub const LEAST_PUCKS: usize = 6;
+pub use crate::scenario::LEAST_PUCKS;
 
 /// The least field value of a shape other than the annulus.
 pub const ON_A_SHAPE: f32 = 0.8;
@@ -54,7 +52,6 @@ pub fn rule_pucks(field: &FieldSource, arena: &Arena) -> Result<usize, ScenarioE
         return Err(ScenarioError::TooFewPucks {
             field: field.clone(),
             most,
-            least: LEAST_PUCKS,
         });
     }
     if let Ok(mut counts) = COUNTS.lock() {
