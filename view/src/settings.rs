@@ -228,7 +228,7 @@ fn field(value: &str, allowed: &Allowed) -> Result<FieldSource, String> {
         .map_err(|e: sim::fields::source::FieldError| e.to_string())?;
     match &field {
         FieldSource::Image(path) if allowed.field_file.as_ref() != Some(path) => Err(
-            "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z), either turned (letter:L@mirror)"
+            "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z), either turned (letter:L@mirror), generated (gen:ring:3)"
                 .into(),
         ),
         _ => Ok(field),

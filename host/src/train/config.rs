@@ -41,8 +41,9 @@ pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
 pub struct TrainConfig {
     /// The field: annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the
     /// thesis' T, L, V, X, Z), either turned (letter:L@mirror; @rot90,
-    /// @rot180, @rot270 clockwise, @mirror, @mirror-rot90, ...) or an image
-    /// file (PNG, JPEG) [default: annulus].
+    /// @rot180, @rot270 clockwise, @mirror, @mirror-rot90, ...), a generated
+    /// shape (gen:FAMILY:SEED, docs/generated-shapes.md) or an image file
+    /// (PNG, JPEG) [default: annulus].
     #[arg(long, required = false)]
     pub field: FieldSource,
     /// Sensor model: disc (the reference model's discs), disc-thesis (with

@@ -12,6 +12,7 @@
 //! letters (0.97 at 10 px, 0.85 at 50, 0.71 at 100, 0.41 at 200) and 770 px
 //! for the L, which falls more slowly (0.87 at 100 px).
 
+use crate::fields::raster::Drawing;
 use crate::fields::ScalarField;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -89,40 +90,24 @@ impl Letter {
         }
     }
 
-    /// Whether pixel (`x`, `y`)'s centre lies on a stroke.
-    fn on_stroke(self, x: usize, y: usize) -> bool {
-        let p = (x as f64 + 0.5, y as f64 + 0.5);
-        self.strokes()
-            .iter()
-            .any(|&[a, b]| segment_distance(p, a, b) <= STROKE_WIDTH / 2.0)
+    /// The letter as strokes.
+    fn drawing(self) -> Drawing {
+        Drawing {
+            strokes: self.strokes().iter().map(|&s| (s, STROKE_WIDTH)).collect(),
+            polygons: Vec::new(),
+        }
     }
 
     /// Each pixel's Euclidean distance to the nearest stroke pixel (0 on the
     /// stroke), row-major.
-    pub(crate) fn distance_map(self) -> Vec<f64> {
-        let n = LETTER_SIZE;
-        let mut sq: Vec<f64> = (0..n * n)
-            .map(|k| {
-                if self.on_stroke(k % n, k / n) {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
-        squared_distance_transform(&mut sq, n, n);
-        sq.into_iter().map(f64::sqrt).collect()
+    #[cfg(test)]
+    fn distance_map(self) -> Vec<f64> {
+        self.drawing().distance_map(LETTER_SIZE)
     }
 
     /// The letter's field: 1 on the stroke, `1 - distance / falloff` off it.
     pub fn field(self) -> ScalarField {
-        let falloff = self.falloff();
-        let values = self
-            .distance_map()
-            .into_iter()
-            .map(|d| (1.0 - d / falloff).max(0.0) as f32)
-            .collect();
-        ScalarField::new(LETTER_SIZE, LETTER_SIZE, values).expect("600 x 600 values")
+        self.drawing().field(LETTER_SIZE, self.falloff())
     }
 }
 
@@ -144,103 +129,9 @@ impl fmt::Display for Letter {
     }
 }
 
-/// Distance from `p` to the segment `a`-`b`.
-fn segment_distance(p: (f64, f64), a: (f64, f64), b: (f64, f64)) -> f64 {
-    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
-    let t = (((p.0 - a.0) * dx + (p.1 - a.1) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
-    (p.0 - a.0 - t * dx).hypot(p.1 - a.1 - t * dy)
-}
-
-/// Exact squared Euclidean distance transform in place (Felzenszwalb and
-/// Huttenlocher): `grid` holds 0 on features and infinity elsewhere; rows
-/// then columns.
-fn squared_distance_transform(grid: &mut [f64], width: usize, height: usize) {
-    let mut line = vec![0.0; width.max(height)];
-    let mut out = vec![0.0; width.max(height)];
-    for y in 0..height {
-        line[..width].copy_from_slice(&grid[y * width..(y + 1) * width]);
-        lower_envelope(&line[..width], &mut out[..width]);
-        grid[y * width..(y + 1) * width].copy_from_slice(&out[..width]);
-    }
-    for x in 0..width {
-        for y in 0..height {
-            line[y] = grid[y * width + x];
-        }
-        lower_envelope(&line[..height], &mut out[..height]);
-        for y in 0..height {
-            grid[y * width + x] = out[y];
-        }
-    }
-}
-
-/// One dimension of the transform: `out[q] = min_p (q - p)^2 + f[p]`, over
-/// the finite entries of `f` (all infinite gives infinity everywhere).
-fn lower_envelope(f: &[f64], out: &mut [f64]) {
-    let n = f.len();
-    let mut v = vec![0usize; n];
-    let mut z = vec![0.0f64; n + 1];
-    let mut finite = (0..n).filter(|&q| f[q].is_finite());
-    let Some(first) = finite.next() else {
-        out.fill(f64::INFINITY);
-        return;
-    };
-    let mut k = 0usize;
-    v[0] = first;
-    z[0] = f64::NEG_INFINITY;
-    z[1] = f64::INFINITY;
-    for q in finite {
-        // z[0] is minus infinity, so k never drops below 0
-        let s = loop {
-            let p = v[k];
-            let s =
-                ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
-            if s > z[k] {
-                break s;
-            }
-            k -= 1;
-        };
-        k += 1;
-        v[k] = q;
-        z[k] = s;
-        z[k + 1] = f64::INFINITY;
-    }
-    let mut k = 0;
-    for (q, o) in out.iter_mut().enumerate() {
-        while z[k + 1] < q as f64 {
-            k += 1;
-        }
-        let d = q as f64 - v[k] as f64;
-        *o = d * d + f[v[k]];
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn distance_transform_is_exact_on_a_small_grid() {
-        let (w, h) = (7, 5);
-        let features = [(1usize, 1usize), (5, 3)];
-        let mut g: Vec<f64> = (0..w * h)
-            .map(|k| {
-                if features.contains(&(k % w, k / w)) {
-                    0.0
-                } else {
-                    f64::INFINITY
-                }
-            })
-            .collect();
-        squared_distance_transform(&mut g, w, h);
-        for (k, &got) in g.iter().enumerate() {
-            let (x, y) = ((k % w) as f64, (k / w) as f64);
-            let brute = features
-                .iter()
-                .map(|&(fx, fy)| (x - fx as f64).powi(2) + (y - fy as f64).powi(2))
-                .fold(f64::INFINITY, f64::min);
-            assert_eq!(got, brute, "cell {k}");
-        }
-    }
 
     /// Mean field value of the pixels at `d` (+- 0.5) px from the stroke.
     fn profile_at(distances: &[f64], field: &ScalarField, d: f64) -> f64 {

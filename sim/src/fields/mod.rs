@@ -16,7 +16,9 @@
 //!
 //! Room 2 of the simulator (`lib.rs`): what the robots read and Eval measures, below every stage.
 
+pub mod generated;
 pub mod letters;
+pub(crate) mod raster;
 pub mod source;
 pub mod turn;
 

@@ -1,9 +1,11 @@
 //! Where a field comes from: the annulus, a generated letter, one of the
 //! thesis' own letter images (built in from `experiments/fields/`), either
-//! letter turned or mirrored (`letter:L@mirror`, [`Turn`]), or an image
-//! file (one cell per pixel, the mean of R, G and B over 255).
+//! letter turned or mirrored (`letter:L@mirror`, [`Turn`]), a generated
+//! shape (`gen:ring:3`, [`GeneratedShape`]), or an image file (one cell per
+//! pixel, the mean of R, G and B over 255).
 
 use crate::base::ranges::{self, Range, RangeError};
+use crate::fields::generated::{GeneratedShape, UnknownShape};
 use crate::fields::letters::Letter;
 use crate::fields::turn::{Turn, UnknownTurn};
 use crate::fields::ScalarField;
@@ -13,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
 /// Where a field comes from, by name: `annulus`, `letter:T`, `thesis:T`,
-/// `letter:L@mirror`, or an image file's path.
+/// `letter:L@mirror`, `gen:ring:3`, or an image file's path.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "String", into = "String")]
 pub enum FieldSource {
@@ -29,6 +31,8 @@ pub enum FieldSource {
     /// (parsing builds no other), turned or mirrored: `letter:L@mirror`,
     /// `thesis:T@rot180`.
     Turned(Box<FieldSource>, Turn),
+    /// A generated shape (`gen:ring:3`).
+    Generated(GeneratedShape),
     /// A PNG or JPEG image (any other argument: its path).
     Image(PathBuf),
 }
@@ -53,6 +57,8 @@ pub enum FieldError {
     NoThesisImage(String),
     /// A built-in letter followed by `@` and no turn's name.
     UnknownTurn(UnknownTurn),
+    /// `gen:` followed by no generated shape's name.
+    UnknownShape(UnknownShape),
     /// Neither a field's name nor an existing file.
     Unknown(PathBuf),
 }
@@ -82,11 +88,13 @@ impl fmt::Display for FieldError {
                 )
             }
             FieldError::UnknownTurn(e) => write!(f, "in the field name: {e}"),
+            FieldError::UnknownShape(e) => write!(f, "in the field name: {e}"),
             FieldError::Unknown(path) => write!(
                 f,
                 "no field is named {:?} and there is no image file of that name: a field is \
                  annulus, letter:X (X one of {}), thesis:X (X one of {}), either letter \
-                 turned (letter:L@mirror) or the path of a PNG or JPEG image",
+                 turned (letter:L@mirror), a generated shape (gen:ring:3) or the path of a PNG \
+                 or JPEG image",
                 path.display().to_string(),
                 Letter::NAMES,
                 THESIS_LETTERS.join(", ")
@@ -107,6 +115,11 @@ impl FromStr for FieldSource {
         if let Some((letter, turn)) = s.split_once('@').filter(|_| built_in) {
             let turn = turn.parse().map_err(FieldError::UnknownTurn)?;
             Ok(FieldSource::Turned(Box::new(letter.parse()?), turn))
+        } else if let Some(shape) = s.strip_prefix("gen:") {
+            shape
+                .parse()
+                .map(FieldSource::Generated)
+                .map_err(FieldError::UnknownShape)
         } else if s == "annulus" {
             Ok(FieldSource::Annulus)
         } else if let Some(letter) = s.strip_prefix("letter:") {
@@ -134,6 +147,7 @@ impl fmt::Display for FieldSource {
             FieldSource::Letter(l) => write!(f, "letter:{l}"),
             FieldSource::Thesis(l) => write!(f, "thesis:{l}"),
             FieldSource::Turned(letter, turn) => write!(f, "{letter}@{turn}"),
+            FieldSource::Generated(shape) => write!(f, "gen:{shape}"),
             FieldSource::Image(p) => write!(f, "{}", p.display()),
         }
     }
@@ -156,6 +170,7 @@ impl FieldSource {
                 field_of(image::load_from_memory(bytes).map_err(err)?, &name)
             }
             FieldSource::Turned(letter, turn) => Ok(turn.apply(&letter.load()?)),
+            FieldSource::Generated(shape) => Ok(shape.field()),
             FieldSource::Image(path) => load_image(path),
         }
     }
