@@ -29,10 +29,10 @@
 //! search's settings; every search setting must be given (in `[defaults]`
 //! or the stage), none is taken from `host search`'s defaults. A train
 //! stage's are a training config's (`from`: `--init-from` that table). An
-//! evaluate stage runs `oc` and the named stages' tables on each of its
-//! `fields` for its world's `steps` on each of its `seeds`: a stage searched
-//! or trained on one field only on that field, one on several fields (a
-//! general table) on all. A publish stage copies the tables, logs and
+//! evaluate stage runs `oc`, the named stages' tables and the named
+//! `.policy` files on each of its `fields` for its world's `steps` on each
+//! of its `seeds`: a stage searched or trained on one field only on that
+//! field; one on several fields (a general table) and a policy file on all. A publish stage copies the tables, logs and
 //! evaluations into `dir/runs/` and writes `dir/results.json` ([`publish`](super::publish)).
 //!
 //! Outputs in the output directory: `<stage>.policy` and
@@ -356,8 +356,8 @@ fn stage(
                 bail!("an evaluate stage names its fields and seeds");
             }
             for c in &evaluation.controllers {
-                if c != "oc" && !earlier.iter().any(|s| &s.name == c) {
-                    bail!("controllers: {c:?} is neither oc nor an earlier stage");
+                if c != "oc" && !c.ends_with(".policy") && !earlier.iter().any(|s| &s.name == c) {
+                    bail!("controllers: {c:?} is neither oc, an earlier stage nor a .policy file");
                 }
             }
             Work::Evaluate(evaluation)

@@ -148,7 +148,7 @@ fn uses(stage: &Stage) -> Vec<&str> {
             .controllers
             .iter()
             .map(String::as_str)
-            .filter(|c| *c != "oc")
+            .filter(|c| *c != "oc" && !is_policy_file(c))
             .collect(),
         Work::Publish(p) => p.evaluations.iter().map(String::as_str).collect(),
     }
@@ -243,6 +243,12 @@ fn stage_hash(stage: &Stage, scale: f64, hashes: &BTreeMap<&str, String>) -> Res
     Ok(hash(&hashed))
 }
 
+/// Whether an evaluate stage's controller names a policy file (a shipped
+/// table, run on every field) rather than a stage.
+fn is_policy_file(controller: &str) -> bool {
+    controller.ends_with(".policy")
+}
+
 /// Runs one stage.
 fn run_stage(
     campaign: &Campaign,
@@ -334,6 +340,8 @@ fn evaluate(campaign: &Campaign, e: &Evaluation, options: &CampaignOptions) -> R
         for c in &e.controllers {
             let controller = if c == "oc" {
                 ControllerChoice::Orbital
+            } else if is_policy_file(c) {
+                ControllerChoice::Policy(PathBuf::from(c))
             } else {
                 let stage = campaign
                     .stage(c)
