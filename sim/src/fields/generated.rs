@@ -226,24 +226,27 @@ impl Sketch {
         self.lines.iter().chain(&self.filled).flatten()
     }
 
+    /// The sketch with every point moved by `f`.
+    fn map(&self, f: impl Fn(Point) -> Point) -> Sketch {
+        let all = |shapes: &[Vec<Point>]| -> Vec<Vec<Point>> {
+            shapes
+                .iter()
+                .map(|s| s.iter().map(|&p| f(p)).collect())
+                .collect()
+        };
+        Sketch {
+            lines: all(&self.lines),
+            filled: all(&self.filled),
+        }
+    }
+
     /// Stroked `width` wide, turned by `turn` radians, shrunk to at most
     /// [`LONGEST`] px, centred in the image.
     fn placed(self, width: f64, turn: f64) -> Drawing {
         let (sin, cos) = turn.sin_cos();
-        let turned = |&(x, y): &Point| (x * cos - y * sin, x * sin + y * cos);
-        let lines: Vec<Vec<Point>> = self
-            .lines
-            .iter()
-            .map(|l| l.iter().map(turned).collect())
-            .collect();
-        let filled: Vec<Vec<Point>> = self
-            .filled
-            .iter()
-            .map(|p| p.iter().map(turned).collect())
-            .collect();
-        let turned_sketch = Sketch { lines, filled };
+        let turned = self.map(|(x, y)| (x * cos - y * sin, x * sin + y * cos));
         let (mut low, mut high) = ((f64::MAX, f64::MAX), (f64::MIN, f64::MIN));
-        for &(x, y) in turned_sketch.points() {
+        for &(x, y) in turned.points() {
             low = (low.0.min(x), low.1.min(y));
             high = (high.0.max(x), high.1.max(y));
         }
@@ -251,26 +254,19 @@ impl Sketch {
         let scale = (LONGEST / longest).min(1.0);
         let centre = ((low.0 + high.0) / 2.0, (low.1 + high.1) / 2.0);
         let middle = SIZE as f64 / 2.0;
-        let place = |&(x, y): &Point| {
+        let placed = turned.map(|(x, y)| {
             (
                 middle + (x - centre.0) * scale,
                 middle + (y - centre.1) * scale,
             )
-        };
+        });
         Drawing {
-            strokes: turned_sketch
+            strokes: placed
                 .lines
                 .iter()
-                .flat_map(|line| {
-                    line.windows(2)
-                        .map(|w| ([place(&w[0]), place(&w[1])], width * scale))
-                })
+                .flat_map(|line| line.windows(2).map(|w| ([w[0], w[1]], width * scale)))
                 .collect(),
-            polygons: turned_sketch
-                .filled
-                .iter()
-                .map(|p| p.iter().map(place).collect())
-                .collect(),
+            polygons: placed.filled,
         }
     }
 }
