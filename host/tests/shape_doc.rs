@@ -125,35 +125,35 @@ fn report_table(dir: &Path) -> String {
     out
 }
 
-/// The text of `page` between the line `begin` and the line `end`.
-fn between<'a>(page: &'a str, begin: &str, end: &str) -> &'a str {
+/// Fails unless docs/shape.md reads `expected` between the lines `begin`
+/// and `end`, printing what it must read.
+fn check_section(begin: &str, end: &str, expected: &str) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let page = std::fs::read_to_string(root.join("docs/shape.md")).unwrap();
     let from = page
         .find(begin)
         .unwrap_or_else(|| panic!("no marker {begin}"))
         + begin.len()
         + 1;
     let to = page.find(end).unwrap_or_else(|| panic!("no marker {end}"));
-    &page[from..to]
+    assert!(
+        &page[from..to] == expected,
+        "docs/shape.md's table differs from its runs; between the markers it must read:\n{expected}"
+    );
 }
 
 #[test]
 fn the_shape_pages_table_of_unseen_shapes_is_what_their_report_cards_give() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let page = std::fs::read_to_string(root.join("docs/shape.md")).unwrap();
-    let expected = table(&root.join("docs/shape"));
-    assert!(
-        between(&page, BEGIN, END) == expected,
-        "docs/shape.md's table differs from its report cards; between the markers it must read:\n{expected}"
-    );
+    check_section(BEGIN, END, &table(&root.join("docs/shape")));
 }
 
 #[test]
 fn the_shape_pages_table_of_the_reports_shapes_is_what_their_cards_and_evaluations_give() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let page = std::fs::read_to_string(root.join("docs/shape.md")).unwrap();
-    let expected = report_table(&root.join("docs/shape/report"));
-    assert!(
-        between(&page, REPORT_BEGIN, REPORT_END) == expected,
-        "docs/shape.md's table of the report's shapes differs from its runs; between the markers it must read:\n{expected}"
+    check_section(
+        REPORT_BEGIN,
+        REPORT_END,
+        &report_table(&root.join("docs/shape/report")),
     );
 }
