@@ -220,6 +220,57 @@ fn every_shipped_tables_stage_names_the_shipped_blobs_run_hasher_and_field_and_e
 }
 
 #[test]
+fn an_evaluate_stage_runs_a_policy_file_on_every_field_generated_shapes_included() {
+    let dir = tempfile::tempdir().unwrap();
+    let policy = root().join("policies/robot-general.policy");
+    let file = dir.path().join("files.toml");
+    std::fs::write(
+        &file,
+        format!(
+            r#"
+title = "a shipped table on two shapes"
+[defaults]
+sensors = "robot"
+arena = "tv75"
+[[stages]]
+name = "report"
+kind = "evaluate"
+steps = 100000
+seeds = [901]
+fields = ["thesis:V", "gen:ring:0"]
+controllers = [{:?}]
+"#,
+            policy.display().to_string()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    run_campaign(&file, &out, &[]);
+    let report = std::fs::read_to_string(out.join("report.jsonl")).unwrap();
+    let lines: Vec<serde_json::Value> = report
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let runs: Vec<(&str, &str)> = lines
+        .iter()
+        .map(|l| {
+            (
+                l["field"].as_str().unwrap(),
+                l["controller"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    let controller = format!("policy:{}", policy.display());
+    assert_eq!(
+        runs,
+        [
+            ("thesis:V", controller.as_str()),
+            ("gen:ring:0", controller.as_str())
+        ]
+    );
+}
+
+#[test]
 fn a_stage_continuing_from_a_later_or_unknown_stage_is_refused() {
     let later = SMALL.replace("from = \"first\"", "from = \"report\"");
     let error = format!("{:#}", Campaign::parse("small", &later).unwrap_err());

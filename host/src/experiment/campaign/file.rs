@@ -32,8 +32,9 @@
 //! evaluate stage runs `oc`, the named stages' tables and the named
 //! `.policy` files on each of its `fields` for its world's `steps` on each
 //! of its `seeds`: a stage searched or trained on one field only on that
-//! field; one on several fields (a general table) and a policy file on all. A publish stage copies the tables, logs and
-//! evaluations into `dir/runs/` and writes `dir/results.json` ([`publish`](super::publish)).
+//! field; one on several fields (a general table) and a policy file on all.
+//! A publish stage copies the tables, logs and evaluations into
+//! `dir/runs/` and writes `dir/results.json` ([`publish`](super::publish)).
 //!
 //! Outputs in the output directory: `<stage>.policy` and
 //! `<stage>.search.json` (search), `<stage>.policy` and `<stage>.ckpt`
