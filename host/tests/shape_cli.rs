@@ -208,6 +208,17 @@ fn the_result_never_forms_fewer_than_its_start_on_its_validation_worlds() {
 }
 
 #[test]
+fn on_a_shape_without_innies_the_role_start_scores_as_oc_and_is_not_taken() {
+    let (dir, out) = tiny_run();
+    let state = json(&dir.path().join(out).join("ell.shape.json"));
+    let start = &state["start"];
+    assert_eq!(start["oc"], start["oc_role"], "{start}");
+    assert_ne!(start["chosen"], "oc-role");
+    let card = json(&dir.path().join(out).join("ell.report.json"));
+    assert_eq!(card["hasher"], "original");
+}
+
+#[test]
 fn a_run_killed_mid_search_and_run_again_ends_with_the_table_of_an_unbroken_run() {
     let args = [
         "ell.png",

@@ -71,7 +71,7 @@ pub struct Card {
     pub steps: u64,
     /// The budget, minutes.
     pub minutes: f64,
-    /// The start: `general` or `oc`.
+    /// The start: `general`, `oc` or `oc-role`.
     pub start: String,
     /// The search's generations.
     pub generations: u64,

@@ -9,9 +9,11 @@
 //!    generations from a step rate measured on this machine for this shape
 //!    (a short timed run of the general table), recorded in the state file
 //!    ([`state`]); `--generations` gives the count instead;
-//! 3. the start: the better on the shape of the shipped general table
+//! 3. the start: the best on the shape of the shipped general table
 //!    ([`GENERAL_TABLE`], built in) and orbital construction distilled
-//!    into a table of its hasher, scored on start worlds of their own;
+//!    into a table of its hasher and into one of the role hasher (outies
+//!    and innies, where the shape has innies: the annulus), scored on
+//!    start worlds of their own; the search keeps the start's hasher;
 //! 4. the search ([`search_settings`]: the general table's recipe) at the
 //!    run's noise, every candidate also scored at twice it, a challenger
 //!    kept only if it forms more on validation worlds never scored on, so
@@ -41,7 +43,7 @@ use crate::train::distil::distil_orbital;
 use crate::train::TrainConfig;
 use anyhow::{bail, Context, Result};
 use card::{evaluate, write_picture, Card, Contender};
-use shared::{PolicyBlob, PolicyTable};
+use shared::{PolicyBlob, PolicyTable, StateHasher};
 use state::{Budget, RunKey, ShapeState, StartChoice};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -191,9 +193,9 @@ fn budget(
     let generation =
         (settings.population * settings.fitness_seeds) as u64 * settings.fitness_steps * worlds
             + settings.validation_seeds as u64 * settings.validation_steps * worlds;
-    // the distillation runs one world at a time
-    let fixed = scaled(DISTIL_STEPS, request.scale) * threads
-        + 2 * START_SEEDS as u64 * settings.fitness_steps * worlds
+    // the two distillations run one world at a time
+    let fixed = 2 * scaled(DISTIL_STEPS, request.scale) * threads
+        + STARTS.len() as u64 * START_SEEDS as u64 * settings.fitness_steps * worlds
         + settings.validation_seeds as u64 * settings.validation_steps * worlds
         + 3 * 2 * REPORT_SEEDS as u64 * scaled(REPORT_STEPS, request.scale);
     let steps = request.budget_minutes * 60.0 * rate - fixed as f64;
@@ -204,37 +206,45 @@ fn budget(
     })
 }
 
-/// The better on the shape's start worlds of the general table and
-/// orbital construction distilled (the general table on a tie).
+/// The starts a run may take, in the order a tie keeps: the general
+/// table, OC distilled into its hasher, OC distilled into the role hasher.
+const STARTS: [&str; 3] = ["general", "oc", "oc-role"];
+
+/// The best on the shape's start worlds of [`STARTS`] (the earlier on a
+/// tie), and the steps its distillation took.
 fn choose_start(
     config: &TrainConfig,
     scorer: &Scorer,
     general: &PolicyTable,
     settings: &SearchConfig,
     scale: f64,
-) -> Result<(StartChoice, u64)> {
+) -> Result<StartChoice> {
     let seeds = fitness_seeds(config.seed, START_GENERATION, START_SEEDS);
     let distilled = scaled(DISTIL_STEPS, scale);
-    let oc = distil_orbital(config, distilled)?;
-    let scores = scorer.score(
-        &[general.clone(), oc.clone()],
-        &seeds,
-        settings.fitness_steps,
-    )?;
-    let oc_wins = scores[1].beats(&scores[0]);
-    let (chosen, table) = if oc_wins {
-        ("oc", oc)
-    } else {
-        ("general", general.clone())
-    };
-    let choice = StartChoice {
-        chosen: chosen.to_string(),
+    let mut role = config.clone();
+    role.learn.hasher.0 = StateHasher::OriginalRole;
+    let tables = [
+        general.clone(),
+        distil_orbital(config, distilled)?,
+        distil_orbital(&role, distilled)?,
+    ];
+    let scores = scorer.score(&tables, &seeds, settings.fitness_steps)?;
+    let best = (1..tables.len()).fold(0, |best, i| {
+        if scores[i].beats(&scores[best]) {
+            i
+        } else {
+            best
+        }
+    });
+    Ok(StartChoice {
+        chosen: STARTS[best].to_string(),
         general: scores[0],
         oc: scores[1],
+        oc_role: scores[2],
         seeds,
-        table: table.packed().to_vec(),
-    };
-    Ok((choice, if oc_wins { distilled } else { 0 }))
+        hasher: tables[best].hasher().name().to_string(),
+        table: tables[best].packed().to_vec(),
+    })
 }
 
 /// Runs `host shape`, resuming from the state file if there is one.
@@ -254,7 +264,7 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     };
     world.learn.hasher.0 = general.hasher();
     let mut settings = search_settings(request.scale);
-    let (config, scorer) = scorer_of(world, &settings)?;
+    let (mut config, scorer) = scorer_of(world, &settings)?;
     if *general.actions() != scorer.actions() {
         bail!("the general table's actions are not this world's: it is for the robot's actions");
     }
@@ -283,21 +293,23 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     let start = match &state.start {
         Some(start) => start.clone(),
         None => {
-            let (start, _) =
-                choose_start(&config, &scorer, general.table(), &settings, request.scale)?;
+            let start = choose_start(&config, &scorer, general.table(), &settings, request.scale)?;
             state.start = Some(start.clone());
             state.write(&state_file)?;
             start
         }
     };
-    let distilled = if start.chosen == "oc" {
+    let distilled = if start.chosen == "general" {
+        0
+    } else {
         settings.start = Start::Orbital;
         scaled(DISTIL_STEPS, request.scale)
-    } else {
-        0
     };
-    let table = PolicyTable::from_packed(general.hasher(), &start.table)
-        .with_context(|| format!("state file {}: the start table", state_file.display()))?;
+    let in_state = || format!("state file {}: the start table", state_file.display());
+    config.learn.hasher.0 = StateHasher::from_name(&start.hasher)
+        .with_context(|| format!("{}: no hasher {:?}", in_state(), start.hasher))?;
+    let table =
+        PolicyTable::from_packed(config.learn.hasher.0, &start.table).with_context(in_state)?;
     // 4. the search
     let done = state.generations.clone();
     let mut progress = Progress::new(settings.generations, done.len() as u64);

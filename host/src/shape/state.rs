@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The state file's format.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 
 /// What a run is: a rerun resumes only a state of the same.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -45,18 +45,23 @@ pub struct Budget {
     pub generations: u64,
 }
 
-/// The start chosen: the better on the shape of the general table and
-/// distilled orbital construction.
+/// The start chosen: the best on the shape of the general table and
+/// orbital construction distilled into the general table's hasher and
+/// into the role hasher.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StartChoice {
-    /// `general` or `oc`.
+    /// `general`, `oc` or `oc-role`.
     pub chosen: String,
     /// The general table's score on the start worlds.
     pub general: Score,
     /// Distilled orbital construction's score on them.
     pub oc: Score,
+    /// Orbital construction distilled into the role hasher's score on them.
+    pub oc_role: Score,
     /// The seeds of the start worlds.
     pub seeds: Vec<u64>,
+    /// The chosen table's hasher, by name.
+    pub hasher: String,
     /// The chosen table, packed.
     pub table: Vec<u8>,
 }
