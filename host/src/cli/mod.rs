@@ -54,7 +54,7 @@ pub enum Command {
     Search(SearchArgs),
     /// From a picture to a flashable policy and its report card
     /// (docs/shape.md): checks the image and its puck count, searches from
-    /// the better of the general table and orbital construction within a
+    /// the best of the general table and orbital construction within a
     /// time budget (resumable), and writes <out>/<name>.policy,
     /// .report.json, .report.md and .png.
     Shape(shape::ShapeArgs),
