@@ -186,6 +186,43 @@ fn a_tiny_run_writes_a_blob_flash_accepts_and_a_report_whose_result_host_run_rep
 }
 
 #[test]
+fn the_cards_orbital_construction_is_what_host_run_gives_for_oc() {
+    // the annulus, where OC forms within a tiny run's steps
+    let dir = tempfile::tempdir().unwrap();
+    let args = [
+        "annulus",
+        "--out",
+        "o",
+        "--generations",
+        "1",
+        "--scale",
+        "0.05",
+    ];
+    succeeded(&shape(dir.path(), &args));
+    let report = json(&dir.path().join("o/annulus.report.json"));
+    let (pucks, steps) = (report["pucks"].to_string(), report["steps"].to_string());
+    let mut total = 0;
+    for world in report["worlds"].as_array().unwrap() {
+        if world["controller"] != "oc" {
+            continue;
+        }
+        let run = host()
+            .current_dir(dir.path())
+            .args(["run", "--field", "annulus", "--sensors", "robot"])
+            .args(["--noise", &world["noise"].to_string(), "--pucks", &pucks])
+            .args(["--steps", &steps, "--seed", &world["seed"].to_string()])
+            .args(["--controller", "oc", "--json"])
+            .output()
+            .unwrap();
+        succeeded(&run);
+        let summary: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        assert_eq!(summary["formations"], world["formations"], "{world}");
+        total += summary["formations"].as_u64().unwrap();
+    }
+    assert!(total > 0, "OC forms on the annulus: {report}");
+}
+
+#[test]
 fn the_result_never_forms_fewer_than_its_start_on_its_validation_worlds() {
     let (dir, out) = tiny_run();
     let log = json(&dir.path().join(out).join("ell.search.json"));

@@ -22,6 +22,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use shared::PolicyBlob;
 use sim::render::{draw, draw_ground, RenderOptions};
+use sim::scenario::ControllerChoice;
 use std::path::Path;
 
 /// A controller of the report card.
@@ -99,10 +100,13 @@ pub fn formations(
         seed,
         ..config.clone()
     };
-    let scenario = world.scenario()?;
+    let mut scenario = world.scenario()?;
     let (mut sim, mut controller) = match contender {
         Contender::Table(blob) => scenario.build_with_policy(blob.as_ref().clone())?,
-        Contender::Orbital => scenario.build()?,
+        Contender::Orbital => {
+            scenario.controller = ControllerChoice::Orbital;
+            scenario.build()?
+        }
     };
     sim.run(controller.as_mut(), steps);
     Ok(sim.totals().formations)
