@@ -211,7 +211,7 @@ fn budget(
 const STARTS: [&str; 3] = ["general", "oc", "oc-role"];
 
 /// The best on the shape's start worlds of [`STARTS`] (the earlier on a
-/// tie), and the steps its distillation took.
+/// tie).
 fn choose_start(
     config: &TrainConfig,
     scorer: &Scorer,

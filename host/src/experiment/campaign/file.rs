@@ -128,6 +128,12 @@ pub struct Evaluation {
     pub seeds: Vec<u64>,
 }
 
+/// Whether an evaluate stage's controller names a policy file (a shipped
+/// table, run on every field) rather than a stage.
+pub fn is_policy_file(controller: &str) -> bool {
+    controller.ends_with(".policy")
+}
+
 /// The keys a stage has beside its world's and its search's.
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -357,7 +363,7 @@ fn stage(
                 bail!("an evaluate stage names its fields and seeds");
             }
             for c in &evaluation.controllers {
-                if c != "oc" && !c.ends_with(".policy") && !earlier.iter().any(|s| &s.name == c) {
+                if c != "oc" && !is_policy_file(c) && !earlier.iter().any(|s| &s.name == c) {
                     bail!("controllers: {c:?} is neither oc, an earlier stage nor a .policy file");
                 }
             }

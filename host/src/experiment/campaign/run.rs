@@ -2,7 +2,7 @@
 //! and its settings' hash (`<stage>.done`) are there, so that a killed run
 //! resumes at the stage it was in.
 
-use super::file::{Campaign, Evaluation, Stage, Work};
+use super::file::{is_policy_file, Campaign, Evaluation, Stage, Work};
 use crate::experiment::plan::hash;
 use crate::search::{SearchConfig, SearchRequest, Start};
 use crate::train::{TrainConfig, TrainFlags, TrainRequest};
@@ -241,12 +241,6 @@ fn stage_hash(stage: &Stage, scale: f64, hashes: &BTreeMap<&str, String>) -> Res
         },
     };
     Ok(hash(&hashed))
-}
-
-/// Whether an evaluate stage's controller names a policy file (a shipped
-/// table, run on every field) rather than a stage.
-fn is_policy_file(controller: &str) -> bool {
-    controller.ends_with(".policy")
 }
 
 /// Runs one stage.
