@@ -172,7 +172,7 @@ fn formations(
 ) -> Result<u64> {
     let mut prepared = config.prepare()?;
     if let Some(blob) = blob {
-        sim::scenario::drive_with(prepared.config_mut(), blob, &config.field);
+        sim::scenario::drive_with(prepared.config_mut(), blob);
     }
     let mut sim = prepared.simulation(config.seed)?;
     sim.run(controller.as_mut(), window);

@@ -43,7 +43,8 @@ Settings (keyword arguments of every environment, as ``host run``'s flags):
   or ``"state"`` (the reading hashed by ``hasher``, a discrete state);
 - ``hasher="original"``: ``"original"``, ``"original-obstacle"``,
   ``"bits7"``, ``"bits9"`` (checked whatever the observation;
-  ``"original-role"`` is refused: the environments have no innies);
+  the role hashers ``"original-role"`` and ``"bits9-role"`` are refused: the
+  environments have no innies);
 - ``action="discrete"``: ``"discrete"`` (an index into ``actions``) or
   ``"continuous"`` (an angular speed, radians per step, clipped to the
   largest of ``actions``);

@@ -11,11 +11,11 @@
 //! | 4 .. 4+k-1      | 16 x m     | m = floor(mid x 2^k), clamped to 2^k - 1       |
 //! | 8 (10-bit only) | 256        | left obstacle sensor sees a robot              |
 //! | 9 (10-bit only) | 512        | right obstacle sensor sees a robot             |
-//! | 8 (role only)   | 256        | the robot is an innie ([`Role`])               |
+//! | 4+k (role only) | 2^(4+k)    | the robot is an innie ([`Role`])               |
 //!
 //! k = 3, 4, 5 for the 7-, 8- and 9-bit hashers; the 10-bit hasher is the
-//! 8-bit one plus the obstacle bits, the role hasher the 8-bit one plus the
-//! robot's role. 1 always means "sensed". Comparisons and the bin are
+//! 8-bit one plus the obstacle bits, the role hashers the 8- and 9-bit ones
+//! plus the robot's role (bit 8 and bit 9). 1 always means "sensed". Comparisons and the bin are
 //! computed on the Q1.15 [`FieldValue`]s, so they are exact on both the host
 //! and the AVR.
 //!
@@ -73,11 +73,11 @@ impl Role {
     }
 }
 
-/// The four state representations of the thesis and the role layout, one
-/// type.
+/// The four state representations of the thesis and the two role layouts,
+/// one type.
 ///
 /// The wire id of each (in policy blobs) is its bit count for the thesis'
-/// four, and `0x80 | 9` for the role hasher ([`StateHasher::id`]).
+/// four, and `0x80 |` its bit count for a role hasher ([`StateHasher::id`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum StateHasher {
     /// 7 bits: 3-bit mid bin (8 field divisions). 128 states.
@@ -92,6 +92,10 @@ pub enum StateHasher {
     /// innie), so that one shared table can hold both of orbital
     /// construction's behaviours. 512 states.
     OriginalRole,
+    /// 10 bits, ours: Bits9 plus the robot's [`Role`] (bit 9 set for an
+    /// innie): the 9-bit state's finer field bins with both roles. 1024
+    /// states.
+    Bits9Role,
 }
 
 /// The quantised inputs a state encodes: what a hash keeps of a reading.
@@ -111,18 +115,20 @@ pub struct StateInputs {
     pub obstacle_left: bool,
     /// Bit 9 of the 10-bit hash: right obstacle (always false otherwise).
     pub obstacle_right: bool,
-    /// Bit 8 of the role hash: the robot is an innie (always false otherwise).
+    /// The role bit of a role hash: the robot is an innie (always false
+    /// otherwise).
     pub innie: bool,
 }
 
 impl StateHasher {
-    /// Every hasher, the thesis' four smallest first, then the role hasher.
-    pub const ALL: [StateHasher; 5] = [
+    /// Every hasher, the thesis' four smallest first, then the role hashers.
+    pub const ALL: [StateHasher; 6] = [
         StateHasher::Bits7,
         StateHasher::Original,
         StateHasher::Bits9,
         StateHasher::OriginalObstacle,
         StateHasher::OriginalRole,
+        StateHasher::Bits9Role,
     ];
 
     /// The hasher of a wire id ([`StateHasher::id`]).
@@ -133,17 +139,19 @@ impl StateHasher {
             9 => Some(StateHasher::Bits9),
             10 => Some(StateHasher::OriginalObstacle),
             0x89 => Some(StateHasher::OriginalRole),
+            0x8A => Some(StateHasher::Bits9Role),
             _ => None,
         }
     }
 
-    /// The wire id in policy blobs: the bit count of the thesis' four,
-    /// `0x89` (the high bit for "with the role", and 9 bits) for the role
-    /// hasher.
+    /// The wire id in policy blobs: the bit count of the thesis' four;
+    /// the high bit ("with the role") and the bit count for a role hasher:
+    /// `0x89`, `0x8A`.
     pub const fn id(self) -> u8 {
-        match self {
-            StateHasher::OriginalRole => 0x89,
-            other => other.bits(),
+        if self.has_role_bit() {
+            0x80 | self.bits()
+        } else {
+            self.bits()
         }
     }
 
@@ -153,7 +161,7 @@ impl StateHasher {
             StateHasher::Bits7 => 7,
             StateHasher::Original => 8,
             StateHasher::Bits9 | StateHasher::OriginalRole => 9,
-            StateHasher::OriginalObstacle => 10,
+            StateHasher::OriginalObstacle | StateHasher::Bits9Role => 10,
         }
     }
 
@@ -162,12 +170,13 @@ impl StateHasher {
         1 << self.bits()
     }
 
-    /// Bits of the mid field bin (k): 3, 4, 5, or 4 for the 10-bit hasher.
+    /// Bits of the mid field bin (k): 3, 4, 5, or 4 for the 10-bit hasher
+    /// and the 9-bit role hasher, 5 for the 10-bit role hasher.
     pub const fn mid_bits(self) -> u32 {
         match self {
             StateHasher::Bits7 => 3,
             StateHasher::Original | StateHasher::OriginalObstacle | StateHasher::OriginalRole => 4,
-            StateHasher::Bits9 => 5,
+            StateHasher::Bits9 | StateHasher::Bits9Role => 5,
         }
     }
 
@@ -178,7 +187,18 @@ impl StateHasher {
 
     /// Whether the hash carries the robot's role.
     pub const fn has_role_bit(self) -> bool {
-        matches!(self, StateHasher::OriginalRole)
+        matches!(self, StateHasher::OriginalRole | StateHasher::Bits9Role)
+    }
+
+    /// The bit of the robot's role in a role hash (bit 4 + k, above the
+    /// field bin), or 0 for a hasher without it: a state's other role is
+    /// `state ^ role_mask`.
+    pub const fn role_mask(self) -> u16 {
+        if self.has_role_bit() {
+            1 << (4 + self.mid_bits())
+        } else {
+            0
+        }
     }
 
     /// The thesis' name for the hasher.
@@ -189,16 +209,17 @@ impl StateHasher {
             StateHasher::Bits9 => "bits9",
             StateHasher::OriginalObstacle => "original-obstacle",
             StateHasher::OriginalRole => "original-role",
+            StateHasher::Bits9Role => "bits9-role",
         }
     }
 
     /// Every name [`StateHasher::from_name`] takes, as messages list them.
     pub const NAMES: &'static str =
-        "original, original-obstacle, bits7, bits9 (or their bit counts 8, 10, 7, 9), original-role";
+        "original, original-obstacle, bits7, bits9 (or their bit counts 8, 10, 7, 9), original-role, bits9-role";
 
     /// Parses a name (`original`, `original-obstacle`, `bits7`, `bits9`,
-    /// `original-role`) or a bit count of the thesis' four (`7`, `8`, `9`,
-    /// `10`).
+    /// `original-role`, `bits9-role`) or a bit count of the thesis' four
+    /// (`7`, `8`, `9`, `10`).
     pub fn from_name(name: &str) -> Option<StateHasher> {
         match name {
             "7" | "bits7" => Some(StateHasher::Bits7),
@@ -206,6 +227,7 @@ impl StateHasher {
             "9" | "bits9" => Some(StateHasher::Bits9),
             "10" | "original-obstacle" => Some(StateHasher::OriginalObstacle),
             "original-role" => Some(StateHasher::OriginalRole),
+            "bits9-role" => Some(StateHasher::Bits9Role),
             _ => None,
         }
     }
@@ -251,8 +273,8 @@ impl StateHasher {
         if self.has_obstacle_bits() {
             s |= u16::from(inputs.obstacle_left) << 8 | u16::from(inputs.obstacle_right) << 9;
         }
-        if self.has_role_bit() {
-            s |= u16::from(inputs.innie) << 8;
+        if inputs.innie {
+            s |= self.role_mask();
         }
         State(s)
     }
@@ -274,7 +296,7 @@ impl StateHasher {
             mid_bin: (s >> 4) & ((1 << k) - 1),
             obstacle_left: obstacles && s & 256 != 0,
             obstacle_right: obstacles && s & 512 != 0,
-            innie: self.has_role_bit() && s & 256 != 0,
+            innie: s & self.role_mask() != 0,
         })
     }
 

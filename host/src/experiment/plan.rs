@@ -102,8 +102,10 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
     ((steps as f64 * scale).round() as u64).max(1)
 }
 
-/// The settings as a hash sees them: an innie count equal to the field's
-/// default counts as unset (the same run either way), and settings that use
+/// The settings as a hash sees them: an innie count equal to orbital
+/// construction's on the field counts as unset (the same run either way;
+/// the role hasher's count is its run's, the flashed swarm's unless set),
+/// and settings that use
 /// nothing newer than checkpoint format 1, 2, 3, 4, 6 or 7 are hashed in its
 /// layout ([`TrainConfigV1`] to [`TrainConfigV7`]), so that trials run
 /// before the newer settings existed keep their hashes; settings with one
@@ -140,7 +142,11 @@ enum Hashed {
 /// [`Hashed`] settings of `config`.
 fn hashed(config: &TrainConfig) -> Hashed {
     let mut c = config.clone();
-    if c.innies == Some(orbital_innies(&c.field, c.robots.unwrap_or(THESIS_ROBOTS))) {
+    let robots = c.robots.unwrap_or(THESIS_ROBOTS);
+    if c.learn.hasher.0.has_role_bit() {
+        c.innies = Some(c.role_innies(robots));
+    }
+    if c.innies == Some(orbital_innies(&c.field, robots)) {
         c.innies = None;
     }
     let robot_senses = c.sensors.is_robot();

@@ -154,7 +154,7 @@ impl Running {
                     .context("a policy arm without its policy file")?;
                 let blob = sim::control::policy_file::read(path)?;
                 let mut prepared = c.prepare()?;
-                sim::scenario::drive_with(prepared.config_mut(), &blob, &c.field);
+                sim::scenario::drive_with(prepared.config_mut(), &blob);
                 let sim = prepared.simulation(c.seed).context("invalid settings")?;
                 Running::Policy(Box::new(sim), GreedyPolicy::new(blob))
             }

@@ -15,7 +15,8 @@ use sim::{control::Controller, control::Perception};
 #[serde(default, deny_unknown_fields)]
 pub struct LearnConfig {
     /// State hasher: original, original-obstacle, bits7, bits9 (or 8, 10,
-    /// 7, 9), original-role (innies and outies apart) [default: original].
+    /// 7, 9), original-role or bits9-role (innies and outies apart: the 8
+    /// or 9 bits and the robot's role) [default: original].
     #[arg(long, required = false)]
     pub hasher: StateHasherName,
     /// Angular speeds of the actions, radians per step (2 to 4).

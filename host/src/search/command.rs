@@ -22,7 +22,7 @@ use crate::train::{TrainConfig, TrainFlags};
 use anyhow::{bail, Context, Result};
 use rand::SeedableRng;
 use serde::{Deserialize, Serialize};
-use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
+use shared::{PolicyBlob, PolicyTable, Provenance};
 use sim::base::rng::SimRng;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -278,14 +278,7 @@ pub fn scorer_of(base: TrainConfig, settings: &SearchConfig) -> Result<(TrainCon
     let configs = worlds_from(base, settings)?;
     let config = configs[0].clone();
     settings.validate(config.learn.actions.len())?;
-    let prepared = configs
-        .iter()
-        .map(TrainConfig::prepare)
-        .collect::<Result<Vec<_>>>()?;
-    let forward = prepared[0].config().world.forward_speed as f32;
-    let actions = ActionTable::new(&config.learn.actions, forward)
-        .context("the run's actions are not a valid action table")?;
-    let scorer = Scorer::new(prepared, actions, settings.threads)?;
+    let scorer = Scorer::new(&configs, settings.threads)?;
     Ok((config, scorer))
 }
 
@@ -526,10 +519,7 @@ mod tests {
         let configs = worlds(&request).unwrap();
         let config = configs[0].clone();
         assert_eq!(config.pucks, Some(12), "the annulus' count on the TV");
-        let prepared: Vec<_> = configs.iter().map(|c| c.prepare().unwrap()).collect();
-        let forward = prepared[0].config().world.forward_speed as f32;
-        let actions = ActionTable::new(&config.learn.actions, forward).unwrap();
-        let scorer = Scorer::new(prepared, actions, threads).unwrap();
+        let scorer = Scorer::new(&configs, threads).unwrap();
         let (table, distilled) = start_table(&config, &request.search.start).unwrap();
         run(&config, &request.search, &scorer, table, distilled).unwrap()
     }

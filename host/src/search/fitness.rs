@@ -13,7 +13,8 @@
 //! own.
 
 use crate::experiment::plan::mix;
-use anyhow::{Context, Result};
+use crate::train::TrainConfig;
+use anyhow::{bail, Context, Result};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use shared::{ActionTable, PolicyBlob, PolicyTable, Provenance};
@@ -77,27 +78,42 @@ impl Score {
 }
 
 /// Builds worlds of one run's settings (one per field) and drives them
-/// with tables.
+/// with tables, each world's robots as the table would be flashed: a role
+/// table's with the run's innies ([`TrainConfig::role_innies`]), the
+/// others' all alike.
 pub struct Scorer {
     prepared: Vec<PreparedScenario>,
+    role_innies: Vec<usize>,
     actions: ActionTable,
     pool: rayon::ThreadPool,
 }
 
 impl Scorer {
-    /// A scorer of the worlds of each of `prepared` (one per field) with
-    /// `actions`, on `threads` threads (0: one per core).
-    pub fn new(
-        prepared: Vec<PreparedScenario>,
-        actions: ActionTable,
-        threads: usize,
-    ) -> Result<Scorer> {
+    /// A scorer of the worlds of each of `configs` (one per field; the
+    /// first one's actions), on `threads` threads (0: one per core).
+    pub fn new(configs: &[TrainConfig], threads: usize) -> Result<Scorer> {
+        let prepared = configs
+            .iter()
+            .map(TrainConfig::prepare)
+            .collect::<Result<Vec<_>>>()?;
+        let role_innies = prepared
+            .iter()
+            .zip(configs)
+            .map(|(p, c)| c.role_innies(p.config().world.robots))
+            .collect();
+        let (Some(first), Some(config)) = (prepared.first(), configs.first()) else {
+            bail!("a search scores on at least one field");
+        };
+        let forward = first.config().world.forward_speed as f32;
+        let actions = ActionTable::new(&config.learn.actions, forward)
+            .context("the run's actions are not a valid action table")?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .context("cannot start the search's threads")?;
         Ok(Scorer {
             prepared,
+            role_innies,
             actions,
             pool,
         })
@@ -156,7 +172,11 @@ impl Scorer {
     ) -> Result<(u64, f64)> {
         let provenance = Provenance::new("search", "candidate", 0, seed)?;
         let blob = PolicyBlob::new(self.actions, table.clone(), provenance)?;
-        let mut sim = self.prepared[field]
+        let mut prepared = self.prepared[field].clone();
+        if table.hasher().has_role_bit() {
+            prepared.config_mut().world.innies = self.role_innies[field];
+        }
+        let mut sim = prepared
             .simulation(seed)
             .context("cannot build a search world")?;
         sim.run(&mut GreedyPolicy::new(blob), steps);

@@ -11,8 +11,8 @@
 //!    ([`state`]); `--generations` gives the count instead;
 //! 3. the start: the best on the shape of the shipped general table
 //!    ([`GENERAL_TABLE`], built in) and orbital construction distilled
-//!    into a table of its hasher and into one of the role hasher (outies
-//!    and innies, where the shape has innies: the annulus), scored on
+//!    into a table of its hasher and into one of the role hasher (the
+//!    robots of odd id innies, as flashed, on every shape), scored on
 //!    start worlds of their own; the search keeps the start's hasher;
 //! 4. the search ([`search_settings`]: the general table's recipe) at the
 //!    run's noise, every candidate also scored at twice it, a challenger

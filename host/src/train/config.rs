@@ -13,8 +13,8 @@ use shared::blob::name_prefix;
 use sim::base::ranges;
 use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::choices::{ScenarioChoices, WorldChoices};
-use sim::scenario::orbital_innies;
 use sim::scenario::sensor_choice::SensorChoice;
+use sim::scenario::{orbital_innies, role_innies};
 use sim::{
     config::disc_sensors::ObstacleTargets, config::SuccessSignal, config::Walls,
     fields::source::FieldSource, scenario::ControllerChoice, scenario::PreparedScenario,
@@ -95,9 +95,10 @@ pub struct TrainConfig {
     #[arg(skip)]
     pub success: SuccessSignal,
     /// Innies among the robots of an orbital-construction run or of a
-    /// learning run with the role hasher (original-role) [default: half the
-    /// robots on the annulus, none on letters and images]. Other learning
-    /// runs have none.
+    /// learning run with the role hasher (original-role) [default: for
+    /// orbital construction half the robots on the annulus, none on letters
+    /// and images; for the role hasher the flashed swarm's on every field,
+    /// the robots of odd id]. Other learning runs have none.
     #[arg(long)]
     pub innies: Option<usize>,
     /// The disc sensor model's obstacle discs; `None` for the model's own
@@ -317,8 +318,8 @@ impl TrainConfig {
             bail!("innies = {n}: cannot exceed robots = {}", c.world.robots);
         }
         if self.learn.hasher.0.has_role_bit() {
-            // a role-aware policy learns both roles, in orbital construction's mix
-            c.world.innies = self.oc_innies(c.world.robots);
+            // a role-aware policy learns both roles, in the flashed swarm's mix
+            c.world.innies = self.role_innies(c.world.robots);
         }
         c.validate().context("invalid simulation settings")?;
         Ok(prepared)
@@ -329,6 +330,13 @@ impl TrainConfig {
     pub fn oc_innies(&self, robots: usize) -> usize {
         self.innies
             .unwrap_or_else(|| orbital_innies(&self.field, robots))
+    }
+
+    /// The innies of a run of these settings with the role hasher and
+    /// `robots` robots: the flashed swarm's ([`role_innies`]) on every
+    /// field unless set.
+    pub fn role_innies(&self, robots: usize) -> usize {
+        self.innies.unwrap_or_else(|| role_innies(robots))
     }
 
     /// The exploration probability at training step `step`: `--epsilon`,

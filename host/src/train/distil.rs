@@ -5,9 +5,10 @@
 //! action becomes the policy the run starts from (its Q-values preferring
 //! those actions, as `--init-from` does with a policy blob).
 //!
-//! With the role hasher (`original-role`) the world has orbital
-//! construction's innies and outies ([`TrainConfig::prepare`]) and the table
-//! holds both behaviours; with the others every robot is an outie. A state
+//! With the role hasher (`original-role`) the world has the flashed
+//! swarm's innies on every field, the robots of odd id
+//! ([`TrainConfig::prepare`]), and the table holds both behaviours; with
+//! the others every robot is an outie. A state
 //! orbital construction never reached takes the action of the same state
 //! of the other role if that one was reached, else the most frequent action
 //! overall. The world is seeded with the run's seed mixed with
@@ -85,11 +86,9 @@ pub fn distil_orbital(config: &TrainConfig, steps: u64) -> Result<PolicyTable> {
     let fallback = most(&overall).unwrap_or(0);
     let mut table = PolicyTable::new(hasher);
     for s in 0..hasher.num_states() {
-        let other_role = if hasher.has_role_bit() {
-            Some(s ^ 256)
-        } else {
-            None
-        };
+        let other_role = hasher
+            .has_role_bit()
+            .then(|| s ^ usize::from(hasher.role_mask()));
         let action = most(counts(s))
             .or_else(|| other_role.and_then(|o| most(counts(o))))
             .unwrap_or(fallback);

@@ -160,13 +160,24 @@ pub fn orbital_innies(field: &FieldSource, robots: usize) -> usize {
     }
 }
 
+/// The innies of a swarm of `robots` flashed with ids 0, 1, 2, ...: the
+/// robots whose id makes them innies by the firmware's rule
+/// ([`shared::Role::of_robot_id`]: odd ids), on every field. A role-aware
+/// policy runs with these wherever it runs, as the flashed robots do.
+pub fn role_innies(robots: usize) -> usize {
+    (0..robots)
+        .filter(|&id| {
+            u8::try_from(id).is_ok_and(|id| shared::Role::of_robot_id(id) == shared::Role::Innie)
+        })
+        .count()
+}
+
 /// Settings for robots driven by `blob`: its forward speed, and with the
-/// role hasher orbital construction's mix of innies and outies on `field`
-/// ([`orbital_innies`]).
-pub fn drive_with(config: &mut SimConfig, blob: &shared::PolicyBlob, field: &FieldSource) {
+/// role hasher the flashed swarm's innies ([`role_innies`]).
+pub fn drive_with(config: &mut SimConfig, blob: &shared::PolicyBlob) {
     config.world.forward_speed = f64::from(blob.actions().forward_speed());
     if blob.hasher().has_role_bit() {
-        config.world.innies = orbital_innies(field, config.world.robots);
+        config.world.innies = role_innies(config.world.robots);
     }
 }
 
@@ -262,7 +273,7 @@ impl Scenario {
         blob: shared::PolicyBlob,
     ) -> Result<(Simulation<SelectedSensors>, Box<dyn Controller + Send>), ScenarioError> {
         let mut prepared = self.prepare()?;
-        drive_with(prepared.config_mut(), &blob, &self.field);
+        drive_with(prepared.config_mut(), &blob);
         let sim = prepared.simulation(self.seed)?;
         Ok((sim, Box::new(GreedyPolicy::new(blob))))
     }
