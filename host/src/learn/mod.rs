@@ -1,10 +1,12 @@
 //! Tabular Q-learning with one policy shared by all robots: the table
 //! ([`qtable`]), the learning controller ([`learner`]), rewarded by
 //! `sim::episodes::reward`, its n-step returns' waiting steps
-//! ([`returns`]), and a learned table frozen ([`frozen`]).
+//! ([`returns`]), a learned table frozen ([`frozen`]), and a greedy table
+//! carried into a finer state ([`lift`]).
 
 pub mod frozen;
 pub mod learner;
+pub mod lift;
 pub mod qtable;
 pub mod returns;
 

@@ -322,7 +322,8 @@ fn resume(args: &TrainRequest, path: &Path) -> Result<(Trainer<SelectedSensors>,
 }
 
 /// The Q-table `--init-from` names: a checkpoint's, or one acting like a
-/// policy blob. Its hasher and actions must be the run's.
+/// policy blob (a blob of a coarser state lifted into the run's,
+/// [`crate::learn::lift`]). Its hasher and actions must be the run's.
 pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     // a checkpoint or a policy blob: no larger than the larger of the two
     let bytes = ranges::read_file(path, &ranges::CHECKPOINT_FILE)
@@ -330,7 +331,10 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     let learn = &config.learn;
     let (table, speeds) = if bytes.starts_with(&PolicyBlob::MAGIC) {
         let blob = sim::control::policy_file::decode(path, &bytes)?;
-        let q = QTable::from_policy(blob.table(), blob.actions().len(), learn.initial_q);
+        // a greedy table of a coarser state starts a finer one, acting alike
+        let policy = crate::learn::lift::lift(blob.table(), learn.hasher.0)
+            .unwrap_or_else(|| blob.table().clone());
+        let q = QTable::from_policy(&policy, blob.actions().len(), learn.initial_q);
         (q, Some(blob.actions().angular_speeds().to_vec()))
     } else {
         let state: TrainingState = checkpoint::decode(&bytes)
@@ -340,7 +344,7 @@ pub fn seed_table(path: &Path, config: &TrainConfig) -> Result<QTable> {
     let (hasher, actions) = (table.hasher(), table.num_actions());
     if hasher != learn.hasher.0 || actions != learn.actions.len() {
         bail!(
-            "{} was trained with hasher {hasher} and {actions} actions, but this run uses hasher {} and {} actions",
+            "{} was trained with hasher {hasher} and {actions} actions, but this run uses hasher {} and {} actions (a policy blob's table lifts only into a hasher with field bins at least as fine that reads every bit it reads)",
             path.display(),
             learn.hasher.0,
             learn.actions.len()
