@@ -1,14 +1,22 @@
-//! docs/generated-shapes.md's tables are what the general-shapes campaign's
-//! evaluations (`docs/generated-shapes/evaluate-shapes*.jsonl`, written by
-//! `host experiment experiments/campaigns/general-shapes.toml`) give.
+//! docs/generated-shapes.md's tables are what the campaigns' evaluations
+//! give: the general-shapes campaign's
+//! (`docs/generated-shapes/evaluate-shapes*.jsonl`, written by `host
+//! experiment experiments/campaigns/general-shapes.toml`) and the
+//! general-state campaign's (`docs/generated-shapes/evaluate-states.jsonl`
+//! and its tables, `state-*.policy`, written by `host experiment
+//! experiments/campaigns/general-state.toml`).
 
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-/// The lines around the tables.
+/// The lines around the general-shapes campaign's tables.
 const BEGIN: &str = "<!-- generated-shapes begin: generated from docs/generated-shapes/*.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const END: &str = "<!-- generated-shapes end -->";
+
+/// The lines around the general-state campaign's tables.
+const STATES_BEGIN: &str = "<!-- general-state begin: generated from docs/generated-shapes/evaluate-states.jsonl and state-*.policy by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
+const STATES_END: &str = "<!-- general-state end -->";
 
 /// The controllers as the evaluation names them, and as the table does.
 const CONTROLLERS: [(&str, &str); 3] = [
@@ -17,18 +25,34 @@ const CONTROLLERS: [(&str, &str); 3] = [
     ("shapes-from-general", "searched"),
 ];
 
+/// The general-state campaign's tables (stage names, also their files in
+/// docs/generated-shapes/), in the table's order.
+const STATES: [&str; 5] = [
+    "state-original",
+    "state-bits9",
+    "state-obstacle",
+    "state-role",
+    "state-bits9-role",
+];
+
 /// Formations summed over the seeds, by field and controller, in the
 /// evaluation's order of fields.
 type Sums = (Vec<String>, BTreeMap<(String, String), u64>);
 
 fn sums(file: &Path) -> Sums {
+    sums_named(file, &CONTROLLERS)
+}
+
+/// [`sums`] with the controllers named by `names` (evaluation's name or
+/// stage, table's name); others keep the evaluation's name.
+fn sums_named(file: &Path, names: &[(&str, &str)]) -> Sums {
     let text = std::fs::read_to_string(file).unwrap();
     let (mut fields, mut sums) = (Vec::new(), BTreeMap::new());
     for line in text.lines() {
         let run: Value = serde_json::from_str(line).unwrap();
         let field = run["field"].as_str().unwrap().to_string();
         let controller = run["controller"].as_str().unwrap();
-        let controller = CONTROLLERS
+        let controller = names
             .iter()
             .find(|(c, _)| controller == *c || controller.ends_with(&format!("/{c}.policy")))
             .map_or(controller, |(_, name)| name)
@@ -97,6 +121,103 @@ fn tables(dir: &Path) -> String {
         );
     }
     out
+}
+
+/// The general-state campaign's tables: formations per shape of OC, the
+/// shipped general table and each state's table; then per table its
+/// hasher and entries and how it does on the splits.
+fn state_tables(dir: &Path) -> String {
+    let mut names = vec![
+        ("oc", "OC"),
+        ("policy:policies/robot-general.policy", "general"),
+    ];
+    names.extend(
+        STATES
+            .iter()
+            .map(|s| (*s, s.strip_prefix("state-").unwrap())),
+    );
+    let (fields, sums) = sums_named(&dir.join("evaluate-states.jsonl"), &names);
+    let get = |f: &str, c: &str| sums.get(&(f.to_string(), c.to_string())).copied();
+    let columns: Vec<&str> = names.iter().map(|(_, n)| *n).collect();
+    let mut out = format!(
+        "| shape | split | {} |\n| --- | --- |{}\n",
+        columns.join(" | "),
+        " ---: |".repeat(columns.len())
+    );
+    for f in &fields {
+        let cells: Vec<String> = columns
+            .iter()
+            .map(|c| get(f, c).map_or("-".to_string(), |v| v.to_string()))
+            .collect();
+        out += &format!("| `{f}` | {} | {} |\n", split(f), cells.join(" | "));
+    }
+    out += "\n| table | state | entries | held out: at least 25 | unseen seeds: at least 25 | held out: sum of ln(1 + formations) | at least OC where OC forms 20 or more | report: at least the general table |\n\
+            | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
+    let of_split =
+        |which: &str| -> Vec<&String> { fields.iter().filter(|f| split(f) == which).collect() };
+    let (held, unseen, report) = (
+        of_split("held out"),
+        of_split("unseen seed"),
+        of_split("report"),
+    );
+    let oc_forms: Vec<(&String, u64)> = fields
+        .iter()
+        .filter_map(|f| get(f, "OC").filter(|&oc| oc >= 20).map(|oc| (f, oc)))
+        .collect();
+    for (stage, name) in names.iter().skip(1) {
+        let (state, entries) = if *name == "general" {
+            blob_state(&dir.join("../../policies/robot-general.policy"))
+        } else {
+            blob_state(&dir.join(format!("{stage}.policy")))
+        };
+        let at_least = |shapes: &[&String], n: u64| {
+            shapes
+                .iter()
+                .filter(|f| get(f, name).unwrap_or(0) >= n)
+                .count()
+        };
+        let balance: f64 = held
+            .iter()
+            .map(|f| (get(f, name).unwrap_or(0) as f64).ln_1p())
+            .sum();
+        let over_oc = oc_forms
+            .iter()
+            .filter(|(f, oc)| get(f, name).unwrap_or(0) >= *oc)
+            .count();
+        let over_general = report
+            .iter()
+            .filter(|f| get(f, name).unwrap_or(0) >= get(f, "general").unwrap_or(0))
+            .count();
+        out += &format!(
+            "| {name} | `{state}` | {entries} | {} of {} | {} of {} | {balance:.1} | {over_oc} of {} | {over_general} of {} |\n",
+            at_least(&held, 25),
+            held.len(),
+            at_least(&unseen, 25),
+            unseen.len(),
+            oc_forms.len(),
+            report.len(),
+        );
+    }
+    out
+}
+
+/// A policy file's hasher name and its table's entries.
+fn blob_state(file: &Path) -> (&'static str, usize) {
+    let blob = shared::PolicyBlob::decode(&std::fs::read(file).unwrap()).unwrap();
+    (blob.hasher().name(), blob.hasher().num_states())
+}
+
+#[test]
+fn the_general_state_tables_are_what_the_evaluation_gives() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
+    let begin = page.find(STATES_BEGIN).expect("the begin marker") + STATES_BEGIN.len() + 1;
+    let end = page.find(STATES_END).expect("the end marker");
+    let expected = state_tables(&root.join("docs/generated-shapes"));
+    assert!(
+        page[begin..end] == expected,
+        "docs/generated-shapes.md's state tables differ from the evaluation; between the markers they must read:\n{expected}"
+    );
 }
 
 #[test]
