@@ -4,7 +4,9 @@
 //! experiment experiments/campaigns/general-shapes.toml`) and the
 //! general-state campaign's (`docs/generated-shapes/evaluate-states.jsonl`
 //! and its tables, `state-*.policy`, written by `host experiment
-//! experiments/campaigns/general-state.toml`).
+//! experiments/campaigns/general-state.toml`) and the general-policy
+//! campaign's (`docs/generated-shapes/evaluate-policy*.jsonl`, written by
+//! `host experiment experiments/campaigns/general-policy.toml`).
 
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -14,15 +16,21 @@ use std::path::Path;
 const BEGIN: &str = "<!-- generated-shapes begin: generated from docs/generated-shapes/*.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const END: &str = "<!-- generated-shapes end -->";
 
+/// The lines around the general-policy campaign's tables.
+const POLICY_BEGIN: &str = "<!-- general-policy begin: generated from docs/generated-shapes/evaluate-policy*.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
+const POLICY_END: &str = "<!-- general-policy end -->";
+
 /// The lines around the general-state campaign's tables.
 const STATES_BEGIN: &str = "<!-- general-state begin: generated from docs/generated-shapes/evaluate-states.jsonl and state-*.policy by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const STATES_END: &str = "<!-- general-state end -->";
 
-/// The controllers as the evaluation names them, and as the table does.
-const CONTROLLERS: [(&str, &str); 3] = [
+/// The controllers as the evaluations name them, and as the tables do
+/// (each evaluation runs one searched table).
+const CONTROLLERS: [(&str, &str); 4] = [
     ("oc", "OC"),
     ("policy:policies/robot-general.policy", "general"),
     ("shapes-from-general", "searched"),
+    ("general-role", "searched"),
 ];
 
 /// The general-state campaign's tables (stage names, also their files in
@@ -75,10 +83,11 @@ fn split(field: &str) -> &'static str {
     }
 }
 
-/// The tables the evaluations in `dir` give.
-fn tables(dir: &Path) -> String {
-    let (fields, default) = sums(&dir.join("evaluate-shapes.jsonl"));
-    let (_, twice) = sums(&dir.join("evaluate-shapes-2x.jsonl"));
+/// The tables that the evaluation `evaluation` in `dir` gives, at the
+/// default noise and (`evaluation-2x`) twice it.
+fn tables(dir: &Path, evaluation: &str) -> String {
+    let (fields, default) = sums(&dir.join(format!("{evaluation}.jsonl")));
+    let (_, twice) = sums(&dir.join(format!("{evaluation}-2x.jsonl")));
     let get = |sums: &BTreeMap<(String, String), u64>, f: &str, c: &str| {
         sums.get(&(f.to_string(), c.to_string())).copied()
     };
@@ -226,9 +235,22 @@ fn the_generated_shapes_pages_tables_are_what_the_evaluations_give() {
     let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
     let begin = page.find(BEGIN).expect("the begin marker") + BEGIN.len() + 1;
     let end = page.find(END).expect("the end marker");
-    let expected = tables(&root.join("docs/generated-shapes"));
+    let expected = tables(&root.join("docs/generated-shapes"), "evaluate-shapes");
     assert!(
         page[begin..end] == expected,
         "docs/generated-shapes.md's tables differ from the evaluations; between the markers they must read:\n{expected}"
+    );
+}
+
+#[test]
+fn the_general_policy_tables_are_what_its_evaluations_give() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
+    let begin = page.find(POLICY_BEGIN).expect("the begin marker") + POLICY_BEGIN.len() + 1;
+    let end = page.find(POLICY_END).expect("the end marker");
+    let expected = tables(&root.join("docs/generated-shapes"), "evaluate-policy");
+    assert!(
+        page[begin..end] == expected,
+        "docs/generated-shapes.md's general-policy tables differ from the evaluations; between the markers they must read:\n{expected}"
     );
 }
