@@ -216,41 +216,38 @@ fn blob_state(file: &Path) -> (&'static str, usize) {
     (blob.hasher().name(), blob.hasher().num_states())
 }
 
+/// The campaigns' outputs copied for the page.
+fn data() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/generated-shapes")
+}
+
+/// Fails unless the page reads `expected` between the markers.
+fn assert_between(begin: &str, end: &str, expected: &str) {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/generated-shapes.md");
+    let page = std::fs::read_to_string(file).unwrap();
+    let from = page.find(begin).expect("the begin marker") + begin.len() + 1;
+    let to = page.find(end).expect("the end marker");
+    assert!(
+        page[from..to] == *expected,
+        "docs/generated-shapes.md differs from the campaign's outputs; after {begin} it must read:\n{expected}"
+    );
+}
+
 #[test]
 fn the_general_state_tables_are_what_the_evaluation_gives() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
-    let begin = page.find(STATES_BEGIN).expect("the begin marker") + STATES_BEGIN.len() + 1;
-    let end = page.find(STATES_END).expect("the end marker");
-    let expected = state_tables(&root.join("docs/generated-shapes"));
-    assert!(
-        page[begin..end] == expected,
-        "docs/generated-shapes.md's state tables differ from the evaluation; between the markers they must read:\n{expected}"
-    );
+    assert_between(STATES_BEGIN, STATES_END, &state_tables(&data()));
 }
 
 #[test]
 fn the_generated_shapes_pages_tables_are_what_the_evaluations_give() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
-    let begin = page.find(BEGIN).expect("the begin marker") + BEGIN.len() + 1;
-    let end = page.find(END).expect("the end marker");
-    let expected = tables(&root.join("docs/generated-shapes"), "evaluate-shapes");
-    assert!(
-        page[begin..end] == expected,
-        "docs/generated-shapes.md's tables differ from the evaluations; between the markers they must read:\n{expected}"
-    );
+    assert_between(BEGIN, END, &tables(&data(), "evaluate-shapes"));
 }
 
 #[test]
 fn the_general_policy_tables_are_what_its_evaluations_give() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let page = std::fs::read_to_string(root.join("docs/generated-shapes.md")).unwrap();
-    let begin = page.find(POLICY_BEGIN).expect("the begin marker") + POLICY_BEGIN.len() + 1;
-    let end = page.find(POLICY_END).expect("the end marker");
-    let expected = tables(&root.join("docs/generated-shapes"), "evaluate-policy");
-    assert!(
-        page[begin..end] == expected,
-        "docs/generated-shapes.md's general-policy tables differ from the evaluations; between the markers they must read:\n{expected}"
+    assert_between(
+        POLICY_BEGIN,
+        POLICY_END,
+        &tables(&data(), "evaluate-policy"),
     );
 }
