@@ -681,7 +681,7 @@ pub const INNIES: Range = Range::closed(
     0.0,
     1000.0,
     "",
-    "at most the robots; half of them on the annulus",
+    "at most the robots; by default half of them on the annulus for OC, the robots of odd id for a role table",
 );
 
 /// `host`'s seeds: every 64-bit unsigned integer is one.
