@@ -20,6 +20,10 @@ const END: &str = "<!-- generated-shapes end -->";
 const POLICY_BEGIN: &str = "<!-- general-policy begin: generated from docs/generated-shapes/evaluate-policy*.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const POLICY_END: &str = "<!-- general-policy end -->";
 
+/// The lines around the annulus-first lineage's table.
+const ANNULUS_FIRST_BEGIN: &str = "<!-- annulus-first begin: generated from docs/generated-shapes/evaluate-after-annulus.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
+const ANNULUS_FIRST_END: &str = "<!-- annulus-first end -->";
+
 /// The lines around the general-state campaign's tables.
 const STATES_BEGIN: &str = "<!-- general-state begin: generated from docs/generated-shapes/evaluate-states.jsonl and state-*.policy by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const STATES_END: &str = "<!-- general-state end -->";
@@ -132,6 +136,43 @@ fn tables(dir: &Path, evaluation: &str) -> String {
     out
 }
 
+/// Formations per shape (a row each, with its split) of the controllers
+/// `names` (a column each, by the table's name).
+fn per_shape((fields, sums): &Sums, names: &[(&str, &str)]) -> String {
+    let mut out = format!(
+        "| shape | split | {} |\n| --- | --- |{}\n",
+        names
+            .iter()
+            .map(|(_, n)| *n)
+            .collect::<Vec<_>>()
+            .join(" | "),
+        " ---: |".repeat(names.len())
+    );
+    for f in fields {
+        let cells: Vec<String> = names
+            .iter()
+            .map(|(_, c)| {
+                sums.get(&(f.clone(), c.to_string()))
+                    .map_or("-".to_string(), |v| v.to_string())
+            })
+            .collect();
+        out += &format!("| `{f}` | {} | {} |\n", split(f), cells.join(" | "));
+    }
+    out
+}
+
+/// The annulus-first lineage's table: its two tables per shape.
+fn annulus_first_table(dir: &Path) -> String {
+    let names = [
+        ("general-role-annulus", "annulus first"),
+        ("general-role-after-annulus", "then every shape"),
+    ];
+    per_shape(
+        &sums_named(&dir.join("evaluate-after-annulus.jsonl"), &names),
+        &names,
+    )
+}
+
 /// The general-state campaign's tables: formations per shape of OC, the
 /// shipped general table and each state's table; then per table its
 /// hasher and entries and how it does on the splits.
@@ -147,19 +188,7 @@ fn state_tables(dir: &Path) -> String {
     );
     let (fields, sums) = sums_named(&dir.join("evaluate-states.jsonl"), &names);
     let get = |f: &str, c: &str| sums.get(&(f.to_string(), c.to_string())).copied();
-    let columns: Vec<&str> = names.iter().map(|(_, n)| *n).collect();
-    let mut out = format!(
-        "| shape | split | {} |\n| --- | --- |{}\n",
-        columns.join(" | "),
-        " ---: |".repeat(columns.len())
-    );
-    for f in &fields {
-        let cells: Vec<String> = columns
-            .iter()
-            .map(|c| get(f, c).map_or("-".to_string(), |v| v.to_string()))
-            .collect();
-        out += &format!("| `{f}` | {} | {} |\n", split(f), cells.join(" | "));
-    }
+    let mut out = per_shape(&(fields.clone(), sums.clone()), &names);
     out += "\n| table | state | entries | held out: at least 25 | unseen seeds: at least 25 | held out: sum of ln(1 + formations) | at least OC where OC forms 20 or more | report: at least the general table |\n\
             | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n";
     let of_split =
@@ -249,5 +278,14 @@ fn the_general_policy_tables_are_what_its_evaluations_give() {
         POLICY_BEGIN,
         POLICY_END,
         &tables(&data(), "evaluate-policy"),
+    );
+}
+
+#[test]
+fn the_annulus_first_table_is_what_its_evaluation_gives() {
+    assert_between(
+        ANNULUS_FIRST_BEGIN,
+        ANNULUS_FIRST_END,
+        &annulus_first_table(&data()),
     );
 }
