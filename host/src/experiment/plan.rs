@@ -104,9 +104,9 @@ pub fn scaled(steps: u64, scale: f64) -> u64 {
 
 /// The settings as a hash sees them: an innie count equal to orbital
 /// construction's on the field counts as unset (the same run either way;
-/// the role hasher's count is its run's, the flashed swarm's unless set),
-/// and settings that use
-/// nothing newer than checkpoint format 1, 2, 3, 4, 6 or 7 are hashed in its
+/// a role hasher's count is its run's, the flashed swarm's unless set),
+/// and settings that use nothing newer than checkpoint format 1, 2, 3, 4,
+/// 6 or 7 are hashed in its
 /// layout ([`TrainConfigV1`] to [`TrainConfigV7`]), so that trials run
 /// before the newer settings existed keep their hashes; settings with one
 /// added since format 7 away from its default hash as the JSON of the

@@ -95,10 +95,10 @@ pub struct TrainConfig {
     #[arg(skip)]
     pub success: SuccessSignal,
     /// Innies among the robots of an orbital-construction run or of a
-    /// learning run with the role hasher (original-role) [default: for
-    /// orbital construction half the robots on the annulus, none on letters
-    /// and images; for the role hasher the flashed swarm's on every field,
-    /// the robots of odd id]. Other learning runs have none.
+    /// learning run with a role hasher (original-role, bits9-role)
+    /// [default: for orbital construction half the robots on the annulus,
+    /// none on letters and images; for a role hasher the flashed swarm's on
+    /// every field, the robots of odd id]. Other learning runs have none.
     #[arg(long)]
     pub innies: Option<usize>,
     /// The disc sensor model's obstacle discs; `None` for the model's own

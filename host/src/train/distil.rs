@@ -5,13 +5,12 @@
 //! action becomes the policy the run starts from (its Q-values preferring
 //! those actions, as `--init-from` does with a policy blob).
 //!
-//! With the role hasher (`original-role`) the world has the flashed
-//! swarm's innies on every field, the robots of odd id
+//! With a role hasher (`original-role`, `bits9-role`) the world has the
+//! flashed swarm's innies on every field, the robots of odd id
 //! ([`TrainConfig::prepare`]), and the table holds both behaviours; with
-//! the others every robot is an outie. A state
-//! orbital construction never reached takes the action of the same state
-//! of the other role if that one was reached, else the most frequent action
-//! overall. The world is seeded with the run's seed mixed with
+//! the others every robot is an outie. A state orbital construction never
+//! reached takes the action of the same state of the other role if that
+//! one was reached, else the most frequent action overall. The world is seeded with the run's seed mixed with
 //! [`DISTIL_STREAM`], apart from the training world.
 
 use super::config::TrainConfig;
