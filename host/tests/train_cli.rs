@@ -183,13 +183,45 @@ fn bad_inputs_are_refused_with_a_clear_error() {
         ]
         .concat(),
     );
-    for file in ["out/seven.ckpt", "out/seven.policy"] {
-        let e = fails(d, &["train", "--steps", "10", "--init-from", file]);
-        assert!(
-            e.contains("bits7") && e.contains("original") && e.contains(file),
-            "{e}"
-        );
-    }
+    // a checkpoint of another hasher is refused; a policy blob of a
+    // coarser state starts a finer one lifted, never a coarser one
+    let e = fails(
+        d,
+        &["train", "--steps", "10", "--init-from", "out/seven.ckpt"],
+    );
+    assert!(
+        e.contains("bits7") && e.contains("original") && e.contains("out/seven.ckpt"),
+        "{e}"
+    );
+    let lifted = [
+        &QUICK[..],
+        &[
+            "--steps",
+            "10",
+            "--name",
+            "eight",
+            "--init-from",
+            "out/seven.policy",
+        ],
+    ]
+    .concat();
+    ok(d, &lifted);
+    let e = fails(
+        d,
+        &[
+            "train",
+            "--steps",
+            "10",
+            "--hasher",
+            "bits7",
+            "--init-from",
+            "out/eight.policy",
+        ],
+    );
+    assert!(
+        e.contains("bits7") && e.contains("original") && e.contains("out/eight.policy"),
+        "{e}"
+    );
 
     let ckpt = std::fs::read(d.join("out/seven.ckpt")).unwrap();
     std::fs::write(d.join("cut.ckpt"), &ckpt[..ckpt.len() / 2]).unwrap();
