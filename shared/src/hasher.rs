@@ -194,10 +194,11 @@ impl StateHasher {
     /// field bin), or 0 for a hasher without it: a state's other role is
     /// `state ^ role_mask`.
     pub const fn role_mask(self) -> u16 {
-        if self.has_role_bit() {
-            1 << (4 + self.mid_bits())
-        } else {
-            0
+        // constants, not a shift by mid_bits: the AVR shifts bit by bit
+        match self {
+            StateHasher::OriginalRole => 1 << 8,
+            StateHasher::Bits9Role => 1 << 9,
+            _ => 0,
         }
     }
 
