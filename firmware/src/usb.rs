@@ -487,7 +487,7 @@ impl Touch {
     /// Records the port's state (`configured`: the host has set the
     /// configuration; a reset or unplugging clears it); returns what changed.
     pub fn update(&mut self, configured: bool, baud: u32, dtr: bool) -> TouchChange {
-        let armed = configured && baud == TOUCH_BAUD && !dtr;
+        let armed = Touch::arms(configured, baud, dtr);
         let change = match (self.armed, armed) {
             (false, true) => TouchChange::Armed,
             (true, false) => TouchChange::Cancelled,
@@ -500,6 +500,12 @@ impl Touch {
     /// Whether a reset into the bootloader is pending.
     pub fn armed(&self) -> bool {
         self.armed
+    }
+
+    /// Whether the port's state arms the touch: configured, 1200 baud,
+    /// DTR low.
+    pub fn arms(configured: bool, baud: u32, dtr: bool) -> bool {
+        configured && baud == TOUCH_BAUD && !dtr
     }
 }
 

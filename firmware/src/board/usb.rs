@@ -254,7 +254,16 @@ impl UsbPort {
                         zlp: len < asked && len % PACKET == 0,
                     });
                 }
-                Reply::Ack => clear(UEINTX, TXINI),
+                Reply::Ack => {
+                    // a touch this request arms stops the motors before the
+                    // host has the acknowledgement (the caller then stores
+                    // the key and sets the watchdog)
+                    let c = &self.control;
+                    if !self.touch.armed() && Touch::arms(c.configured(), c.baud(), c.dtr()) {
+                        super::emergency_stop();
+                    }
+                    clear(UEINTX, TXINI)
+                }
                 Reply::Address(a) => {
                     write(UDADDR, a);
                     self.address = Some(a);
