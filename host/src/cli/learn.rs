@@ -27,7 +27,8 @@ pub struct TrainArgs {
     #[arg(long, conflicts_with_all = ["config", "init_from"])]
     pub resume: Option<PathBuf>,
     /// Start from the Q-table of a checkpoint (the thesis' RL2), or from a
-    /// policy blob (its actions preferred); hasher and actions must match.
+    /// policy blob (its actions preferred); hasher and actions must match,
+    /// but a blob of a coarser state starts a finer one lifted.
     #[arg(long)]
     pub init_from: Option<PathBuf>,
     /// Show the run on the live view's page at this address, IP or IP:PORT

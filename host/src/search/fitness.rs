@@ -172,13 +172,14 @@ impl Scorer {
     ) -> Result<(u64, f64)> {
         let provenance = Provenance::new("search", "candidate", 0, seed)?;
         let blob = PolicyBlob::new(self.actions, table.clone(), provenance)?;
-        let mut prepared = self.prepared[field].clone();
-        if table.hasher().has_role_bit() {
+        let mut sim = if table.hasher().has_role_bit() {
+            let mut prepared = self.prepared[field].clone();
             prepared.config_mut().world.innies = self.role_innies[field];
+            prepared.simulation(seed)
+        } else {
+            self.prepared[field].simulation(seed)
         }
-        let mut sim = prepared
-            .simulation(seed)
-            .context("cannot build a search world")?;
+        .context("cannot build a search world")?;
         sim.run(&mut GreedyPolicy::new(blob), steps);
         Ok((sim.totals().formations, sim.totals().mean_eval()))
     }
