@@ -1,10 +1,13 @@
-"""Steps per second of a VMAS scenario of the standard configuration's
-size on CPU: 8 agents and 250 movable passive discs of the agents' size,
-at our arena's density (a disc's radius is 1/80 of the arena side), random
-continuous actions. Runs in a virtual environment with `pip install vmas`
-(not a dependency of this project); prints one JSON object.
+"""Steps per second of a VMAS scenario on CPU, random continuous actions:
+`pucks`, the standard configuration's bodies (8 agents and 250 movable
+passive discs of the agents' size, at our arena's density: a disc's radius
+is 1/80 of the arena side), or a scenario of VMAS's own with its defaults
+(`--agents` to set its `n_agents`). Runs in a virtual environment with
+VMAS installed (not a dependency of this project; the version
+python/benchmarks/throughput.py pins); prints one JSON object, the VMAS
+and PyTorch versions among its fields.
 
-    /tmp/vmas-venv/bin/python python/benchmarks/vmas_steps.py --envs 64 --steps 20
+    /tmp/vmas-venv/bin/python python/benchmarks/vmas_steps.py --scenario transport --envs 64 --steps 20 --threads 1
 """
 
 import argparse
@@ -12,6 +15,7 @@ import json
 import time
 
 import torch
+import vmas
 from vmas import make_env
 from vmas.simulator.core import Agent, Landmark, Sphere, World
 from vmas.simulator.scenario import BaseScenario
@@ -52,21 +56,24 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--envs", type=int, required=True)
     parser.add_argument("--steps", type=int, default=20, help="env.step calls to time (each steps every env)")
-    parser.add_argument("--scenario", default="pucks", help="'pucks' (8 agents, 250 pucks) or a VMAS scenario taking n_agents")
-    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--scenario", default="pucks", help="'pucks' (8 agents, 250 pucks) or a scenario of VMAS's own")
+    parser.add_argument("--agents", type=int, help="n_agents of a scenario of VMAS's own [default: the scenario's]")
+    parser.add_argument("--threads", type=int, default=2, help="PyTorch's threads")
+    parser.add_argument("--warmup", type=int, default=10, help="untimed env.step calls first")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     if args.scenario == "pucks":
         env = make_env(PuckScenario(), num_envs=args.envs, device="cpu", continuous_actions=True, seed=0)
-    else:  # a scenario of VMAS's own, with 8 agents
-        env = make_env(args.scenario, num_envs=args.envs, device="cpu", continuous_actions=True, seed=0, n_agents=8)
+    else:
+        own = {} if args.agents is None else {"n_agents": args.agents}
+        env = make_env(args.scenario, num_envs=args.envs, device="cpu", continuous_actions=True, seed=0, **own)
     env.reset()
     gen = torch.Generator().manual_seed(0)
 
     def actions():
         return [torch.rand((args.envs, 2), generator=gen) * 2 - 1 for _ in env.agents]
 
-    for _ in range(10):  # warm-up: the first calls pay for allocation and caching
+    for _ in range(args.warmup):  # warm-up: the first calls pay for allocation and caching
         env.step(actions())
     start, cpu = time.perf_counter(), time.process_time()
     for _ in range(args.steps):
@@ -76,7 +83,7 @@ def main():
         "scenario": args.scenario, "agents": len(env.agents), "bodies": len(env.world.entities), "envs": args.envs,
         "calls": args.steps, "seconds": seconds, "steps_per_second": args.envs * args.steps / seconds,
         "steps_per_cpu_second": args.envs * args.steps / cpu_seconds,
-        "torch": torch.__version__, "threads": torch.get_num_threads(),
+        "vmas": vmas.__version__, "torch": torch.__version__, "threads": torch.get_num_threads(),
     }))
 
 

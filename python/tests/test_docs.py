@@ -1,8 +1,9 @@
 """The Python pages show the examples that run and the figures that were
 measured: docs/python-examples.md the example files verbatim,
 docs/python-results.md the learning tables rendered from their results
-files, docs/performance.md the throughput table rendered from the results
-file of the benchmark (python/benchmarks/throughput.py)."""
+files, docs/performance.md the throughput table and docs/python.md the
+comparison with VMAS rendered from the results file of the benchmark
+(python/benchmarks/throughput.py), which also runs here at a tiny scale."""
 
 import argparse
 import importlib.util
@@ -30,6 +31,34 @@ def test_the_throughput_table_is_rendered_from_the_measured_results(repo):
     throughput = benchmark(repo, "throughput")
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
     assert table in (repo / "docs" / "performance.md").read_text(), "docs/performance.md does not hold the rendered table"
+
+
+def test_the_comparison_with_vmas_is_rendered_from_the_measured_results_of_the_pinned_version(repo):
+    throughput = benchmark(repo, "throughput")
+    results = json.loads((repo / "docs" / "python-throughput.json").read_text())
+    assert results["versions"]["vmas"] == throughput.VMAS_VERSION
+    sides = {(row["side"], row.get("threads")) for row in results["rows"]}
+    assert {("ours", 1), ("vmas", 1)} <= sides and len({t for _, t in sides if t}) == 2, "both sides at one thread and on every core"
+    table = throughput.render_vmas(results)
+    assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered comparison"
+    install = f"pip install vmas=={throughput.VMAS_VERSION}"
+    assert install in (repo / "docs" / "performance.md").read_text() and install in throughput.__doc__
+
+
+def test_the_throughput_benchmark_runs_every_configuration_at_a_tiny_scale(repo, host):
+    throughput = benchmark(repo, "throughput")
+    args = argparse.Namespace(host=str(host), vmas_python=None, rounds=1, tiny=True)
+    results = throughput.measure(args)
+    rows = results["rows"]
+    assert all(len(row["runs"]) == 1 and row["runs"][0] > 0 and row["cpu_runs"][0] > 0 for row in rows)
+    assert results["bytes_per_world"] > 0, "more worlds hold more memory"
+    scale = throughput.Scale(tiny=True)
+    for worlds in scale.worlds:
+        for threads in {1, max(row.get("threads", 1) for row in rows)}:
+            assert throughput.find(rows, "ours", worlds, threads) is not None, (worlds, threads)
+    table = throughput.render(results)
+    assert all(row["name"] in table for row in rows)
+    assert table.count("- Target") == 1 + 2 * len({1, max(row.get("threads", 1) for row in rows)})
 
 
 def test_the_learning_table_is_rendered_from_the_measured_results(repo):
