@@ -116,7 +116,7 @@ pub fn measure_learner(label: &str, config: &TrainConfig, window: u64) -> Result
     )?;
     Ok(GapRow {
         label: label.to_string(),
-        seed: config.seed,
+        seed: config.world.seed,
         trained_steps: config.steps,
         window,
         learning: Some(learning),
@@ -143,7 +143,7 @@ pub fn measure_policy(
     )?;
     Ok(GapRow {
         label: label.to_string(),
-        seed: config.seed,
+        seed: config.world.seed,
         trained_steps: 0,
         window,
         learning: None,
@@ -174,7 +174,7 @@ fn formations(
     if let Some(blob) = blob {
         sim::scenario::drive_with(prepared.config_mut(), blob);
     }
-    let mut sim = prepared.simulation(config.seed)?;
+    let mut sim = prepared.simulation(config.world.seed)?;
     sim.run(controller.as_mut(), window);
     Ok(sim.totals().formations)
 }

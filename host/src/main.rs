@@ -192,7 +192,7 @@ fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
     };
     args.flags.apply(&mut config)?;
     if args.randomise {
-        config.noise = 1.0;
+        config.world.noise = 1.0;
     }
     config.validate()?;
     let blob = args
@@ -203,7 +203,7 @@ fn policy_gap(args: cli::learn::GapArgs) -> Result<()> {
     let mut report = GapReport::load(&args.json)?;
     let mut rows = Vec::new();
     for &seed in &args.seeds {
-        config.seed = seed;
+        config.world.seed = seed;
         let row = match &blob {
             Some(blob) => measure_policy(&args.label, blob, &config, args.window)?,
             None => measure_learner(&args.label, &config, args.window)?,

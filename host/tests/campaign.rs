@@ -202,7 +202,7 @@ fn every_shipped_tables_stage_names_the_shipped_blobs_run_hasher_and_field_and_e
             assert_eq!(blob.hasher(), world.learn.hasher.0, "{what}");
             assert_eq!(
                 blob.provenance().field.as_str(),
-                world.field.to_string(),
+                world.world.field.to_string(),
                 "{what}"
             );
             shipped.push(ships.file_name().unwrap().to_string_lossy().into_owned());

@@ -30,13 +30,13 @@ fn every_arm_of_every_experiment_file_takes_the_rule_count_or_states_why_not() {
                 continue;
             };
             on_screens += 1;
-            let rule = rule_pucks(&arm.config.field, &arena).unwrap();
+            let rule = rule_pucks(&arm.config.world.field, &arena).unwrap();
             let written = written_in_defaults || table.get("pucks").is_some();
-            if arm.pucks_reason.is_none() && (arm.config.pucks != Some(rule) || written) {
+            if arm.pucks_reason.is_none() && (arm.config.world.pucks != Some(rule) || written) {
                 unexplained.push(format!(
                     "experiments/{name}.toml, arm {:?}: {:?} pucks, rule {rule}{}",
                     arm.name,
-                    arm.config.pucks,
+                    arm.config.world.pucks,
                     if written { ", written in the file" } else { "" }
                 ));
             }
@@ -54,7 +54,7 @@ fn a_count_other_than_the_rules_needs_a_reason_and_the_error_names_file_and_arm(
     let path = dir.path().join("odd.toml");
     let plain = ExperimentSpec::parse("x", ON_THE_TV).unwrap();
     assert_eq!(
-        plain.arms[0].config.pucks,
+        plain.arms[0].config.world.pucks,
         Some(11),
         "our I takes 11 on the TV"
     );
@@ -76,7 +76,7 @@ fn a_count_other_than_the_rules_needs_a_reason_and_the_error_names_file_and_arm(
         "controller = \"oc\"\npucks = 12\npucks_reason = \"as many as the annulus\"",
     );
     let spec = ExperimentSpec::parse("x", &explained).unwrap();
-    assert_eq!(spec.arms[0].config.pucks, Some(12));
+    assert_eq!(spec.arms[0].config.world.pucks, Some(12));
     let stray = ON_THE_TV.replace(
         "controller = \"oc\"",
         "controller = \"oc\"\npucks_reason = \"x\"",
@@ -89,11 +89,11 @@ fn a_count_other_than_the_rules_needs_a_reason_and_the_error_names_file_and_arm(
 fn a_trial_hashed_with_the_count_left_to_the_arena_is_still_its_arms() {
     let annulus = ON_THE_TV.replace("letter:I", "annulus");
     let spec = ExperimentSpec::parse("x", &annulus).unwrap();
-    assert_eq!(spec.arms[0].config.pucks, Some(12));
+    assert_eq!(spec.arms[0].config.world.pucks, Some(12));
     let plan = &plans(&spec, 1, 1.0, 1)[0];
     // the same arm as hashed before the rule: the count unset
     let mut unset = spec.clone();
-    unset.arms[0].config.pucks = None;
+    unset.arms[0].config.world.pucks = None;
     let before = &plans(&unset, 1, 1.0, 1)[0];
     assert_ne!(plan.hash, before.hash);
     assert!(plan.matches(&before.hash));

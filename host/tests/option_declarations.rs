@@ -1,5 +1,6 @@
 //! Every setting is declared once. A training config's settings (the
-//! fields of `TrainConfig` and the structs it holds) are at the same time
+//! fields of `TrainConfig` and the structs it holds, the world's among
+//! them: `WorldChoices` of `sim`, flags under its `clap` feature) are at the same time
 //! the keys of training and experiment files and the flags of `host train`,
 //! `run`, `render` and the TV tools, which take their argument definitions
 //! from there; so no other `clap` field in `host` may declare a flag of the
@@ -7,8 +8,9 @@
 //! `train/format2.rs`) keep their own copies by design and declare no flags.
 //!
 //! The check reads the sources: each field under an `#[arg(...)]`
-//! attribute declares the flag `--<long>` (the attribute's `long = "..."`,
-//! else the field's name in kebab case).
+//! attribute (or `#[cfg_attr(feature = "clap", arg(...))]`) declares the
+//! flag `--<long>` (the attribute's `long = "..."`, else the field's name
+//! in kebab case).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -48,6 +50,10 @@ fn declarations(file: &Path, name: &str) -> Vec<Declaration> {
     let mut i = 0;
     while i < lines.len() {
         let line = lines[i].trim();
+        let line = line
+            .strip_prefix("#[cfg_attr(feature = \"clap\", ")
+            .map_or(line.to_string(), |rest| format!("#[{rest}"));
+        let line = line.as_str();
         if line.starts_with("#[arg(") && !line.starts_with("#[arg(skip") {
             // The attribute may span lines; the field follows it.
             let mut attribute = String::from(line);
@@ -89,6 +95,11 @@ fn no_flag_of_a_training_setting_is_declared_a_second_time() {
     let mut files = Vec::new();
     rust_files(&src, &mut files);
     let mut settings: BTreeMap<String, Vec<String>> = BTreeMap::new();
+    // the world's settings, declared in `sim`
+    let world = src.join("../../sim/src/scenario/choices.rs");
+    for d in declarations(&world, "sim/src/scenario/choices.rs") {
+        settings.entry(d.flag).or_default().push(d.at);
+    }
     let mut others: Vec<Declaration> = Vec::new();
     for file in &files {
         let name = file

@@ -84,9 +84,12 @@ fn a_role_policy_runs_with_the_odd_ids_as_innies_on_every_field() {
 /// A training config on the TV with the robot's senses on `name`.
 fn training(name: &str, hasher: StateHasher) -> TrainConfig {
     let mut c = TrainConfig {
-        field: field(name),
-        sensors: "robot".parse().unwrap(),
-        robots: Some(5),
+        world: WorldChoices {
+            field: field(name),
+            sensors: "robot".parse().unwrap(),
+            robots: Some(5),
+            ..Default::default()
+        },
         ..TrainConfig::default()
     };
     c.learn.hasher = StateHasherName(hasher);
@@ -134,9 +137,12 @@ fn the_search_scores_a_role_table_with_the_flashed_swarms_innies() {
     // the search's worlds of an 8-bit run on a letter, which has no innies
     // of its own; two role tables alike for outies, apart for innies
     let config = TrainConfig {
-        field: field("thesis:L"),
-        robots: Some(6),
-        pucks: Some(40),
+        world: WorldChoices {
+            field: field("thesis:L"),
+            robots: Some(6),
+            pucks: Some(40),
+            ..Default::default()
+        },
         ..TrainConfig::default()
     };
     let scorer = Scorer::new(&[config], 1).unwrap();

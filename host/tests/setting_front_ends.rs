@@ -31,14 +31,6 @@ const RENAMED_FLAGS: [(&str, &str); 5] = [
 /// author's runs, which experiment files set.
 const FILE_ONLY: [&str; 3] = ["learn.actions", "obstacle_discs", "success"];
 
-/// World settings the live view does not offer: the border keeps the one
-/// the server was started with.
-const NOT_IN_VIEW: [&str; 1] = ["walls"];
-
-/// World settings Python's environments do not take: they have no noise
-/// models and keep the arena's border.
-const NOT_IN_PYTHON: [&str; 2] = ["noise", "walls"];
-
 /// Python's keyword arguments that are no setting of a training run: the
 /// environments' own (episode length, observation and action spaces) and
 /// the robot sensor model's settings, which `host` reads from a file
@@ -131,8 +123,11 @@ fn every_training_setting_is_a_file_key_a_flag_and_a_field_of_the_checkpoint() {
     // the checkpoint's record of the settings: the same keys
     let mut t = Trainer::start(
         TrainConfig {
-            robots: Some(2),
-            pucks: Some(5),
+            world: WorldChoices {
+                robots: Some(2),
+                pucks: Some(5),
+                ..Default::default()
+            },
             ..TrainConfig::default()
         },
         None,
@@ -152,24 +147,24 @@ fn every_training_setting_is_a_file_key_a_flag_and_a_field_of_the_checkpoint() {
 }
 
 #[test]
-fn the_views_url_parameters_and_page_controls_are_the_world_settings() {
+fn the_views_url_parameters_are_the_world_settings_and_the_page_has_a_control_for_each() {
     let offered: BTreeSet<String> = world_settings()
         .into_iter()
-        .filter(|k| !NOT_IN_VIEW.contains(&k.as_str()))
+        .filter(|k| !view::settings::SERVER_KEEPS.contains(&k.as_str()))
         .chain(["controller".to_string()])
         .collect();
-    let parameters: BTreeSet<String> = view::settings::KEYS.iter().map(|k| k.to_string()).collect();
+    let parameters: BTreeSet<String> = view::settings::keys().into_iter().collect();
     assert_eq!(parameters, offered, "the view's URL parameters");
+    // the page's controls: its own, and a text field for each setting the
+    // server names that it has none for
     let page = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../view/src/page.html"),
     )
     .unwrap();
-    for key in &offered {
-        assert!(
-            page.contains(&format!("name=\"{key}\"")),
-            "the page has no control named {key}"
-        );
-    }
+    assert!(
+        page.contains("keys = m.settings.map(([k]) => k);") && page.contains("addControls(keys);"),
+        "the page takes its settings from the server's"
+    );
     // every parameter reads back as the setting it names
     let settings = view::ViewSettings::default();
     let again = settings
@@ -180,11 +175,7 @@ fn the_views_url_parameters_and_page_controls_are_the_world_settings() {
         )
         .unwrap();
     assert_eq!(again, settings);
-    let named: BTreeSet<String> = settings
-        .pairs()
-        .iter()
-        .map(|(k, _)| k.to_string())
-        .collect();
+    let named: BTreeSet<String> = settings.pairs().into_iter().map(|(k, _)| k).collect();
     assert_eq!(
         named, parameters,
         "the view writes every parameter it reads"
@@ -213,7 +204,19 @@ fn pythons_keyword_arguments_are_the_settings_of_the_same_names() {
     let python = python_keywords();
     let file = file_keys();
     let world = world_settings();
-    for name in &python {
+    // the world's settings Python does not name itself reach it by name
+    assert!(
+        python.contains("world"),
+        "Python's arguments have no catch-all of the world's settings"
+    );
+    let native =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../python/src/lib.rs"))
+            .unwrap();
+    assert!(
+        native.contains("arena = None, **world") && native.contains("WorldChoices::names()"),
+        "the native batch takes the other world settings as **world, and names them"
+    );
+    for name in python.iter().filter(|n| *n != "world") {
         let a_setting = world.contains(name)
             || file
                 .iter()
@@ -227,20 +230,6 @@ fn pythons_keyword_arguments_are_the_settings_of_the_same_names() {
         assert!(
             python.contains(own),
             "PYTHON_OWN lists {own}, which Python does not take"
-        );
-    }
-    let missing: Vec<&String> = world
-        .iter()
-        .filter(|w| !python.contains(*w) && !NOT_IN_PYTHON.contains(&w.as_str()))
-        .collect();
-    assert!(
-        missing.is_empty(),
-        "world settings Python does not take: {missing:?} (add them, or to NOT_IN_PYTHON)"
-    );
-    for not in NOT_IN_PYTHON {
-        assert!(
-            !python.contains(not),
-            "NOT_IN_PYTHON lists {not}, which Python takes"
         );
     }
 }

@@ -14,6 +14,7 @@ use host::experiment::ExperimentSpec;
 use host::train::TrainConfig;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 use std::path::{Path, PathBuf};
 
@@ -52,8 +53,11 @@ fn every_shipped_configuration_passes_the_table_of_plausible_ranges() {
     for arena in ["thesis", "tv75"] {
         for s in &sensors {
             let config = TrainConfig {
-                arena: Some(arena.parse::<ArenaChoice>().unwrap()),
-                sensors: s.parse::<SensorChoice>().unwrap(),
+                world: WorldChoices {
+                    arena: Some(arena.parse::<ArenaChoice>().unwrap()),
+                    sensors: s.parse::<SensorChoice>().unwrap(),
+                    ..Default::default()
+                },
                 ..TrainConfig::default()
             };
             if let Err(e) = config.prepare() {

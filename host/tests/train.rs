@@ -6,6 +6,7 @@ use host::train::checkpoint::{self, CheckpointError};
 use host::train::{TrainConfig, Trainer, TrainingState};
 use shared::SensorReading;
 use sim::episodes::reward::Reward;
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::{base::rng::SimRng, episodes::EpisodeStart, episodes::StepOutcome};
 use sim::{control::Controller, control::Perception};
@@ -16,9 +17,12 @@ use std::sync::Arc;
 /// episodes end and reset within the test.
 fn small(seed: u64) -> TrainConfig {
     TrainConfig {
-        robots: Some(4),
-        pucks: Some(60),
-        seed,
+        world: WorldChoices {
+            robots: Some(4),
+            pucks: Some(60),
+            seed,
+            ..Default::default()
+        },
         stuck_limit: Some(700),
         ..TrainConfig::default()
     }
@@ -130,6 +134,11 @@ fn train_then_resume_equals_one_long_run() {
 #[test]
 fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkpoint() {
     let authors = TrainConfig {
+        world: WorldChoices {
+            // the border formats 1 to 3 knew
+            walls: Some(sim::config::Walls::Segments),
+            ..small(11).world
+        },
         formation_check: host::train::config::FormationCheck {
             every: 300,
             stale: true,
@@ -139,8 +148,6 @@ fn a_run_with_the_thesis_authors_settings_resumes_exactly_from_a_format_2_checkp
             radius: 2.0,
             sees: sim::config::disc_sensors::ObstacleTargets::AnyBody,
         }),
-        // the border formats 1 to 3 knew
-        walls: Some(sim::config::Walls::Segments),
         ..small(11)
     };
     assert_eq!(
@@ -155,11 +162,14 @@ fn a_noisy_run_of_the_robot_senses_on_the_tv_s_discs_resumes_exactly_from_a_form
     let discs = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../experiments/arenas/tv75-disc.toml");
     let noisy = TrainConfig {
-        sensors: SensorChoice::Robot(None),
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(discs)),
-        noise: 1.0,
+        world: WorldChoices {
+            sensors: SensorChoice::Robot(None),
+            arena: Some(sim::scenario::arena_choice::ArenaChoice::File(discs)),
+            noise: 1.0,
+            seed: 12,
+            ..Default::default()
+        },
         stuck_limit: Some(900),
-        seed: 12,
         ..TrainConfig::default()
     };
     // resumed mid-episode, with camera links, held blocks and a latency
@@ -171,7 +181,10 @@ fn a_noisy_run_of_the_robot_senses_on_the_tv_s_discs_resumes_exactly_from_a_form
 fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_format_4_checkpoint()
 {
     let rules = TrainConfig {
-        walls: Some(sim::config::Walls::Clamp),
+        world: WorldChoices {
+            walls: Some(sim::config::Walls::Clamp),
+            ..small(13).world
+        },
         learn: host::learn::LearnConfig {
             tie_tolerance: 0.001,
             updates: host::learn::Updates::Batched,
@@ -189,7 +202,10 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
     };
     for changed in [
         TrainConfig {
-            walls: Some(sim::config::Walls::Segments),
+            world: WorldChoices {
+                walls: Some(sim::config::Walls::Segments),
+                ..small(13).world
+            },
             ..small(13)
         },
         TrainConfig {
@@ -207,7 +223,10 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
             ..small(13)
         },
     ] {
-        let what = format!("walls {:?}, learner {:?}", changed.walls, changed.learn);
+        let what = format!(
+            "walls {:?}, learner {:?}",
+            changed.world.walls, changed.learn
+        );
         let mut t = trainer(changed);
         t.run(10_000);
         assert_ne!(t.learner().table(), &base, "{what} changed nothing");
@@ -313,12 +332,15 @@ fn n_step_returns_are_the_same_per_seed_resume_exactly_with_steps_waiting_and_ch
 #[test]
 fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5_checkpoint() {
     let wedge = TrainConfig {
-        sensors: SensorChoice::Robot(None),
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
-            "tv75".into(),
-        )),
-        noise: 1.0,
-        seed: 17,
+        world: WorldChoices {
+            sensors: SensorChoice::Robot(None),
+            arena: Some(sim::scenario::arena_choice::ArenaChoice::Named(
+                "tv75".into(),
+            )),
+            noise: 1.0,
+            seed: 17,
+            ..Default::default()
+        },
         ..TrainConfig::default()
     };
     assert_eq!(resumes_exactly(wedge.clone(), 1100, 2500), 5);
@@ -326,7 +348,10 @@ fn a_wedge_run_on_the_tv_with_the_robot_s_senses_resumes_exactly_from_a_format_5
     let disc_arena = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../experiments/arenas/tv75-disc.toml");
     let disc = TrainConfig {
-        arena: Some(sim::scenario::arena_choice::ArenaChoice::File(disc_arena)),
+        world: WorldChoices {
+            arena: Some(sim::scenario::arena_choice::ArenaChoice::File(disc_arena)),
+            ..wedge.world.clone()
+        },
         ..wedge.clone()
     };
     assert!(resumes_exactly(disc.clone(), 1100, 2500) < 5);
@@ -690,9 +715,12 @@ fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_
         steps: 400,
     };
     let selecting = TrainConfig {
+        world: WorldChoices {
+            // the border formats 1 to 3 knew
+            walls: Some(sim::config::Walls::Segments),
+            ..small(21).world
+        },
         select: Some(select),
-        // the border formats 1 to 3 knew
-        walls: Some(sim::config::Walls::Segments),
         ..small(21)
     };
     let mut with = trainer(selecting.clone());
@@ -724,7 +752,7 @@ fn policy_selection_keeps_the_best_evaluated_policy_without_disturbing_training_
     let evaluation = host::train::selection::Evaluation::new(
         select,
         &selecting.prepare().unwrap(),
-        selecting.seed,
+        selecting.world.seed,
     )
     .unwrap();
     assert!(evaluation.formations(last) <= best.formations);

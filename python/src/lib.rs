@@ -24,11 +24,12 @@ use observation::Observations;
 use policy_codec::PolicyHeader;
 use pyo3::exceptions::{PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyBytes, PyDict};
+use pyo3::types::{PyBool, PyBytes, PyDict};
 use settings::{ActionKind, Autoreset, EnvArgs, ObservationKind, READING_LEN};
 use shared::{ActionTable, StateHasher};
 use sim::episodes::reward::Reward;
 use sim::render::RenderOptions;
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 
 fn value_error(e: impl std::fmt::Display) -> PyErr {
@@ -107,19 +108,50 @@ impl PyBatch {
     }
 }
 
+/// The world settings given as keyword arguments, each as the text
+/// [`WorldChoices::set`] reads: a whole number or a number as written,
+/// a string as it is, `None` as "" (the arena's own).
+fn world_settings(kwargs: &Bound<'_, PyDict>) -> PyResult<Vec<(String, String)>> {
+    kwargs
+        .iter()
+        .map(|(name, value)| {
+            let name: String = name.extract()?;
+            let text = if value.is_none() {
+                String::new()
+            } else if value.is_instance_of::<PyBool>() {
+                return Err(PyTypeError::new_err(format!(
+                    "{name} = {value}: expected a number or a name"
+                )));
+            } else if let Ok(n) = value.extract::<i64>() {
+                n.to_string()
+            } else if let Ok(x) = value.extract::<f64>() {
+                x.to_string()
+            } else if let Ok(s) = value.extract::<String>() {
+                s
+            } else {
+                return Err(PyTypeError::new_err(format!(
+                    "{name} = {value}: expected a number or a name"
+                )));
+            };
+            Ok((name, text))
+        })
+        .collect()
+}
+
 #[pymethods]
 impl PyBatch {
     /// `num_worlds` worlds seeded `seed`, `seed + 1`, ...; the keyword
-    /// arguments are the environments' (docs/python.md). `autoreset` is
-    /// "off", "next-step" or "same-step"; `threads` defaults to one per
-    /// core.
+    /// arguments are the environments' (docs/python.md), the world's
+    /// settings other than those named here among them (`world`, by the
+    /// names of [`WorldChoices`]). `autoreset` is "off", "next-step" or
+    /// "same-step"; `threads` defaults to one per core.
     #[new]
     #[pyo3(signature = (
         num_worlds = 1, *, field = "annulus".to_string(), robots = None, pucks = None, sensors = "disc".to_string(),
         robot_config = None, seed = 1, max_steps = None, thresholds = None, reward = "reference".to_string(),
         gamma = settings::DEFAULT_GAMMA, observation = "reading".to_string(), hasher = "original".to_string(), action = "discrete".to_string(),
         actions = None, forward_speed = ActionTable::DEFAULT_FORWARD_SPEED, autoreset = "next-step".to_string(),
-        threads = None, arena = None
+        threads = None, arena = None, **world
     ))]
     #[allow(
         clippy::too_many_arguments,
@@ -146,6 +178,7 @@ impl PyBatch {
         autoreset: String,
         threads: Option<i64>,
         arena: Option<String>,
+        world: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyBatch> {
         let args = EnvArgs {
             field,
@@ -164,6 +197,7 @@ impl PyBatch {
             action,
             actions: actions.unwrap_or_else(|| ActionTable::DEFAULT_ANGULAR.to_vec()),
             forward_speed,
+            world: world.map(world_settings).transpose()?.unwrap_or_default(),
         };
         // before any world is allocated
         let num_worlds = settings::count(&sim::base::ranges::WORLDS, "num_worlds", num_worlds)
@@ -667,6 +701,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("SENSORS", SensorChoice::NAMES)?;
     m.add("SEED_RANGE", settings::SEED_RANGE)?;
+    m.add("WORLD_SETTINGS", WorldChoices::names().to_vec())?;
     m.add("DEFAULT_ANGULAR", ActionTable::DEFAULT_ANGULAR.to_vec())?;
     m.add("DEFAULT_FORWARD_SPEED", ActionTable::DEFAULT_FORWARD_SPEED)?;
     m.add(

@@ -13,9 +13,11 @@ use sim::config::{SimConfig, Thresholds};
 use sim::episodes::reward::Reward;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena::ArenaSpec;
+use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::sensor_setup::SensorSetup;
-use sim::scenario::{Arena, ControllerChoice, PreparedScenario, Scenario, ScenarioError};
+use sim::scenario::{Arena, ControllerChoice, PreparedScenario, ScenarioError};
 use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
 
@@ -135,6 +137,9 @@ pub struct EnvArgs {
     pub actions: Vec<f32>,
     /// `forward_speed`: units per step.
     pub forward_speed: f32,
+    /// The world's other settings (`noise`, `walls`, any setting of
+    /// [`WorldChoices`] not named above), by name, as text.
+    pub world: Vec<(String, String)>,
 }
 
 impl Default for EnvArgs {
@@ -157,6 +162,7 @@ impl Default for EnvArgs {
             action: "discrete".into(),
             actions: ActionTable::DEFAULT_ANGULAR.to_vec(),
             forward_speed: ActionTable::DEFAULT_FORWARD_SPEED,
+            world: Vec::new(),
         }
     }
 }
@@ -212,7 +218,12 @@ pub fn world_seeds(first: i64, worlds: usize) -> Result<Vec<u64>, ArgumentError>
     Ok((first..=last).collect())
 }
 
-fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, ArgumentError> {
+/// The sensor model named, and the robot sensor model's settings of
+/// `robot_config` (JSON) if given.
+fn sensors(
+    name: &str,
+    robot_config: Option<&str>,
+) -> Result<(SensorChoice, Option<SensorSetup>), ArgumentError> {
     let choice = match name.parse::<SensorChoice>() {
         Ok(
             choice @ (SensorChoice::Disc | SensorChoice::DiscThesis | SensorChoice::Robot(None)),
@@ -226,9 +237,7 @@ fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, Argume
         }
     };
     let Some(json) = robot_config else {
-        return choice
-            .setup()
-            .map_err(|e| ArgumentError::new("sensors", format!("{name:?}"), e.to_string()));
+        return Ok((choice, None));
     };
     if !choice.is_robot() {
         return Err(ArgumentError::new(
@@ -247,7 +256,7 @@ fn sensors(name: &str, robot_config: Option<&str>) -> Result<SensorSetup, Argume
     config
         .validate()
         .map_err(|e| ArgumentError::new("robot_config", json, e.to_string()))?;
-    Ok(SensorSetup::Robot(Box::new(config)))
+    Ok((choice, Some(SensorSetup::Robot(Box::new(config)))))
 }
 
 /// Why an environment cannot be built: a bad argument, or settings the
@@ -369,38 +378,53 @@ impl EnvArgs {
         let actions = ActionTable::new(&self.actions, self.forward_speed).map_err(|e| {
             ArgumentError::new("actions", format!("{:?}", self.actions), e.to_string())
         })?;
-        let sensors = sensors(&self.sensors, self.robot_config.as_deref())?;
-
+        let (sensors, robot_setup) = sensors(&self.sensors, self.robot_config.as_deref())?;
         let arena = match self.arena.as_deref() {
-            None if matches!(sensors, SensorSetup::Robot(_)) => {
-                Arena::Screen(Box::new(ArenaSpec::tv75()))
+            None => None,
+            Some("thesis") => Some(ArenaChoice::Thesis),
+            Some(name) if ArenaSpec::by_name(name).is_some() => {
+                Some(ArenaChoice::Named(name.to_string()))
             }
-            None | Some("thesis") => Arena::default(),
-            Some(name) => Arena::Screen(Box::new(ArenaSpec::by_name(name).ok_or_else(|| {
-                ArgumentError::new(
+            Some(name) => {
+                return Err(ArgumentError::new(
                     "arena",
                     format!("{name:?}"),
                     format!("expected \"thesis\" or one of {}", ArenaSpec::NAMES),
                 )
-            })?)),
+                .into())
+            }
         };
-
-        // The arena's name, as `host train` records it in a blob.
-        let arena_name = match &arena {
-            Arena::Square(_) => "thesis".to_string(),
-            Arena::Screen(spec) => spec.name.clone(),
-        };
-        // Random is the controller whose settings leave every robot an
-        // outie, as the trainer has them; the environment never uses it.
-        let scenario = Scenario {
+        // The world's settings: those above, checked as the environments
+        // word their errors, then the rest by name.
+        let mut world = WorldChoices {
             field,
-            controller: ControllerChoice::Random,
+            sensors,
+            arena,
             robots,
             pucks,
             seed,
-            sensors,
-            arena,
-            ..Scenario::default()
+            ..WorldChoices::default()
+        };
+        for (name, text) in &self.world {
+            world
+                .set(name, text)
+                .map_err(|e| ArgumentError::new(&e.name, format!("{:?}", e.value), e.problem))?;
+        }
+        // Random is the controller whose settings leave every robot an
+        // outie, as the trainer has them; the environment never uses it.
+        let mut scenario = ScenarioChoices {
+            controller: ControllerChoice::Random,
+            world,
+        }
+        .scenario()
+        .map_err(SettingsError::Scenario)?;
+        if let Some(setup) = robot_setup {
+            scenario.sensors = setup;
+        }
+        // The arena's name, as `host train` records it in a blob.
+        let arena_name = match &scenario.arena {
+            Arena::Square(_) => "thesis".to_string(),
+            Arena::Screen(spec) => spec.name.clone(),
         };
         // The arena's counts where none are given.
         let (default_robots, default_pucks) = match &scenario.arena {
@@ -410,6 +434,7 @@ impl EnvArgs {
             ),
             Arena::Screen(spec) => (spec.robots, spec.pucks),
         };
+        let pucks = scenario.pucks;
         let mut prepared = scenario.prepare().map_err(|e| match e {
             // The one combination no single argument decides.
             ScenarioError::Config(c @ ConfigError::TooManyBodies { .. }) => {

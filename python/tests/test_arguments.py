@@ -49,6 +49,10 @@ BAD_SETTINGS = [
     ({"robts": 8}, TypeError, r"unknown keyword argument 'robts' \(did you mean 'robots'\?\): the environment takes field, robots, pucks"),
     ({"robot": 8}, TypeError, r"unknown keyword argument 'robot' \(did you mean 'robots'\?\)"),
     ({"field": "square"}, ValueError, r"no field is named \"square\" .* annulus, letter:X \(X one of T, I, L, V, X, Z\), thesis:X"),
+    # the world's settings the environments take by name
+    ({"noise": -1}, ValueError, r"noise = -1: outside its plausible range \[0, 5\]"),
+    ({"noise": True}, TypeError, r"noise = True: expected a number or a name"),
+    ({"walls": "rubber"}, ValueError, r"walls = \"rubber\": unknown variant `rubber`, expected `clamp` or `segments`"),
 ]
 
 
@@ -129,3 +133,17 @@ def test_the_tv_arena_is_the_robot_senses_default_and_brings_its_own_counts():
     assert len(tv.possible_agents) == 5
     thesis = zumo_swarm.parallel_env(sensors="robot", arena="thesis", robots=3)
     assert len(thesis.possible_agents) == 3
+
+
+def test_every_world_setting_is_a_keyword_and_reaches_the_world():
+    assert set(zumo_swarm._native.WORLD_SETTINGS) <= set(zumo_swarm._settings.SETTINGS)
+    # noise: the same seed moves the robots otherwise
+    runs = []
+    for noise in (0, 1, 1):
+        env = zumo_swarm.vector_env(1, robots=2, pucks=5, sensors="robot", noise=noise)
+        env.reset(seed=3)
+        for _ in range(50):
+            obs, *_ = env.step(np.zeros((1, 2), dtype=np.int64))
+        runs.append(obs)
+    assert not np.array_equal(runs[0], runs[1]) and np.array_equal(runs[1], runs[2])
+

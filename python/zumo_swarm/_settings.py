@@ -2,10 +2,12 @@
 
 The simulator settings (``field``, ``robots``, ``pucks``, ``sensors``,
 ``robot_config``, ``seed``, ``max_steps``, ``thresholds``, ``reward``,
-``observation``, ``hasher``, ``action``, ``actions``, ``forward_speed``) are
-checked in Rust by :class:`zumo_swarm._native.Batch`; this module only
-brings Python values into the types it takes and builds Gymnasium spaces
-from what the batch reports.
+``observation``, ``hasher``, ``action``, ``actions``, ``forward_speed``, and
+every other setting of the world by its name, ``noise`` and ``walls`` among
+them: :data:`zumo_swarm._native.WORLD_SETTINGS`) are checked in Rust by
+:class:`zumo_swarm._native.Batch`; this module only brings Python values
+into the types it takes and builds Gymnasium spaces from what the batch
+reports.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from typing import Any
 import numpy as np
 from gymnasium import spaces
 
-from zumo_swarm._native import SEED_RANGE, Batch
+from zumo_swarm._native import SEED_RANGE, WORLD_SETTINGS, Batch
 
 #: Render modes of every environment: the picture ``host render`` draws.
 RENDER_MODES = ["rgb_array"]
@@ -30,8 +32,11 @@ RENDER_MODES = ["rgb_array"]
 ONE_WORLD_RENDER_MODES = ["rgb_array", "human"]
 
 #: The simulator settings every environment takes: the native batch's
-#: keyword arguments, less those the environments set themselves.
-SETTINGS = tuple(name for name in inspect.signature(Batch).parameters if name not in ("num_worlds", "autoreset", "threads"))
+#: keyword arguments, less those the environments set themselves, and the
+#: world's settings it takes by name.
+SETTINGS = tuple(
+    name for name in inspect.signature(Batch).parameters if name not in ("num_worlds", "autoreset", "threads", "world")
+) + tuple(name for name in WORLD_SETTINGS if name not in inspect.signature(Batch).parameters)
 
 #: Settings that are whole numbers (``None`` for the default); the seed is
 #: checked by :func:`check_seed`.

@@ -37,6 +37,7 @@ use host::robot::replay::decisions::DecisionCheck;
 use host::run_summary::RunSummary;
 use serde::{Deserialize, Serialize};
 use shared::{LogFrame, MotorCommand, PolicyBlob, RobotProfile, Role, RunMode, State};
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_setup::{SelectedSensors, SensorSetup};
 use sim::scenario::Scenario;
 use sim::sensors::robot::RobotSensors;
@@ -105,13 +106,16 @@ impl World {
     /// The scenario `host run --sensors robot` builds of these settings.
     pub fn scenario(&self) -> Result<Scenario> {
         host::train::TrainConfig {
-            field: self.field.clone(),
-            sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
-            arena: self.arena.clone(),
-            robots: self.robots,
-            pucks: self.pucks,
-            noise: self.noise,
-            seed: self.seed,
+            world: WorldChoices {
+                field: self.field.clone(),
+                sensors: sim::scenario::sensor_choice::SensorChoice::Robot(None),
+                arena: self.arena.clone(),
+                robots: self.robots,
+                pucks: self.pucks,
+                noise: self.noise,
+                seed: self.seed,
+                ..Default::default()
+            },
             ..host::train::TrainConfig::default()
         }
         .scenario()

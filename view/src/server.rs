@@ -6,7 +6,7 @@
 //! current hello and frame, for scripts), `GET /stream` (WebSocket:
 //! `hello`, then `frame`s), `POST /control?action=play|pause|step|reset`
 //! (`&seed=N` with reset, `&steps=N` with step), `POST /control?speed=real|10x|max`,
-//! `POST /settings?KEY=VALUE...` (the settings of [`crate::settings::KEYS`],
+//! `POST /settings?KEY=VALUE...` (the settings of [`crate::settings::keys`],
 //! `speed` and `paused`), `POST /policy?name=NAME` (a policy blob as the
 //! body). Refused settings answer 400 naming the key and change nothing.
 //! The simulation's thread steps in slices of at most [`SLICE`], letting
@@ -856,7 +856,7 @@ impl Shared {
     }
 
     /// New settings: the world's (a new simulation, pending steps
-    /// cancelled) when any of [`settings::KEYS`] is given, and `speed` and
+    /// cancelled) when any of [`settings::keys`] is given, and `speed` and
     /// `paused`; refused as a whole, naming the key, if any is bad.
     fn settings(&self, query: &str) -> Result<(), String> {
         let pairs = settings::query_pairs(query);

@@ -89,7 +89,7 @@ pub struct Hello {
     /// outline; empty without a camera.
     pub camera_view: Vec<[f64; 2]>,
     /// The settings, as URL parameters.
-    pub settings: Vec<(&'static str, String)>,
+    pub settings: Vec<(String, String)>,
     /// Steps between formation checks.
     pub check_interval: u64,
     /// A second view to show beside this one (`host train --view`: the
@@ -232,7 +232,7 @@ impl Session {
 
 impl Hello {
     /// What stays of `sim` until its next reset; `settings` as URL parameters.
-    pub fn of(sim: &Simulation<SelectedSensors>, settings: Vec<(&'static str, String)>) -> Hello {
+    pub fn of(sim: &Simulation<SelectedSensors>, settings: Vec<(String, String)>) -> Hello {
         let world = sim.world().config();
         let arena = world.arena();
         Hello {

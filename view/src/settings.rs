@@ -1,9 +1,9 @@
-//! The view's settings: the world's (controller, field, arena, sensors,
-//! noise, robots, pucks, seed) as URL parameters, parsed and limited to
-//! what a browser may choose: built-in fields and arenas, the arena files
-//! the server was started with, the policies of its policy folder and the
-//! ones uploaded. The values' ranges are checked where the scenario is
-//! built ([`sim::scenario::Scenario::prepare`]).
+//! The view's settings: the controller and the world's settings
+//! ([`WorldChoices`], by their names) as URL parameters, parsed and limited
+//! to what a browser may choose: built-in fields and arenas, the arena
+//! files the server was started with, the policies of its policy folder
+//! and the ones uploaded. The values' ranges are checked where the
+//! scenario is built ([`sim::scenario::Scenario::prepare`]).
 
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
@@ -79,9 +79,9 @@ pub fn valid_name(name: &str) -> bool {
             .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '_'))
 }
 
-/// The view's world settings: the controller, and the world's settings as
+/// The view's settings: the controller, and the world's settings as
 /// every front end names them ([`WorldChoices`]; the view offers all but
-/// the border, `walls`, which keeps the server's).
+/// [`SERVER_KEEPS`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ViewSettings {
     /// The controller.
@@ -100,17 +100,22 @@ impl Default for ViewSettings {
     }
 }
 
-/// The URL parameters of the settings, in the page's order.
-pub const KEYS: [&str; 8] = [
-    "controller",
-    "field",
-    "arena",
-    "sensors",
-    "noise",
-    "robots",
-    "pucks",
-    "seed",
-];
+/// World settings a browser does not choose: the border keeps the one
+/// the server was started with.
+pub const SERVER_KEEPS: [&str; 1] = ["walls"];
+
+/// The URL parameters of the settings: `controller`, then the world's
+/// settings by name (all but [`SERVER_KEEPS`]).
+pub fn keys() -> Vec<String> {
+    std::iter::once("controller".to_string())
+        .chain(
+            WorldChoices::names()
+                .iter()
+                .filter(|k| !SERVER_KEEPS.contains(&k.as_str()))
+                .cloned(),
+        )
+        .collect()
+}
 
 /// What a browser may choose beyond the built-in fields and arenas.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -147,30 +152,21 @@ impl ViewSettings {
         }
     }
 
-    /// Each setting as its URL parameter's value ("" for the arena's own).
-    pub fn pairs(&self) -> Vec<(&'static str, String)> {
-        let or_own = |v: Option<usize>| v.map(|n| n.to_string()).unwrap_or_default();
-        vec![
-            ("controller", self.controller.to_string()),
-            ("field", self.world.field.to_string()),
-            (
-                "arena",
+    /// Each setting as its URL parameter's value ("" for the arena's
+    /// own), in the order of [`keys`].
+    pub fn pairs(&self) -> Vec<(String, String)> {
+        std::iter::once(("controller".to_string(), self.controller.to_string()))
+            .chain(
                 self.world
-                    .arena
-                    .as_ref()
-                    .map(|a| a.to_string())
-                    .unwrap_or_default(),
-            ),
-            ("sensors", self.world.sensors.to_string()),
-            ("noise", self.world.noise.to_string()),
-            ("robots", or_own(self.world.robots)),
-            ("pucks", or_own(self.world.pucks)),
-            ("seed", self.world.seed.to_string()),
-        ]
+                    .pairs()
+                    .into_iter()
+                    .filter(|(k, _)| !SERVER_KEEPS.contains(&k.as_str())),
+            )
+            .collect()
     }
 
     /// These settings with the URL parameters `query` applied (keys other
-    /// than [`KEYS`] are left to the caller: `ignore` lists those it
+    /// than [`keys`] are left to the caller: `ignore` lists those it
     /// takes). Errors name the parameter and its value.
     pub fn with_query(
         &self,
@@ -179,77 +175,55 @@ impl ViewSettings {
         ignore: &[&str],
     ) -> Result<ViewSettings, String> {
         let mut s = self.clone();
+        let offered = keys();
         for (key, value) in query_pairs(query) {
             let bad = |why: String| format!("{key}={value}: {why}");
-            let count = |v: &str| -> Result<Option<usize>, String> {
-                if v.is_empty() {
-                    Ok(None)
-                } else {
-                    v.parse()
-                        .map(Some)
-                        .map_err(|_| bad("not a whole number of at least 0".into()))
+            if key == "controller" {
+                s.controller = value.parse().map_err(bad)?;
+            } else if offered.contains(&key) {
+                s.world.set(&key, &value).map_err(|e| bad(e.problem))?;
+                // only the files the server was started with
+                match key.as_str() {
+                    "field" => check_field(&s.world.field, allowed),
+                    "arena" => check_arena(s.world.arena.as_ref(), allowed),
+                    "sensors" => check_sensors(&s.world.sensors, allowed),
+                    _ => Ok(()),
                 }
-            };
-            match key.as_str() {
-                "controller" => s.controller = value.parse().map_err(bad)?,
-                "field" => s.world.field = field(&value, allowed).map_err(bad)?,
-                "arena" => s.world.arena = arena(&value, allowed).map_err(bad)?,
-                "sensors" => s.world.sensors = sensors(&value, allowed).map_err(bad)?,
-                "noise" => {
-                    s.world.noise = value
-                        .parse::<f64>()
-                        .ok()
-                        .filter(|v| v.is_finite())
-                        .ok_or_else(|| bad("not a number".into()))?
-                }
-                "robots" => s.world.robots = count(&value)?,
-                "pucks" => s.world.pucks = count(&value)?,
-                "seed" => {
-                    s.world.seed = value
-                        .parse()
-                        .map_err(|_| bad("not a whole number from 0 to 2^64 - 1".into()))?
-                }
-                k if ignore.contains(&k) => {}
-                _ => {
-                    return Err(format!(
-                        "unknown setting {key:?}: expected {}",
-                        KEYS.join(", ")
-                    ))
-                }
+                .map_err(bad)?;
+            } else if !ignore.contains(&key.as_str()) {
+                return Err(format!(
+                    "unknown setting {key:?}: expected {}",
+                    offered.join(", ")
+                ));
             }
         }
         Ok(s)
     }
 }
 
-fn field(value: &str, allowed: &Allowed) -> Result<FieldSource, String> {
-    let field: FieldSource = value
-        .parse()
-        .map_err(|e: sim::fields::source::FieldError| e.to_string())?;
-    match &field {
+/// A field a browser may choose: built in, or the server's image.
+fn check_field(field: &FieldSource, allowed: &Allowed) -> Result<(), String> {
+    match field {
         FieldSource::Image(path) if allowed.field_file.as_ref() != Some(path) => Err(
             "a field image must be the one the server was started with; built in: annulus, letter:T (I, L, V, X, Z), thesis:T (L, V, X, Z), either turned (letter:L@mirror), generated (gen:ring:3)"
                 .into(),
         ),
-        _ => Ok(field),
+        _ => Ok(()),
     }
 }
 
-fn arena(value: &str, allowed: &Allowed) -> Result<Option<ArenaChoice>, String> {
-    if value.is_empty() {
-        return Ok(None);
-    }
-    let arena: ArenaChoice = value.parse()?;
-    match &arena {
-        ArenaChoice::File(path) if !allowed.arena_files.contains(path) => {
+/// An arena a browser may choose: built in, or one of the server's files.
+fn check_arena(arena: Option<&ArenaChoice>, allowed: &Allowed) -> Result<(), String> {
+    match arena {
+        Some(ArenaChoice::File(path)) if !allowed.arena_files.contains(path) => {
             Err("an arena file must be one the server was started with (--arena-file)".into())
         }
-        _ => Ok(Some(arena)),
+        _ => Ok(()),
     }
 }
 
-fn sensors(value: &str, allowed: &Allowed) -> Result<SensorChoice, String> {
-    let sensors: SensorChoice = value.parse()?;
+/// Sensors a browser may choose: every settings file one of the server's.
+fn check_sensors(sensors: &SensorChoice, allowed: &Allowed) -> Result<(), String> {
     fn files(s: &SensorChoice, out: &mut Vec<PathBuf>) {
         match s {
             SensorChoice::Robot(Some(path)) => out.push(path.clone()),
@@ -258,9 +232,9 @@ fn sensors(value: &str, allowed: &Allowed) -> Result<SensorChoice, String> {
         }
     }
     let mut named = Vec::new();
-    files(&sensors, &mut named);
+    files(sensors, &mut named);
     if named.iter().all(|p| allowed.sensor_files.contains(p)) {
-        Ok(sensors)
+        Ok(())
     } else {
         Err("a sensor settings file must be one the server was started with".into())
     }
@@ -303,7 +277,7 @@ fn decode(s: &str) -> String {
 }
 
 /// `pairs` as a URL query, percent-encoded.
-pub fn encode_query(pairs: &[(&str, String)]) -> String {
+pub fn encode_query(pairs: &[(String, String)]) -> String {
     let encode = |s: &str| {
         s.bytes()
             .map(|b| match b {
@@ -354,8 +328,11 @@ mod tests {
             ("arena=/tmp/x.toml", "arena=/tmp/x.toml: an arena file"),
             ("sensors=robot:/tmp/x.json", "sensor settings file"),
             ("controller=policy:../x", "controller=policy:../x"),
-            ("robots=-1", "robots=-1: not a whole number"),
-            ("noise=nan", "noise=nan: not a number"),
+            (
+                "robots=-1",
+                "robots=-1: invalid value: integer `-1`, expected usize",
+            ),
+            ("noise=nan", "noise=nan: invalid type"),
             ("colour=red", "unknown setting \"colour\""),
         ] {
             let e = d.with_query(query, &none, &[]).unwrap_err();

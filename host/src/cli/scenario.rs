@@ -1,24 +1,21 @@
-//! The scenario flags `run` and `render` share: the world's settings,
-//! taken from a training config's own flags, and what only a scenario has.
+//! The scenario flags `run` and `render` share: the world's settings
+//! ([`WorldChoices`], declared there once) and what only a scenario has.
 
+use clap::parser::ValueSource;
 use clap::{Arg, ArgMatches, Args, FromArgMatches};
 use host::train::TrainConfig;
-use sim::config::{BroadPhase, Walls};
-use sim::fields::source::FieldSource;
-use sim::scenario::arena_choice::ArenaChoice;
-use sim::scenario::choices::ScenarioChoices;
-use sim::scenario::sensor_choice::SensorChoice;
+use sim::config::BroadPhase;
+use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::trained_for;
 use sim::scenario::{ControllerChoice, Scenario};
 
 /// The scenario flags `run` and `render` share: `--controller` and
-/// `--naive`, and the world's settings, which are a training config's own
-/// flags ([`TrainConfig`]'s fields, declared there once: `--field`,
-/// `--sensors`, `--arena`, `--robots`, `--pucks`, `--seed`, `--noise`).
+/// `--naive`, and the world's settings (`--field`, `--sensors`,
+/// `--arena`, `--robots`, `--pucks`, `--seed`, `--noise`, `--walls`).
 #[derive(Clone, Debug)]
 pub struct ScenarioArgs {
     own: ScenarioOwnArgs,
-    world: ArgMatches,
+    world: WorldChoices,
 }
 
 /// What a scenario has and a training run does not.
@@ -32,11 +29,6 @@ struct ScenarioOwnArgs {
     naive: bool,
 }
 
-/// The training config's flags a scenario takes.
-const WORLD_FLAGS: [&str; 8] = [
-    "field", "sensors", "arena", "robots", "pucks", "seed", "noise", "walls",
-];
-
 /// The arguments of [`TrainConfig`] with these ids, declared there.
 pub(crate) fn train_config_args(ids: &[&str]) -> Vec<Arg> {
     TrainConfig::augment_args(clap::Command::new("train"))
@@ -48,7 +40,7 @@ pub(crate) fn train_config_args(ids: &[&str]) -> Vec<Arg> {
 
 impl Args for ScenarioArgs {
     fn augment_args(command: clap::Command) -> clap::Command {
-        ScenarioOwnArgs::augment_args(command).args(train_config_args(&WORLD_FLAGS))
+        WorldChoices::augment_args(ScenarioOwnArgs::augment_args(command))
     }
 
     fn augment_args_for_update(command: clap::Command) -> clap::Command {
@@ -58,9 +50,11 @@ impl Args for ScenarioArgs {
 
 impl FromArgMatches for ScenarioArgs {
     fn from_arg_matches(matches: &ArgMatches) -> Result<ScenarioArgs, clap::Error> {
+        let mut world = WorldChoices::default();
+        world.update_from_arg_matches(matches)?;
         Ok(ScenarioArgs {
             own: ScenarioOwnArgs::from_arg_matches(matches)?,
-            world: matches.clone(),
+            world,
         })
     }
 
@@ -69,7 +63,6 @@ impl FromArgMatches for ScenarioArgs {
         Ok(())
     }
 }
-
 impl ScenarioArgs {
     /// The scenario, with robot sensor and arena files read and checked.
     pub fn scenario(self) -> anyhow::Result<Scenario> {
@@ -105,40 +98,22 @@ impl ScenarioArgs {
 
     /// The training config of the world flags given.
     fn config(&self) -> TrainConfig {
-        let mut config = TrainConfig::default();
-        apply_world_flags(&self.world, &mut config);
-        config
+        TrainConfig {
+            world: self.world.clone(),
+            ..TrainConfig::default()
+        }
     }
 }
 
-/// Writes the world flags of [`WORLD_FLAGS`] that `m` holds into
-/// `config` (a command may take only some of them).
-pub(crate) fn apply_world_flags(m: &ArgMatches, config: &mut TrainConfig) {
-    fn given<T: Clone + Send + Sync + 'static>(m: &ArgMatches, id: &str) -> Option<T> {
-        m.try_get_one::<T>(id).ok().flatten().cloned()
+/// Writes the world flags given on the command line of `m` (a command that
+/// takes only some of them) into `world`, each by its name.
+pub(crate) fn apply_world_flags(m: &ArgMatches, world: &mut WorldChoices) -> anyhow::Result<()> {
+    for name in WorldChoices::names() {
+        if m.ids().any(|id| id == name) && m.value_source(name) == Some(ValueSource::CommandLine) {
+            if let Some(text) = m.get_raw(name).and_then(|mut v| v.next()) {
+                world.set(name, &text.to_string_lossy())?;
+            }
+        }
     }
-    if let Some(field) = given::<FieldSource>(m, "field") {
-        config.field = field;
-    }
-    if let Some(sensors) = given::<SensorChoice>(m, "sensors") {
-        config.sensors = sensors;
-    }
-    if let Some(arena) = given::<ArenaChoice>(m, "arena") {
-        config.arena = Some(arena);
-    }
-    if let Some(robots) = given::<usize>(m, "robots") {
-        config.robots = Some(robots);
-    }
-    if let Some(pucks) = given::<usize>(m, "pucks") {
-        config.pucks = Some(pucks);
-    }
-    if let Some(seed) = given::<u64>(m, "seed") {
-        config.seed = seed;
-    }
-    if let Some(noise) = given::<f64>(m, "noise") {
-        config.noise = noise;
-    }
-    if let Some(walls) = given::<Walls>(m, "walls") {
-        config.walls = Some(walls);
-    }
+    Ok(())
 }

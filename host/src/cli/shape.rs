@@ -9,7 +9,6 @@ use clap::{ArgMatches, Args, FromArgMatches};
 use host::search::config::default_world;
 use host::shape::ShapeRequest;
 use host::train::config::field_label;
-use host::train::TrainConfig;
 use sim::fields::source::FieldSource;
 use std::path::PathBuf;
 
@@ -93,11 +92,9 @@ impl ShapeArgs {
         if let Some(generations) = own.generations {
             sim::base::ranges::GENERATIONS.check_count("--generations", generations)?;
         }
-        let mut world = TrainConfig {
-            field: own.image.clone(),
-            ..default_world()
-        };
-        apply_world_flags(&self.world, &mut world);
+        let mut world = default_world();
+        world.world.field = own.image.clone();
+        apply_world_flags(&self.world, &mut world.world)?;
         if let Some(dir) = self.world.get_one::<PathBuf>("out") {
             world.output.dir = dir.clone();
         }

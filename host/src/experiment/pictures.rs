@@ -27,8 +27,8 @@ pub fn fields(spec: &ExperimentSpec, figure: &FigureSpec) -> Result<Vec<(String,
         .iter()
         .filter(|a| figure.arms.is_empty() || figure.arms.contains(&a.name))
     {
-        if !sources.contains(&arm.config.field) {
-            sources.push(arm.config.field.clone());
+        if !sources.contains(&arm.config.world.field) {
+            sources.push(arm.config.world.field.clone());
         }
     }
     sources

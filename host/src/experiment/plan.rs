@@ -142,14 +142,14 @@ enum Hashed {
 /// [`Hashed`] settings of `config`.
 fn hashed(config: &TrainConfig) -> Hashed {
     let mut c = config.clone();
-    let robots = c.robots.unwrap_or(THESIS_ROBOTS);
+    let robots = c.world.robots.unwrap_or(THESIS_ROBOTS);
     if c.learn.hasher.0.has_role_bit() {
         c.innies = Some(c.role_innies(robots));
     }
-    if c.innies == Some(orbital_innies(&c.field, robots)) {
+    if c.innies == Some(orbital_innies(&c.world.field, robots)) {
         c.innies = None;
     }
-    let robot_senses = c.sensors.is_robot();
+    let robot_senses = c.world.sensors.is_robot();
     let settings = match TrainConfigV7::of(&c) {
         None => Hashed::Current(c),
         Some(v7) => {
@@ -227,17 +227,16 @@ pub fn plans_of_format(
         for trial in 0..trials {
             let mut config = arm.config.clone();
             config.steps = scaled(config.steps, scale);
-            config.seed = trial_seed(seed, &arm.name, trial);
+            config.world.seed = trial_seed(seed, &arm.name, trial);
             config.output = OutputConfig::default();
             let (pretrain, trial_hash) = hashes(arm, &config, trial, scale, seed, format);
             // the same run with the count left to the arena, as trials
             // before the puck rule were hashed
-            let unset = TrainConfig {
-                pucks: None,
-                ..config.clone()
-            };
-            let alias = (config.pucks.is_some() && config.pucks == arena_pucks(&config))
-                .then(|| hashes(arm, &unset, trial, scale, seed, format).1);
+            let mut unset = config.clone();
+            unset.world.pucks = None;
+            let alias = (config.world.pucks.is_some()
+                && config.world.pucks == arena_pucks(&config))
+            .then(|| hashes(arm, &unset, trial, scale, seed, format).1);
             out.push(TrialPlan {
                 experiment: spec.name.clone(),
                 arm: arm.name.clone(),
@@ -266,9 +265,9 @@ fn hashes(
 ) -> (Option<PretrainPlan>, String) {
     let pretrain = arm.pretrain.as_ref().map(|p| {
         let mut pre = config.clone();
-        pre.robots = p.robots.or(arm.config.robots);
+        pre.world.robots = p.robots.or(arm.config.world.robots);
         pre.steps = scaled(p.steps, scale);
-        pre.seed = trial_seed(seed, "pretrain", trial);
+        pre.world.seed = trial_seed(seed, "pretrain", trial);
         PretrainPlan {
             hash: hash(&(format, hashed(&pre))),
             config: pre,

@@ -59,7 +59,7 @@ impl ReusableTrials {
         let stored = std::iter::once(&plan.hash)
             .chain(&plan.alias)
             .find_map(|h| self.by_hash.get(h))?;
-        let same = stored.seed == plan.config.seed && stored.steps == plan.config.steps;
+        let same = stored.seed == plan.config.world.seed && stored.steps == plan.config.steps;
         same.then(|| TrialResult {
             experiment: plan.experiment.clone(),
             arm: plan.arm.clone(),

@@ -431,11 +431,10 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
     }
     let mut merged = defaults.clone();
     merge(&mut merged, table);
-    let mut config: TrainConfig = toml::Value::Table(merged)
-        .try_into()
-        .with_context(context)?;
+    let mut config = TrainConfig::from_toml_table(merged).with_context(context)?;
     config.validate().with_context(context)?;
-    config.pucks = effective_pucks(&config, keys.pucks_reason.as_deref()).with_context(context)?;
+    config.world.pucks =
+        effective_pucks(&config, keys.pucks_reason.as_deref()).with_context(context)?;
     if keys.pretrain.is_some() && keys.controller != ArmController::Learn {
         bail!("{}: only learning arms can be pre-trained", context());
     }
@@ -469,14 +468,14 @@ fn arm(defaults: &toml::Table, mut table: toml::Table) -> Result<ArmSpec> {
 /// cannot be read leaves the count as set: the run fails naming the file.
 fn effective_pucks(config: &TrainConfig, reason: Option<&str>) -> Result<Option<usize>> {
     let rule = match config.arena_choice().arena() {
-        Ok(arena @ Arena::Screen(_)) => Some(rule_pucks(&config.field, &arena)?),
+        Ok(arena @ Arena::Screen(_)) => Some(rule_pucks(&config.world.field, &arena)?),
         Ok(Arena::Square(_)) => None,
-        Err(_) => return Ok(config.pucks),
+        Err(_) => return Ok(config.world.pucks),
     };
-    match (config.pucks, rule, reason) {
+    match (config.world.pucks, rule, reason) {
         (Some(n), Some(r), None) if n != r => bail!(
             "pucks = {n}: the puck rule gives {} {r}; give the reason for another count as pucks_reason",
-            config.field
+            config.world.field
         ),
         (None, _, Some(_)) => bail!("pucks_reason without pucks: the count is the puck rule's"),
         (pucks, rule, _) => Ok(pucks.or(rule)),
@@ -527,12 +526,16 @@ alpha = 0.1
         let spec = ExperimentSpec::parse("x", FILE).unwrap();
         let (a, b) = (&spec.arms[0], &spec.arms[1]);
         assert_eq!(
-            (a.controller, a.config.robots, a.row.as_str()),
+            (a.controller, a.config.world.robots, a.row.as_str()),
             (ArmController::Oc, Some(4), "A")
         );
         assert_eq!(a.thesis[&Metric::Formations], 12.5);
         assert_eq!(
-            (b.config.robots, b.config.learn.alpha, b.config.learn.gamma),
+            (
+                b.config.world.robots,
+                b.config.learn.alpha,
+                b.config.learn.gamma
+            ),
             (Some(2), 0.1, 0.5)
         );
         assert_eq!(

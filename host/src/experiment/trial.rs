@@ -141,7 +141,9 @@ impl Running {
                 let config = prepared.config_mut();
                 config.world.innies = c.oc_innies(config.world.robots);
                 let oc = OrbitalConstruction::new(OrbitalConfig::default(), &config.thresholds);
-                let sim = prepared.simulation(c.seed).context("invalid settings")?;
+                let sim = prepared
+                    .simulation(c.world.seed)
+                    .context("invalid settings")?;
                 Running::Oc(Box::new(sim), oc)
             }
             ArmController::Learn => {
@@ -155,7 +157,9 @@ impl Running {
                 let blob = sim::control::policy_file::read(path)?;
                 let mut prepared = c.prepare()?;
                 sim::scenario::drive_with(prepared.config_mut(), &blob);
-                let sim = prepared.simulation(c.seed).context("invalid settings")?;
+                let sim = prepared
+                    .simulation(c.world.seed)
+                    .context("invalid settings")?;
                 Running::Policy(Box::new(sim), GreedyPolicy::new(blob))
             }
             ArmController::Random => {
@@ -163,7 +167,9 @@ impl Running {
                 let forward_speed = prepared.config().world.forward_speed as f32;
                 let actions =
                     ActionTable::new(&c.learn.actions, forward_speed).context("invalid actions")?;
-                let sim = prepared.simulation(c.seed).context("invalid settings")?;
+                let sim = prepared
+                    .simulation(c.world.seed)
+                    .context("invalid settings")?;
                 Running::Random(Box::new(sim), RandomTurns::new(actions))
             }
         })
@@ -234,7 +240,7 @@ pub fn run_watched(
         experiment: plan.experiment.clone(),
         arm: plan.arm.clone(),
         trial: plan.trial,
-        seed: c.seed,
+        seed: c.world.seed,
         steps: totals.steps,
         formations: totals.formations,
         stuck: totals.stuck,

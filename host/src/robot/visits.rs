@@ -156,8 +156,11 @@ mod tests {
     fn from_a_training_checkpoint() {
         use crate::train::{checkpoint, TrainConfig, Trainer};
         let config = TrainConfig {
-            robots: Some(2),
-            pucks: Some(40),
+            world: sim::scenario::choices::WorldChoices {
+                robots: Some(2),
+                pucks: Some(40),
+                ..Default::default()
+            },
             ..TrainConfig::default()
         };
         let mut trainer = Trainer::start(config, None).unwrap();

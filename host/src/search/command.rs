@@ -231,19 +231,17 @@ fn worlds_from(base: TrainConfig, settings: &SearchConfig) -> Result<Vec<TrainCo
     for &noise in &settings.also_noise {
         sim::base::ranges::NOISE.check_as("also-noise", noise)?;
     }
-    let fields = std::iter::once(base.field.clone()).chain(settings.also_field.clone());
-    let noises: Vec<f64> = std::iter::once(base.noise)
+    let fields = std::iter::once(base.world.field.clone()).chain(settings.also_field.clone());
+    let noises: Vec<f64> = std::iter::once(base.world.noise)
         .chain(settings.also_noise.iter().copied())
         .collect();
     fields
         .flat_map(|field| noises.iter().map(move |&noise| (field.clone(), noise)))
         .map(|(field, noise)| {
-            let mut config = TrainConfig {
-                field,
-                noise,
-                ..base.clone()
-            };
-            config.pucks = config.world().pucks()?;
+            let mut config = base.clone();
+            config.world.field = field;
+            config.world.noise = noise;
+            config.world.pucks = config.world.pucks()?;
             config.validate()?;
             Ok(config)
         })
@@ -259,7 +257,7 @@ pub fn start_table(config: &TrainConfig, start: &Start) -> Result<(PolicyTable, 
             (distil_orbital(config, steps)?, steps)
         }
         Start::Random => {
-            let mut rng = SimRng::seed_from_u64(mix(config.seed ^ RANDOM_START_STREAM));
+            let mut rng = SimRng::seed_from_u64(mix(config.world.seed ^ RANDOM_START_STREAM));
             (random_table(hasher, actions, &mut rng), 0)
         }
         Start::File(path) => (seed_table(path, config)?.greedy_policy(), 0),
@@ -318,7 +316,12 @@ pub fn write_result(
     let log_file = config.output.dir.join(format!("{name}.search.json"));
     let table = PolicyTable::from_packed(config.learn.hasher.0, &log.result)
         .context("the result does not fit the run's hasher")?;
-    let provenance = Provenance::new(&field_label(&config.field), &name, log.steps, config.seed)?;
+    let provenance = Provenance::new(
+        &field_label(&config.world.field),
+        &name,
+        log.steps,
+        config.world.seed,
+    )?;
     let blob = PolicyBlob::new(scorer.actions(), table, provenance)?
         .with_trained_for(config.trained_for());
     crate::policy_file::write(&policy, &blob)?;
@@ -365,7 +368,7 @@ pub fn run_from(
     each: &mut Each<'_>,
 ) -> Result<SearchLog> {
     let actions = config.learn.actions.len();
-    let validation = validation_seeds(config.seed, settings.validation_seeds);
+    let validation = validation_seeds(config.world.seed, settings.validation_seeds);
     // every world is run once per field
     let fields = scorer.fields() as u64;
     let validation_cost = settings.validation_steps * validation.len() as u64 * fields;
@@ -380,11 +383,11 @@ pub fn run_from(
     let (mut result, mut result_validation) = (start, start_validation);
     let mut generations: Vec<Generation> = Vec::new();
     for g in 0..settings.generations {
-        let mut rng = SimRng::seed_from_u64(mix(mix(config.seed ^ SAMPLE_STREAM) ^ g));
+        let mut rng = SimRng::seed_from_u64(mix(mix(config.world.seed ^ SAMPLE_STREAM) ^ g));
         let candidates: Vec<PolicyTable> = std::iter::once(result.clone())
             .chain((1..settings.population).map(|_| distribution.sample(&mut rng)))
             .collect();
-        let seeds = fitness_seeds(config.seed, g, settings.fitness_seeds);
+        let seeds = fitness_seeds(config.world.seed, g, settings.fitness_seeds);
         let earlier = done.get(g as usize);
         if let Some(earlier) = earlier {
             if earlier.generation != g
@@ -518,7 +521,7 @@ mod tests {
         };
         let configs = worlds(&request).unwrap();
         let config = configs[0].clone();
-        assert_eq!(config.pucks, Some(12), "the annulus' count on the TV");
+        assert_eq!(config.world.pucks, Some(12), "the annulus' count on the TV");
         let scorer = Scorer::new(&configs, threads).unwrap();
         let (table, distilled) = start_table(&config, &request.search.start).unwrap();
         run(&config, &request.search, &scorer, table, distilled).unwrap()
@@ -560,7 +563,7 @@ mod tests {
         };
         let configs = worlds(&request).unwrap();
         assert_eq!(
-            configs.iter().map(|c| c.pucks).collect::<Vec<_>>(),
+            configs.iter().map(|c| c.world.pucks).collect::<Vec<_>>(),
             [Some(12), Some(11)],
             "each shape's own count on the TV"
         );
@@ -580,7 +583,7 @@ mod tests {
         let configs = worlds(&search(vec![2.0])).unwrap();
         let worlds_seen: Vec<_> = configs
             .iter()
-            .map(|c| (field_label(&c.field), c.noise, c.pucks))
+            .map(|c| (field_label(&c.world.field), c.world.noise, c.world.pucks))
             .collect();
         assert_eq!(
             worlds_seen,

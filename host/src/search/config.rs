@@ -8,6 +8,7 @@ use anyhow::{bail, Result};
 use serde::{Deserialize, Serialize};
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 use std::path::PathBuf;
 
@@ -16,9 +17,12 @@ use std::path::PathBuf;
 /// (1); every other setting a training config's default.
 pub fn default_world() -> TrainConfig {
     TrainConfig {
-        sensors: SensorChoice::Robot(None),
-        arena: Some(ArenaChoice::Named("tv75".into())),
-        noise: 1.0,
+        world: WorldChoices {
+            sensors: SensorChoice::Robot(None),
+            arena: Some(ArenaChoice::Named("tv75".into())),
+            noise: 1.0,
+            ..WorldChoices::default()
+        },
         ..TrainConfig::default()
     }
 }

@@ -95,11 +95,9 @@ pub fn formations(
     seed: u64,
     steps: u64,
 ) -> Result<u64> {
-    let world = TrainConfig {
-        noise,
-        seed,
-        ..config.clone()
-    };
+    let mut world = config.clone();
+    world.world.noise = noise;
+    world.world.seed = seed;
     let mut scenario = world.scenario()?;
     let (mut sim, mut controller) = match contender {
         Contender::Table(blob) => scenario.build_with_policy(blob.as_ref().clone())?,
@@ -120,7 +118,7 @@ pub fn evaluate(
     seeds: &[u64],
     steps: u64,
 ) -> Result<(Vec<Levels>, Vec<WorldRun>)> {
-    let noises = [config.noise, 2.0 * config.noise];
+    let noises = [config.world.noise, 2.0 * config.world.noise];
     let jobs: Vec<(usize, f64, u64)> = (0..contenders.len())
         .flat_map(|c| {
             noises
@@ -213,10 +211,8 @@ pub fn write_picture(
     steps: u64,
     path: &Path,
 ) -> Result<()> {
-    let world = TrainConfig {
-        seed,
-        ..config.clone()
-    };
+    let mut world = config.clone();
+    world.world.seed = seed;
     let (mut sim, mut controller) = world.scenario()?.build_with_policy(blob.clone())?;
     let options = RenderOptions {
         band: true,

@@ -81,7 +81,7 @@ pub struct Checked {
 /// `invert`; refused when it looks drawn dark on light (offering
 /// `--invert`) or when fewer than six pucks placed on it reach success.
 pub fn check(config: &TrainConfig, invert: bool, inverted_file: &Path) -> Result<Checked> {
-    let given = &config.field;
+    let given = &config.world.field;
     let loaded = given.load().with_context(|| format!("image {given}"))?;
     let field = if invert {
         crate::render::write_image(&inverted(&loaded), inverted_file)?;
@@ -102,7 +102,7 @@ pub fn check(config: &TrainConfig, invert: bool, inverted_file: &Path) -> Result
              part of the image; --invert flips it"
         );
     }
-    let pucks = match config.pucks {
+    let pucks = match config.world.pucks {
         Some(pucks) => pucks,
         None => {
             let arena = config.arena_choice().arena()?;

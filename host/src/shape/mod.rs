@@ -219,7 +219,7 @@ fn choose_start(
     settings: &SearchConfig,
     scale: f64,
 ) -> Result<StartChoice> {
-    let seeds = fitness_seeds(config.seed, START_GENERATION, START_SEEDS);
+    let seeds = fitness_seeds(config.world.seed, START_GENERATION, START_SEEDS);
     let distilled = scaled(DISTIL_STEPS, scale);
     let mut role = config.clone();
     role.learn.hasher.0 = StateHasher::OriginalRole;
@@ -257,11 +257,9 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     // 1. the image
     let checked = image::check(&request.world, request.invert, &at("field.png"))?;
     let general = PolicyBlob::decode(GENERAL_TABLE).context("the built-in general table")?;
-    let mut world = TrainConfig {
-        field: checked.field,
-        pucks: Some(checked.pucks),
-        ..request.world.clone()
-    };
+    let mut world = request.world.clone();
+    world.world.field = checked.field;
+    world.world.pucks = Some(checked.pucks);
     world.learn.hasher.0 = general.hasher();
     let mut settings = search_settings(request.scale);
     let (mut config, scorer) = scorer_of(world, &settings)?;
@@ -270,7 +268,7 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     }
     // 2. the budget
     let key = RunKey {
-        image: request.world.field.to_string(),
+        image: request.world.world.field.to_string(),
         invert: request.invert,
         world: config.clone(),
         scale: request.scale,
@@ -282,7 +280,13 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
         Some(state) => state,
         None => ShapeState {
             format: state::FORMAT,
-            budget: budget(request, &scorer, general.table(), &settings, config.seed)?,
+            budget: budget(
+                request,
+                &scorer,
+                general.table(),
+                &settings,
+                config.world.seed,
+            )?,
             run: key,
             start: None,
             generations: Vec::new(),
@@ -331,8 +335,8 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     let (policy, log_file) = write_result(&config, &scorer, &log)?;
     // 5. the report card
     let result = sim::control::policy_file::read(&policy)?;
-    let validation = validation_seeds(config.seed, settings.validation_seeds);
-    let seeds: Vec<u64> = validation_seeds(config.seed ^ REPORT_STREAM, 2 * REPORT_SEEDS)
+    let validation = validation_seeds(config.world.seed, settings.validation_seeds);
+    let seeds: Vec<u64> = validation_seeds(config.world.seed ^ REPORT_STREAM, 2 * REPORT_SEEDS)
         .into_iter()
         .filter(|s| !validation.contains(s))
         .take(REPORT_SEEDS)
@@ -345,7 +349,7 @@ pub fn shape(request: &ShapeRequest) -> Result<ShapeReport> {
     ];
     let (levels, worlds) = evaluate(&config, &contenders, &seeds, steps)?;
     let card = Card {
-        field: config.field.to_string(),
+        field: config.world.field.to_string(),
         pucks: checked.pucks,
         hasher: config.learn.hasher.0.name().to_string(),
         seeds: seeds.clone(),

@@ -288,7 +288,7 @@ fn start(args: &TrainRequest) -> Result<(Trainer<SelectedSensors>, u64)> {
     };
     args.flags.apply(&mut config)?;
     if args.randomise {
-        config.noise = 1.0;
+        config.world.noise = 1.0;
     }
     config.validate()?;
     // before any step (a distillation or a pre-evaluation included)
@@ -435,8 +435,8 @@ fn run(
             let c = trainer.config();
             format!(
                 "{}, sensors {}, arena {}",
-                c.field,
-                c.sensors,
+                c.world.field,
+                c.world.sensors,
                 c.arena_choice()
             )
         },
@@ -453,7 +453,7 @@ struct OrbitalRun {
 impl OrbitalRun {
     fn start(config: &TrainConfig, steps: u64) -> Result<OrbitalRun> {
         let prepared = config.prepare()?;
-        let mut sim = prepared.simulation(config.seed)?;
+        let mut sim = prepared.simulation(config.world.seed)?;
         let mut controller =
             OrbitalConstruction::new(OrbitalConfig::default(), &prepared.config().thresholds);
         let cancel = Arc::new(AtomicBool::new(false));

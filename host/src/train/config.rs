@@ -8,6 +8,7 @@ use crate::learn::LearnConfig;
 use anyhow::{bail, Context, Result};
 use clap::parser::ValueSource;
 use clap::{ArgAction, ArgMatches, Args, FromArgMatches};
+use serde::de::{self, DeserializeOwned, Deserializer, IgnoredAny, MapAccess, Visitor};
 use serde::{Deserialize, Serialize};
 use shared::blob::name_prefix;
 use sim::base::ranges;
@@ -21,6 +22,7 @@ use sim::{
     scenario::Scenario,
 };
 use std::path::{Path, PathBuf};
+use std::sync::LazyLock;
 
 /// Steps `host train` runs by default: on the annulus with 8 robots and
 /// 250 pucks, about 13 s at 150,000 steps/s, forming dozens of shapes
@@ -39,44 +41,16 @@ pub const DEFAULT_CHECKPOINT_EVERY: u64 = 1_000_000;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Args)]
 #[serde(default, deny_unknown_fields)]
 pub struct TrainConfig {
-    /// The field: annulus, letter:T (our T, I, L, V, X, Z), thesis:T (the
-    /// thesis' T, L, V, X, Z), either turned (letter:L@mirror; @rot90,
-    /// @rot180, @rot270 clockwise, @mirror, @mirror-rot90, ...), a generated
-    /// shape (gen:FAMILY:SEED, docs/generated-shapes.md) or an image file
-    /// (PNG, JPEG) [default: annulus].
-    #[arg(long, required = false)]
-    pub field: FieldSource,
-    /// Sensor model: disc (the reference model's discs), disc-thesis (with
-    /// the thesis' larger, robots-only obstacle discs), robot (the Zumo's
-    /// photo-transistors and Pixy camera, through the firmware's arithmetic)
-    /// or robot:CONFIG.json (docs/robot-sensors.md) [default: disc].
-    #[arg(long, required = false)]
-    pub sensors: SensorChoice,
-    /// The arena: thesis (the reference model's 800 x 800 square), tv75
-    /// (the thesis' 75" TV lying flat) or a FILE.toml of a screen arena
-    /// [default: tv75 with the robot's senses, else thesis].
-    #[arg(long)]
-    pub arena: Option<ArenaChoice>,
-    /// Number of robots [default: the arena's: 8 in the thesis' square, 5
-    /// on tv75].
-    #[arg(long)]
-    pub robots: Option<usize>,
-    /// Number of pucks [default: the arena's: 250 in the thesis' square, 12
-    /// on tv75].
-    #[arg(long)]
-    pub pucks: Option<usize>,
-    /// Real-world noise (domain randomisation) in multiples of the default
-    /// (0 none, 1 the default, 2 twice as much): the robots' motion and the
-    /// robot senses' readings [default: 0].
-    #[arg(long, required = false)]
-    pub noise: f64,
+    /// The world: its settings are the config's own keys and flags
+    /// (`field`, `sensors`, `arena`, `robots`, `pucks`, `seed`, `noise`,
+    /// `walls`), declared once in [`WorldChoices`].
+    #[serde(flatten)]
+    #[command(flatten)]
+    pub world: WorldChoices,
     /// Steps to run [default: 2,000,000; when resuming, the checkpoint's
     /// run length].
     #[arg(long, required = false)]
     pub steps: u64,
-    /// Seed of every random choice [default: 1].
-    #[arg(long, required = false)]
-    pub seed: u64,
     /// Steps before an unformed episode counts as stuck [default: the
     /// field's: 150,000 on the annulus, 50,000 otherwise].
     #[arg(long)]
@@ -115,12 +89,6 @@ pub struct TrainConfig {
     /// (docs/training.md) [default: none, the initial Q-values].
     #[arg(long)]
     pub distil_oc: Option<u64>,
-    /// How the arena's border keeps the bodies in: clamp (put back inside,
-    /// no contact: the thesis author's program) or segments (walls the
-    /// bodies bounce off) [default: clamp in the thesis' square, segments
-    /// on a screen].
-    #[arg(long)]
-    pub walls: Option<Walls>,
     /// Decaying exploration: the exploration probability falls linearly
     /// from --epsilon at step 0 to 0 at this step (in steps of
     /// 1,000) and stays 0 [default: none, --epsilon throughout].
@@ -206,14 +174,8 @@ impl Default for TrainConfig {
     /// no noise, [`DEFAULT_STEPS`], seed 1, the thesis' learner.
     fn default() -> TrainConfig {
         TrainConfig {
-            field: FieldSource::Annulus,
-            sensors: SensorChoice::Disc,
-            arena: None,
-            robots: None,
-            pucks: None,
-            noise: 0.0,
+            world: WorldChoices::default(),
             steps: DEFAULT_STEPS,
-            seed: 1,
             stuck_limit: None,
             learn: LearnConfig::default(),
             output: OutputConfig::default(),
@@ -223,7 +185,6 @@ impl Default for TrainConfig {
             obstacle_discs: None,
             select: None,
             distil_oc: None,
-            walls: None,
             epsilon_decay: None,
             n_step: None,
         }
@@ -239,7 +200,7 @@ impl TrainConfig {
     pub fn from_file(path: &Path) -> Result<TrainConfig> {
         let text = ranges::read_text(path, &ranges::SETTINGS_FILE)
             .with_context(|| format!("cannot read config file {}", path.display()))?;
-        toml::from_str(&text).with_context(|| {
+        TrainConfig::from_toml(&text).with_context(|| {
             format!(
                 "config file {} is not a valid training config",
                 path.display()
@@ -247,10 +208,21 @@ impl TrainConfig {
         })
     }
 
+    /// The config of TOML text: an error names the key, with its line.
+    pub fn from_toml(text: &str) -> Result<TrainConfig, toml::de::Error> {
+        read_checked(&text)
+    }
+
+    /// The config of a TOML table (an experiment's settings, merged from
+    /// its files): an error names the key.
+    pub fn from_toml_table(table: toml::Table) -> Result<TrainConfig, toml::de::Error> {
+        read_checked(&toml::Value::Table(table))
+    }
+
     /// How the run's border keeps the bodies in: `walls`, else the
     /// arena's own (the thesis' square clamps, a screen has its bezel).
     pub fn walls_in_effect(&self) -> Walls {
-        self.walls.unwrap_or(match self.arena_choice() {
+        self.world.walls.unwrap_or(match self.arena_choice() {
             ArenaChoice::Thesis => Walls::Clamp,
             ArenaChoice::Named(_) | ArenaChoice::File(_) => Walls::Segments,
         })
@@ -258,13 +230,13 @@ impl TrainConfig {
 
     /// The arena the run uses.
     pub fn arena_choice(&self) -> ArenaChoice {
-        self.world().arena_choice()
+        self.world.arena_choice()
     }
 
     /// The sensor model and arena the run trains for, as its policy blob
     /// records them.
     pub fn trained_for(&self) -> shared::TrainedFor {
-        sim::scenario::trained_for::trained_for(&self.sensors, &self.arena_choice())
+        sim::scenario::trained_for::trained_for(&self.world.sensors, &self.arena_choice())
     }
 
     /// The run as a scenario (arena and sensor files read and checked),
@@ -277,21 +249,7 @@ impl TrainConfig {
     pub fn choices(&self) -> ScenarioChoices {
         ScenarioChoices {
             controller: ControllerChoice::Random,
-            world: self.world(),
-        }
-    }
-
-    /// The world's settings by name.
-    pub fn world(&self) -> WorldChoices {
-        WorldChoices {
-            field: self.field.clone(),
-            sensors: self.sensors.clone(),
-            arena: self.arena.clone(),
-            robots: self.robots,
-            pucks: self.pucks,
-            seed: self.seed,
-            noise: self.noise,
-            walls: self.walls,
+            world: self.world.clone(),
         }
     }
 
@@ -329,7 +287,7 @@ impl TrainConfig {
     /// `robots` robots.
     pub fn oc_innies(&self, robots: usize) -> usize {
         self.innies
-            .unwrap_or_else(|| orbital_innies(&self.field, robots))
+            .unwrap_or_else(|| orbital_innies(&self.world.field, robots))
     }
 
     /// The innies of a run of these settings with the role hasher and
@@ -365,7 +323,7 @@ impl TrainConfig {
             Some(name) => name.clone(),
             None => name_prefix(&format!(
                 "{}-{}",
-                field_label(&self.field).replace(':', "-"),
+                field_label(&self.world.field).replace(':', "-"),
                 self.learn.hasher.0.name()
             ))
             .to_string(),
@@ -377,7 +335,7 @@ impl TrainConfig {
     /// the setting.
     pub fn validate(&self) -> Result<()> {
         ranges::STEPS.check_count("steps", self.steps)?;
-        sim::scenario::choices::check_world_ranges(self.robots, self.pucks, self.noise)?;
+        self.world.check_ranges()?;
         if let Some(limit) = self.stuck_limit {
             ranges::STUCK_LIMIT.check_count("stuck_limit", limit)?;
         }
@@ -404,10 +362,10 @@ impl TrainConfig {
             ranges::N_STEP.check_count("n_step", u64::from(n))?;
         }
         ranges::CHECKPOINT_EVERY.check_count("checkpoint_every", self.output.checkpoint_every)?;
-        if self.obstacle_discs.is_some() && self.sensors != SensorChoice::Disc {
+        if self.obstacle_discs.is_some() && self.world.sensors != SensorChoice::Disc {
             bail!(
                 "obstacle_discs: only the disc sensor model takes them (sensors = {:?})",
-                self.sensors.to_string()
+                self.world.sensors.to_string()
             );
         }
         let name = self.name();
@@ -421,6 +379,80 @@ impl TrainConfig {
             );
         }
         Ok(())
+    }
+}
+
+/// TOML a config is read from.
+trait TomlSource {
+    /// The source as a `T`.
+    fn read<T: DeserializeOwned>(&self) -> Result<T, toml::de::Error>;
+}
+
+impl TomlSource for &str {
+    fn read<T: DeserializeOwned>(&self) -> Result<T, toml::de::Error> {
+        toml::from_str(self)
+    }
+}
+
+impl TomlSource for toml::Value {
+    fn read<T: DeserializeOwned>(&self) -> Result<T, toml::de::Error> {
+        self.clone().try_into()
+    }
+}
+
+/// A config read so that its errors name the key and keep its place: the
+/// world's settings are flattened into the config, and serde reads
+/// flattened keys through a buffer that forgets both, so the keys, then
+/// the world's settings on their own, are read first.
+fn read_checked(source: &impl TomlSource) -> Result<TrainConfig, toml::de::Error> {
+    source.read::<SettingKeys>()?;
+    source.read::<WorldChoices>()?;
+    source.read::<TrainConfig>()
+}
+
+/// The top-level keys of a config, each a setting's ([`TrainConfig`]'s
+/// serde form names them); reading one of no setting fails, naming it.
+struct SettingKeys;
+
+impl<'de> Deserialize<'de> for SettingKeys {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<SettingKeys, D::Error> {
+        /// A key of a setting.
+        struct Key;
+        impl<'de> Deserialize<'de> for Key {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> std::result::Result<Key, D::Error> {
+                static NAMES: LazyLock<Vec<String>> =
+                    LazyLock::new(|| match serde_json::to_value(TrainConfig::default()) {
+                        Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
+                        _ => Vec::new(),
+                    });
+                let key = String::deserialize(d)?;
+                if NAMES.contains(&key) {
+                    Ok(Key)
+                } else {
+                    Err(de::Error::custom(format!(
+                        "unknown field `{key}`, expected one of {}",
+                        NAMES.join(", ")
+                    )))
+                }
+            }
+        }
+        struct Keys;
+        impl<'de> Visitor<'de> for Keys {
+            type Value = SettingKeys;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a table of settings")
+            }
+            fn visit_map<A: MapAccess<'de>>(
+                self,
+                mut map: A,
+            ) -> std::result::Result<SettingKeys, A::Error> {
+                while map.next_key::<Key>()?.is_some() {
+                    map.next_value::<IgnoredAny>()?;
+                }
+                Ok(SettingKeys)
+            }
+        }
+        d.deserialize_map(Keys)
     }
 }
 
@@ -535,8 +567,11 @@ mod tests {
     #[test]
     fn a_file_names_what_it_changes_and_flags_win() {
         let text = "robots = 4\nfield = \"letter:L\"\n[learn]\nhasher = \"bits7\"\nalpha = 0.5\n[output]\nname = \"x\"\n";
-        let mut c: TrainConfig = toml::from_str(text).unwrap();
-        assert_eq!((c.robots, c.pucks, c.learn.alpha), (Some(4), None, 0.5));
+        let mut c = TrainConfig::from_toml(text).unwrap();
+        assert_eq!(
+            (c.world.robots, c.world.pucks, c.learn.alpha),
+            (Some(4), None, 0.5)
+        );
         let world = &c.prepare().unwrap().config().clone();
         assert_eq!(
             (world.episode.stuck_limit, world.world.pucks),
@@ -545,7 +580,12 @@ mod tests {
         let flags = TrainFlags::parse(["--alpha", "0.1", "--robots", "2", "--steps", "9"]).unwrap();
         flags.apply(&mut c).unwrap();
         assert_eq!(
-            (c.robots, c.learn.alpha, c.learn.hasher.0.bits(), c.steps),
+            (
+                c.world.robots,
+                c.learn.alpha,
+                c.learn.hasher.0.bits(),
+                c.steps
+            ),
             (Some(2), 0.1, 7, 9)
         );
         assert_eq!(flags.given_settings(), ["--alpha", "--robots"]);
@@ -555,25 +595,39 @@ mod tests {
 
     #[test]
     fn malformed_files_give_the_line() {
-        let e = toml::from_str::<TrainConfig>("robots = 4\npucks = = 3\n")
+        let e = TrainConfig::from_toml("robots = 4\npucks = = 3\n")
             .unwrap_err()
             .to_string();
         assert!(e.contains("line 2"), "{e}");
-        let e = toml::from_str::<TrainConfig>("robots = 4\n\nalpah = 0.3\n")
+        let e = TrainConfig::from_toml("robots = 4\n\nalpah = 0.3\n")
             .unwrap_err()
             .to_string();
         assert!(e.contains("line 3") && e.contains("alpah"), "{e}");
-        let e = toml::from_str::<TrainConfig>("[learn]\nhasher = \"bits12\"\n")
+        let e = TrainConfig::from_toml("[learn]\nhasher = \"bits12\"\n")
             .unwrap_err()
             .to_string();
         assert!(e.contains("bits12") && e.contains("line 2"), "{e}");
+        // a world's setting, flattened into the config, keeps its line too
+        let e = TrainConfig::from_toml("steps = 9\nrobots = \"four\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2") && e.contains("four"), "{e}");
+        let e = TrainConfig::from_toml("steps = 9\nfield = \"letter:Q\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 2") && e.contains("letter:Q"), "{e}");
+        // a table without lines names the key
+        let mut table = toml::Table::new();
+        table.insert("robot".into(), toml::Value::Integer(4));
+        let e = TrainConfig::from_toml_table(table).unwrap_err().to_string();
+        assert!(e.contains("`robot`"), "{e}");
     }
 
     #[test]
     fn names_derive_from_field_and_hasher_and_are_checked() {
         let mut c = TrainConfig::default();
         assert_eq!(c.name(), "annulus-original");
-        c.field = FieldSource::Letter(sim::fields::letters::Letter::T);
+        c.world.field = FieldSource::Letter(sim::fields::letters::Letter::T);
         assert_eq!(c.name(), "letter-T-original");
         c.output.name = Some("../escape".into());
         assert!(c

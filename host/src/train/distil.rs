@@ -62,7 +62,7 @@ fn most(counts: &[u64]) -> Option<usize> {
 pub fn distil_orbital(config: &TrainConfig, steps: u64) -> Result<PolicyTable> {
     let prepared = config.prepare()?;
     let mut sim = prepared
-        .simulation(config.seed ^ DISTIL_STREAM)
+        .simulation(config.world.seed ^ DISTIL_STREAM)
         .context("cannot build the distillation world")?;
     let hasher = config.learn.hasher.0;
     let speeds = config.learn.actions.clone();
@@ -117,12 +117,15 @@ mod tests {
     #[test]
     fn a_distilled_role_table_acts_as_orbital_construction_for_both_roles() {
         let config = TrainConfig {
+            world: sim::scenario::choices::WorldChoices {
+                robots: Some(4),
+                pucks: Some(60),
+                ..Default::default()
+            },
             learn: crate::learn::LearnConfig {
                 hasher: crate::learn::StateHasherName(shared::StateHasher::OriginalRole),
                 ..Default::default()
             },
-            robots: Some(4),
-            pucks: Some(60),
             ..TrainConfig::default()
         };
         let table = distil_orbital(&config, 3000).unwrap();

@@ -21,6 +21,7 @@ use sim::config::{SuccessSignal, Walls};
 use sim::episodes::reward::Reward;
 use sim::fields::source::FieldSource;
 use sim::scenario::arena_choice::ArenaChoice;
+use sim::scenario::choices::WorldChoices;
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::simulation::SimulationState;
 
@@ -138,15 +139,16 @@ impl LearnConfigV7 {
 impl TrainConfigV7 {
     /// `c`'s settings of this layout, whatever the rest.
     fn project(c: &TrainConfig) -> TrainConfigV7 {
+        let w = &c.world;
         TrainConfigV7 {
-            field: c.field.clone(),
-            sensors: c.sensors.clone(),
-            arena: c.arena.clone(),
-            robots: c.robots,
-            pucks: c.pucks,
-            noise: c.noise,
+            field: w.field.clone(),
+            sensors: w.sensors.clone(),
+            arena: w.arena.clone(),
+            robots: w.robots,
+            pucks: w.pucks,
+            noise: w.noise,
             steps: c.steps,
-            seed: c.seed,
+            seed: w.seed,
             stuck_limit: c.stuck_limit,
             learn: LearnConfigV7::project(&c.learn),
             output: c.output.clone(),
@@ -156,7 +158,7 @@ impl TrainConfigV7 {
             obstacle_discs: c.obstacle_discs,
             select: c.select,
             distil_oc: c.distil_oc,
-            walls: c.walls,
+            walls: w.walls,
             rules: LearnerRules {
                 tie_tolerance: c.learn.tie_tolerance,
                 updates: c.learn.updates,
@@ -199,14 +201,18 @@ impl From<TrainConfigV7> for TrainConfig {
     )]
     fn from(c: TrainConfigV7) -> TrainConfig {
         TrainConfig {
-            field: c.field,
-            sensors: c.sensors,
-            arena: c.arena,
-            robots: c.robots,
-            pucks: c.pucks,
-            noise: c.noise,
+            world: WorldChoices {
+                field: c.field,
+                sensors: c.sensors,
+                arena: c.arena,
+                robots: c.robots,
+                pucks: c.pucks,
+                seed: c.seed,
+                noise: c.noise,
+                walls: c.walls,
+                ..WorldChoices::default()
+            },
             steps: c.steps,
-            seed: c.seed,
             stuck_limit: c.stuck_limit,
             learn: c.learn.with_rules(c.rules),
             output: c.output,
@@ -216,7 +222,6 @@ impl From<TrainConfigV7> for TrainConfig {
             obstacle_discs: c.obstacle_discs,
             select: c.select,
             distil_oc: c.distil_oc,
-            walls: c.walls,
             epsilon_decay: c.epsilon_decay,
             n_step: c.n_step,
             ..TrainConfig::default()

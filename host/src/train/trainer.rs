@@ -69,7 +69,7 @@ impl Trainer<SelectedSensors> {
             (None, table) => table,
         };
         // the scenario's errors say what kind of setting is wrong
-        let sim = config.prepare()?.simulation(config.seed)?;
+        let sim = config.prepare()?.simulation(config.world.seed)?;
         Trainer::new(config, sim, seed_table)
     }
 
@@ -121,7 +121,7 @@ impl<S: SensorModel> Trainer<S> {
         if crc != state.field_crc {
             bail!(
                 "the field {} differs from the one the checkpoint trained on (CRC-32 {crc:#010x}, checkpoint {:#010x})",
-                state.config.field,
+                state.config.world.field,
                 state.field_crc
             );
         }
@@ -295,8 +295,9 @@ impl<S: SensorModel> Trainer<S> {
             self.sim.config().world.forward_speed as f32,
         )
         .context("cannot export the policy")?;
-        let provenance = Provenance::new(&field_label(&c.field), &c.name(), steps, c.seed)
-            .context("cannot export the policy")?;
+        let provenance =
+            Provenance::new(&field_label(&c.world.field), &c.name(), steps, c.world.seed)
+                .context("cannot export the policy")?;
         Ok((actions, provenance))
     }
 }
@@ -305,7 +306,7 @@ impl<S: SensorModel> Trainer<S> {
 fn evaluation_of(config: &TrainConfig) -> Result<Option<Evaluation>> {
     config
         .select
-        .map(|select| Evaluation::new(select, &config.prepare()?, config.seed))
+        .map(|select| Evaluation::new(select, &config.prepare()?, config.world.seed))
         .transpose()
 }
 

@@ -115,7 +115,7 @@ impl GreedyWorld {
         let config = trainer.config();
         let mut sim = config
             .prepare()?
-            .simulation(config.seed ^ VIEW_STREAM)
+            .simulation(config.world.seed ^ VIEW_STREAM)
             .context("cannot build the greedy table's world")?;
         let follower = View::follow(bind, &sim)
             .map_err(|e| anyhow!(e))

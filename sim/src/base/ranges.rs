@@ -947,6 +947,15 @@ pub const BAUD: Range = Range::closed(
     "the firmware sends 115200",
 );
 
+/// The row a setting named `key` is checked against: the one `key` names
+/// (its first key), if any.
+pub fn row(key: &str) -> Option<&'static Range> {
+    SECTIONS
+        .iter()
+        .flat_map(|(_, rows)| rows.iter().copied())
+        .find(|r| r.key() == key)
+}
+
 /// The table: every range by section, in the order `docs/ranges.md` shows it.
 pub const SECTIONS: &[(&str, &[&Range])] = &[
     (

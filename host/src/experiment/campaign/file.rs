@@ -83,11 +83,11 @@ impl Stage {
     /// publication).
     pub fn fields(&self) -> Vec<String> {
         match &self.work {
-            Work::Search { world, search } => std::iter::once(&world.field)
+            Work::Search { world, search } => std::iter::once(&world.world.field)
                 .chain(&search.also_field)
                 .map(|f| f.to_string())
                 .collect(),
-            Work::Train { world } => vec![world.field.to_string()],
+            Work::Train { world } => vec![world.world.field.to_string()],
             Work::Evaluate(_) | Work::Publish(_) => Vec::new(),
         }
     }
@@ -335,7 +335,7 @@ fn stage(
             bail!("{key}: a search setting, and this is a {kind} stage");
         }
     }
-    let mut world: TrainConfig = toml::Value::Table(merged).try_into()?;
+    let mut world = TrainConfig::from_toml_table(merged)?;
     world.output.name = Some(keys.name.clone());
     world.validate()?;
     let world = Box::new(world);

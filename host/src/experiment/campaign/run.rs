@@ -354,11 +354,9 @@ fn evaluate(campaign: &Campaign, e: &Evaluation, options: &CampaignOptions) -> R
     runs.par_iter()
         .map(|(field, controller, seed)| {
             // on a screen, the shape's puck count by the puck rule
-            let config = TrainConfig {
-                seed: *seed,
-                field: field.clone(),
-                ..world.clone()
-            };
+            let mut config = world.clone();
+            config.world.seed = *seed;
+            config.world.field = field.clone();
             config.validate()?;
             let mut scenario = config.scenario()?;
             scenario.controller = controller.clone();
