@@ -233,3 +233,61 @@ fn pythons_keyword_arguments_are_the_settings_of_the_same_names() {
         );
     }
 }
+
+#[test]
+fn the_stuck_limit_declared_only_as_a_world_setting_reaches_every_front_end_and_the_world() {
+    // the stuck limit of the world a front end's settings build
+    let limit = |w: &WorldChoices| {
+        let choices = sim::scenario::choices::ScenarioChoices {
+            controller: sim::scenario::ControllerChoice::Random,
+            world: w.clone(),
+        };
+        let prepared = choices.scenario().unwrap().prepare().unwrap();
+        prepared.config().episode.stuck_limit
+    };
+    // host train's flag and a settings file's key
+    let mut flagged = TrainConfig::default();
+    TrainFlags::parse(["--stuck-limit", "700"])
+        .unwrap()
+        .apply(&mut flagged)
+        .unwrap();
+    let filed = TrainConfig::from_toml("stuck_limit = 700\n").unwrap();
+    assert_eq!(flagged, filed);
+    assert_eq!(limit(&filed.world), 700);
+    // the checkpoint's record, and the run it resumes
+    let mut t = Trainer::start(
+        TrainConfig {
+            world: WorldChoices {
+                robots: Some(2),
+                pucks: Some(5),
+                ..filed.world.clone()
+            },
+            ..filed.clone()
+        },
+        None,
+    )
+    .unwrap();
+    t.run(10);
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, &t.state()).unwrap();
+    let body: ciborium::Value = ciborium::from_reader(&bytes[18..bytes.len() - 4]).unwrap();
+    assert_eq!(
+        serde_json::to_value(&body).unwrap()["config"]["stuck_limit"],
+        700
+    );
+    assert_eq!(
+        checkpoint::decode(&bytes).unwrap().config.world.stuck_limit,
+        Some(700)
+    );
+    // the view's URL parameter
+    let view = view::ViewSettings::default()
+        .with_query("stuck_limit=700", &Default::default(), &[])
+        .unwrap();
+    assert_eq!(limit(&view.world), 700);
+    assert!(view::settings::keys().contains(&"stuck_limit".to_string()));
+    // Python's keyword argument: the world's setting by name, as text
+    // (python/tests/test_arguments.py sees it end an episode)
+    let mut python = WorldChoices::default();
+    python.set("stuck_limit", "700").unwrap();
+    assert_eq!(limit(&python), 700);
+}

@@ -18,12 +18,12 @@ use std::sync::Arc;
 fn small(seed: u64) -> TrainConfig {
     TrainConfig {
         world: WorldChoices {
+            stuck_limit: Some(700),
             robots: Some(4),
             pucks: Some(60),
             seed,
             ..Default::default()
         },
-        stuck_limit: Some(700),
         ..TrainConfig::default()
     }
 }
@@ -163,13 +163,13 @@ fn a_noisy_run_of_the_robot_senses_on_the_tv_s_discs_resumes_exactly_from_a_form
         .join("../experiments/arenas/tv75-disc.toml");
     let noisy = TrainConfig {
         world: WorldChoices {
+            stuck_limit: Some(900),
             sensors: SensorChoice::Robot(None),
             arena: Some(sim::scenario::arena_choice::ArenaChoice::File(discs)),
             noise: 1.0,
             seed: 12,
             ..Default::default()
         },
-        stuck_limit: Some(900),
         ..TrainConfig::default()
     };
     // resumed mid-episode, with camera links, held blocks and a latency
@@ -182,6 +182,7 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
 {
     let rules = TrainConfig {
         world: WorldChoices {
+            stuck_limit: Some(800),
             walls: Some(sim::config::Walls::Clamp),
             ..small(13).world
         },
@@ -190,7 +191,6 @@ fn a_clamping_border_with_near_ties_and_batched_updates_resumes_exactly_from_a_f
             updates: host::learn::Updates::Batched,
             ..Default::default()
         },
-        stuck_limit: Some(800),
         ..small(13)
     };
     assert_eq!(resumes_exactly(rules.clone(), 1300, 2700), 4);

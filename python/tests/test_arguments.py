@@ -147,3 +147,14 @@ def test_every_world_setting_is_a_keyword_and_reaches_the_world():
         runs.append(obs)
     assert not np.array_equal(runs[0], runs[1]) and np.array_equal(runs[1], runs[2])
 
+
+
+def test_the_stuck_limit_a_world_setting_truncates_episodes_where_it_says():
+    env = zumo_swarm.vector_env(1, robots=2, pucks=5, stuck_limit=30)
+    env.reset(seed=1)
+    ends = []
+    for step in range(1, 31):
+        _, _, terminated, truncated, _ = env.step(np.zeros((1, 2), dtype=np.int64))
+        if terminated[0] or truncated[0]:
+            ends.append(step)
+    assert ends == [30]

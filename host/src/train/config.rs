@@ -51,10 +51,6 @@ pub struct TrainConfig {
     /// run length].
     #[arg(long, required = false)]
     pub steps: u64,
-    /// Steps before an unformed episode counts as stuck [default: the
-    /// field's: 150,000 on the annulus, 50,000 otherwise].
-    #[arg(long)]
-    pub stuck_limit: Option<u64>,
     /// The learner.
     #[command(flatten)]
     pub learn: LearnConfig,
@@ -176,7 +172,6 @@ impl Default for TrainConfig {
         TrainConfig {
             world: WorldChoices::default(),
             steps: DEFAULT_STEPS,
-            stuck_limit: None,
             learn: LearnConfig::default(),
             output: OutputConfig::default(),
             formation_check: FormationCheck::default(),
@@ -262,9 +257,6 @@ impl TrainConfig {
         // the scenario's errors say what kind of setting is wrong
         let mut prepared = self.scenario()?.prepare()?;
         let c = prepared.config_mut();
-        if let Some(limit) = self.stuck_limit {
-            c.episode.stuck_limit = limit;
-        }
         c.episode.check_interval = self.formation_check.every;
         c.episode.stale_eval = self.formation_check.stale;
         c.episode.success_signal = self.success;
@@ -336,9 +328,6 @@ impl TrainConfig {
     pub fn validate(&self) -> Result<()> {
         ranges::STEPS.check_count("steps", self.steps)?;
         self.world.check_ranges()?;
-        if let Some(limit) = self.stuck_limit {
-            ranges::STUCK_LIMIT.check_count("stuck_limit", limit)?;
-        }
         ranges::CHECK_INTERVAL.check_count("formation_check.every", self.formation_check.every)?;
         if let Some(discs) = self.obstacle_discs {
             ranges::DISC_RADIUS.check_as("obstacle_discs.radius", discs.radius)?;

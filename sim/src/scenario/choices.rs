@@ -69,6 +69,11 @@ pub struct WorldChoices {
     /// on a screen].
     #[cfg_attr(feature = "clap", arg(long))]
     pub walls: Option<Walls>,
+    /// Steps before an unformed episode counts as stuck [default: a screen
+    /// arena's own (15,000 on tv75), else the field's: 150,000 on the
+    /// annulus, 50,000 otherwise].
+    #[cfg_attr(feature = "clap", arg(long))]
+    pub stuck_limit: Option<u64>,
 }
 
 impl Default for WorldChoices {
@@ -84,6 +89,7 @@ impl Default for WorldChoices {
             seed: s.seed,
             noise: s.noise,
             walls: s.walls,
+            stuck_limit: s.stuck_limit,
         }
     }
 }
@@ -239,6 +245,7 @@ impl ScenarioChoices {
             sensors: w.sensors.setup()?,
             noise: w.noise,
             walls: w.walls,
+            stuck_limit: w.stuck_limit,
         })
     }
 }
@@ -275,6 +282,7 @@ mod tests {
             seed: 7,
             noise: 1.5,
             walls: Some(Walls::Segments),
+            stuck_limit: Some(3_000),
         };
         let mut again = WorldChoices::default();
         for (name, text) in world.pairs() {

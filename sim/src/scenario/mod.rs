@@ -99,6 +99,9 @@ pub struct Scenario {
     /// How the border keeps the bodies in; `None` for the arena's own
     /// ([`Walls`]: the thesis' square's default, a screen's bezel).
     pub walls: Option<Walls>,
+    /// Steps before an unformed episode counts as stuck; `None` for a
+    /// screen arena's own, else the field's ([`field_config`]).
+    pub stuck_limit: Option<u64>,
 }
 
 impl Default for Scenario {
@@ -116,6 +119,7 @@ impl Default for Scenario {
             sensors: SensorSetup::Disc,
             noise: 0.0,
             walls: None,
+            stuck_limit: None,
         }
     }
 }
@@ -230,6 +234,9 @@ impl Scenario {
         c.world.broad_phase = self.broad_phase;
         if let Some(walls) = self.walls {
             c.physics.walls = walls;
+        }
+        if let Some(limit) = self.stuck_limit {
+            c.episode.stuck_limit = limit;
         }
         // robots on a screen may show only a share of the motion noise
         let motion = match &self.arena {
