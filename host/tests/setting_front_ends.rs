@@ -64,6 +64,26 @@ fn keys(value: &Value, prefix: &str, out: &mut BTreeSet<String>) {
     }
 }
 
+/// The checkpoint of 10 steps of `config` with 2 robots and 5 pucks: its
+/// bytes, and its body (CBOR) as JSON.
+fn checkpoint_of(config: TrainConfig) -> (Vec<u8>, Value) {
+    let config = TrainConfig {
+        world: WorldChoices {
+            robots: Some(2),
+            pucks: Some(5),
+            ..config.world.clone()
+        },
+        ..config
+    };
+    let mut t = Trainer::start(config, None).unwrap();
+    t.run(10);
+    let mut bytes = Vec::new();
+    checkpoint::write_to(&mut bytes, &t.state()).unwrap();
+    let body: ciborium::Value = ciborium::from_reader(&bytes[18..bytes.len() - 4]).unwrap();
+    let body = serde_json::to_value(&body).unwrap();
+    (bytes, body)
+}
+
 /// The keys of a training settings file: the config's serde form.
 fn file_keys() -> BTreeSet<String> {
     let mut out = BTreeSet::new();
@@ -121,23 +141,7 @@ fn every_training_setting_is_a_file_key_a_flag_and_a_field_of_the_checkpoint() {
         flagged.difference(&file).collect::<Vec<_>>()
     );
     // the checkpoint's record of the settings: the same keys
-    let mut t = Trainer::start(
-        TrainConfig {
-            world: WorldChoices {
-                robots: Some(2),
-                pucks: Some(5),
-                ..Default::default()
-            },
-            ..TrainConfig::default()
-        },
-        None,
-    )
-    .unwrap();
-    t.run(10);
-    let mut bytes = Vec::new();
-    checkpoint::write_to(&mut bytes, &t.state()).unwrap();
-    let body: ciborium::Value = ciborium::from_reader(&bytes[18..bytes.len() - 4]).unwrap();
-    let body = serde_json::to_value(&body).unwrap();
+    let (_, body) = checkpoint_of(TrainConfig::default());
     let mut recorded = BTreeSet::new();
     keys(&body["config"], "", &mut recorded);
     assert_eq!(
@@ -255,26 +259,8 @@ fn the_stuck_limit_declared_only_as_a_world_setting_reaches_every_front_end_and_
     assert_eq!(flagged, filed);
     assert_eq!(limit(&filed.world), 700);
     // the checkpoint's record, and the run it resumes
-    let mut t = Trainer::start(
-        TrainConfig {
-            world: WorldChoices {
-                robots: Some(2),
-                pucks: Some(5),
-                ..filed.world.clone()
-            },
-            ..filed.clone()
-        },
-        None,
-    )
-    .unwrap();
-    t.run(10);
-    let mut bytes = Vec::new();
-    checkpoint::write_to(&mut bytes, &t.state()).unwrap();
-    let body: ciborium::Value = ciborium::from_reader(&bytes[18..bytes.len() - 4]).unwrap();
-    assert_eq!(
-        serde_json::to_value(&body).unwrap()["config"]["stuck_limit"],
-        700
-    );
+    let (bytes, body) = checkpoint_of(filed.clone());
+    assert_eq!(body["config"]["stuck_limit"], 700);
     assert_eq!(
         checkpoint::decode(&bytes).unwrap().config.world.stuck_limit,
         Some(700)
