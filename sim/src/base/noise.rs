@@ -34,7 +34,24 @@ fn mix(mut z: u64) -> u64 {
 /// A generator for one use at one place: `seed` (the world's), `purpose`,
 /// and the two coordinates of the place (episode or step, robot).
 pub fn stream(seed: u64, purpose: Purpose, a: u64, b: u64) -> Stream {
-    Stream::seeded(mix(mix(mix(seed ^ purpose as u64) ^ a) ^ b))
+    place(seed, purpose, a).stream(b)
+}
+
+/// The streams of one use at one first coordinate (a step), for any
+/// second (each robot): their hash so far, computed once for all of them.
+#[derive(Clone, Copy, Debug)]
+pub struct Place(u64);
+
+/// The streams of `purpose` at first coordinate `a` ([`stream`]'s).
+pub fn place(seed: u64, purpose: Purpose, a: u64) -> Place {
+    Place(mix(mix(seed ^ purpose as u64) ^ a))
+}
+
+impl Place {
+    /// The generator at second coordinate `b`: `stream(seed, purpose, a, b)`.
+    pub fn stream(self, b: u64) -> Stream {
+        Stream::seeded(mix(self.0 ^ b))
+    }
 }
 
 /// PCG 128/64 (XSL RR): the draws of [`crate::base::rng::SimRng`]
