@@ -34,7 +34,26 @@ fn mix(mut z: u64) -> u64 {
 /// A generator for one use at one place: `seed` (the world's), `purpose`,
 /// and the two coordinates of the place (episode or step, robot).
 pub fn stream(seed: u64, purpose: Purpose, a: u64, b: u64) -> Stream {
-    Stream::seeded(mix(mix(mix(seed ^ purpose as u64) ^ a) ^ b))
+    place(seed, purpose, a).stream(b)
+}
+
+/// The streams of one use at one first coordinate (a step), for any
+/// second (each robot): their hash so far, computed once for all of them.
+#[derive(Clone, Copy, Debug)]
+pub struct Place(u64);
+
+/// The streams of `purpose` at first coordinate `a` ([`stream`]'s).
+pub fn place(seed: u64, purpose: Purpose, a: u64) -> Place {
+    Place(mix(mix(seed ^ purpose as u64) ^ a))
+}
+
+impl Place {
+    /// The generator at second coordinate `b`: `stream(seed, purpose, a, b)`.
+    /// Inlined: a noisy robot step seeds three a robot.
+    #[inline(always)]
+    pub fn stream(self, b: u64) -> Stream {
+        Stream::seeded(mix(self.0 ^ b))
+    }
 }
 
 /// PCG 128/64 (XSL RR): the draws of [`crate::base::rng::SimRng`]
@@ -114,7 +133,9 @@ impl Stream {
 /// A standard normal draw (Irwin-Hall: 12 uniforms less 6). The uniforms
 /// are whole multiples of [`UNIT`], a power of two, so their sum rounds
 /// at the same places as the sum of the whole numbers scaled once: the
-/// same value as summing the uniforms themselves.
+/// same value as summing the uniforms themselves. Inlined into its few
+/// callers: most of a noisy step's draws were calls.
+#[inline(always)]
 pub fn normal(rng: &mut Stream) -> f64 {
     let mut sum = rng.next_whole();
     for _ in 1..12 {

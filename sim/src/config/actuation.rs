@@ -10,7 +10,7 @@
 //! step's if the period is dropped): the robot turns `(w + b) p` and drives
 //! `forward_speed f p`.
 
-use crate::base::noise::{self, Purpose};
+use crate::base::noise::{self, Place, Purpose};
 use crate::base::ranges;
 use crate::config::validate::{check, ConfigError};
 use serde::{Deserialize, Serialize};
@@ -144,10 +144,16 @@ impl ActuationNoise {
     /// Robot `robot`'s period at step `step`: its length relative to the
     /// nominal one, and whether it is dropped.
     pub fn period(&self, seed: u64, step: u64, robot: usize) -> (f64, bool) {
+        self.period_at(noise::place(seed, Purpose::Period, step), robot)
+    }
+
+    /// [`Self::period`] with the step's [`Purpose::Period`] place, which
+    /// every robot's period of the step shares.
+    pub(crate) fn period_at(&self, step: Place, robot: usize) -> (f64, bool) {
         if self.period_jitter == 0.0 && self.drop_period == 0.0 {
             return (1.0, false);
         }
-        let mut rng = noise::stream(seed, Purpose::Period, step, robot as u64);
+        let mut rng = step.stream(robot as u64);
         let length = 1.0 + self.period_jitter * noise::normal(&mut rng);
         (length, noise::chance(&mut rng, self.drop_period))
     }

@@ -68,13 +68,26 @@ impl PhotoResponse {
     /// The discharge time in microseconds over a field value `v` in [0, 1]
     /// with projector gamma `gamma`.
     pub fn discharge_us(&self, v: f64, gamma: f64) -> f64 {
-        self.discharge_of_light_us(v.clamp(0.0, 1.0).powf(gamma))
+        self.discharge_of_light_us(light(v, gamma).unwrap_or(0.0))
     }
 
     /// The discharge time under `light`, relative to full white's.
     pub(crate) fn discharge_of_light_us(&self, light: f64) -> f64 {
         let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
         1.0 / (slow + light.max(0.0) * (fast - slow))
+    }
+}
+
+/// The light `v.clamp(0, 1)^gamma` of full white at field value `v`, or
+/// `None` for none (`v` at most 0, as off the screen's frame: a quarter
+/// of the readings on `tv75`), skipping libm's `pow`, which gives a zero
+/// there: under a zero of either sign a sensor discharges in its dark time
+/// ([`PhotoResponse::discharge_of_light_us`]), whatever the gain on it.
+fn light(v: f64, gamma: f64) -> Option<f64> {
+    if v <= 0.0 {
+        None
+    } else {
+        Some(v.clamp(0.0, 1.0).powf(gamma))
     }
 }
 
@@ -327,7 +340,7 @@ impl PhotoSensors {
                 None => self.response[i].discharge_us(shown[i], self.gamma),
                 Some(n) => {
                     let light =
-                        shown[i].clamp(0.0, 1.0).powf(self.gamma) * n.grid.at(point, n.arena);
+                        light(shown[i], self.gamma).map_or(0.0, |l| l * n.grid.at(point, n.arena));
                     n.noise
                         .jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
                 }

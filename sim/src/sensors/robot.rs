@@ -25,7 +25,7 @@
 //! [`RobotSensorConfig`] (JSON, every field optional; `docs/robot-sensors.md`).
 
 use crate::base::gain_grid::GainGrid;
-use crate::base::noise::{self, Purpose};
+use crate::base::noise::{self, Place, Purpose};
 use crate::base::vec2::Vec2;
 use crate::config::validate::ConfigError;
 use crate::config::WorldConfig;
@@ -98,6 +98,8 @@ pub struct RobotSensors {
     camera: PixyCamera,
     latency_frames: u8,
     noise: RobotNoise,
+    /// Whether `noise` is other than [`RobotNoise::NONE`] (compared once).
+    noisy: bool,
     /// The screen's brightness gains and the (seed, episode) they are of.
     brightness: Option<(u64, u64, GainGrid)>,
     /// Each robot's camera link.
@@ -118,6 +120,7 @@ impl RobotSensors {
             camera: PixyCamera::new(&config.camera, world.unit_mm),
             latency_frames: config.camera.latency_frames,
             noise: config.noise.clone(),
+            noisy: config.noise != RobotNoise::NONE,
             brightness: None,
             links: Vec::new(),
             observations: Vec::new(),
@@ -149,14 +152,21 @@ impl RobotSensors {
 
     /// Robot `robot`'s observation of the world, into `observations`: its
     /// field sensors' reading, and the camera frame its link delivers.
-    fn observe(&mut self, world: &World, field: &ScalarField, robot: usize) {
-        let (seed, step, episode) = (world.state().seed, world.steps(), world.state().episode);
+    /// With noise, `step` holds the step's [`Purpose::Discharge`] and
+    /// [`Purpose::Camera`] places, which every robot's streams share;
+    /// without, it is `None`.
+    fn observe(
+        &mut self,
+        world: &World,
+        field: &ScalarField,
+        robot: usize,
+        step: Option<[Place; 2]>,
+    ) {
+        let (seed, episode) = (world.state().seed, world.state().episode);
         let (pos, direction) = (world.bodies()[robot].pos, world.robots()[robot].direction);
         let layout = world.config().field_layout();
-        let photo = if self.noise == RobotNoise::NONE {
-            self.photo.read(pos, direction, field, &layout, None)
-        } else {
-            let mut rng = noise::stream(seed, Purpose::Discharge, step, robot as u64);
+        let photo = if let Some([discharge, _]) = step {
+            let mut rng = discharge.stream(robot as u64);
             let arena = world.config().arena();
             let grid = brightness_grid(&mut self.brightness, &self.noise, seed, episode);
             let noise = PhotoNoise {
@@ -166,6 +176,8 @@ impl RobotSensors {
                 rng: &mut rng,
             };
             self.photo.read(pos, direction, field, &layout, Some(noise))
+        } else {
+            self.photo.read(pos, direction, field, &layout, None)
         };
 
         let mut capture = std::mem::take(&mut self.capture);
@@ -174,8 +186,8 @@ impl RobotSensors {
         // What reaches the robot now: the camera sends nothing when it sees
         // nothing, and a dropped frame does not arrive. Without noise there
         // is nothing to draw (the noise draws none at zero amounts).
-        let arrives = self.noise == RobotNoise::NONE || {
-            let mut rng = noise::stream(seed, Purpose::Camera, step, robot as u64);
+        let arrives = step.is_none_or(|[_, camera]| {
+            let mut rng = camera.stream(robot as u64);
             self.noise.perturb_frame(
                 &mut capture,
                 classify.puck_signature,
@@ -183,7 +195,7 @@ impl RobotSensors {
                 &mut rng,
             );
             !noise::chance(&mut rng, self.noise.frame_drop)
-        };
+        });
         let link = &mut self.links[robot];
         if link.episode != episode {
             *link = CameraMemory {
@@ -229,8 +241,12 @@ impl SensorModel for RobotSensors {
         self.links.resize(robots, CameraMemory::default());
         self.observations
             .resize(robots, RobotObservation::default());
+        let (seed, step) = (world.state().seed, world.steps());
+        let places = self
+            .noisy
+            .then(|| [Purpose::Discharge, Purpose::Camera].map(|p| noise::place(seed, p, step)));
         for (i, reading) in out.iter_mut().enumerate().take(robots) {
-            self.observe(world, field, i);
+            self.observe(world, field, i, places);
             *reading = self.observations[i].reading;
         }
     }

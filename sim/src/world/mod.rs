@@ -7,8 +7,10 @@
 //!
 //! Room 5 of the simulator (`lib.rs`), the first stage of a step (**world** -> physics -> sensors -> control): it owns the bodies and calls physics to move them.
 
+use crate::base::noise::{self, Purpose};
 use crate::base::rng::SimRng;
 use crate::base::vec2::Vec2;
+use crate::config::actuation::RobotMotion;
 use crate::config::validate::ConfigError;
 use crate::config::{PhysicsConfig, SimConfig, WorldConfig};
 use crate::physics::body::{Body, Robot, RobotKind};
@@ -54,6 +56,10 @@ pub struct World {
     scratch: PhysicsScratch,
     /// Each robot's forward speed of the step (with actuation noise).
     scratch_speeds: Vec<f64>,
+    /// Each robot's motion of the episode
+    /// ([`crate::config::actuation::ActuationNoise::motion`]),
+    /// drawn when the episode begins rather than every step.
+    motions: Vec<RobotMotion>,
 }
 
 impl World {
@@ -83,11 +89,13 @@ impl World {
     pub fn from_state(state: WorldState) -> World {
         let index = index_of(&state);
         let scratch = PhysicsScratch::new(&state.bodies, state.robots.len());
+        let motions = motions_of(&state);
         World {
             state,
             index,
             scratch,
             scratch_speeds: Vec::new(),
+            motions,
         }
     }
 
@@ -141,6 +149,7 @@ impl World {
         s.last_turns.clear();
         self.index = index_of(s);
         self.scratch = PhysicsScratch::new(&s.bodies, s.robots.len());
+        self.motions = motions_of(s);
     }
 
     /// Turns every robot by its angular speed (radians, positive = right),
@@ -181,9 +190,10 @@ impl World {
         let actuation = &s.config.actuation;
         s.last_turns.resize(s.robots.len(), 0.0);
         self.scratch_speeds.resize(s.robots.len(), 0.0);
+        let step = noise::place(s.seed, Purpose::Period, s.steps);
         for (i, robot) in s.robots.iter_mut().enumerate() {
-            let motion = actuation.motion(s.seed, s.episode, i);
-            let (length, dropped) = actuation.period(s.seed, s.steps, i);
+            let motion = self.motions[i];
+            let (length, dropped) = actuation.period_at(step, i);
             let commanded = turns.get(i).copied().unwrap_or(0.0);
             let turn = if dropped { s.last_turns[i] } else { commanded };
             s.last_turns[i] = turn;
@@ -317,6 +327,14 @@ impl World {
 pub(crate) fn disc_overlaps(centre: Vec2, radius: f64, pos: Vec2, circle_radius: f64) -> bool {
     let r = radius + circle_radius;
     (pos - centre).length_squared() < r * r
+}
+
+/// Each robot's motion in a state's episode.
+fn motions_of(state: &WorldState) -> Vec<RobotMotion> {
+    let actuation = &state.config.actuation;
+    (0..state.robots.len())
+        .map(|i| actuation.motion(state.seed, state.episode, i))
+        .collect()
 }
 
 /// A fresh neighbour index of a state's bodies.
