@@ -158,6 +158,28 @@ fn url_parameters_set_the_simulation_and_the_address_bar_keeps_them() {
 }
 
 #[test]
+fn a_world_setting_the_page_has_no_control_of_its_own_for_gets_a_field_that_sets_it() {
+    let address = serve(small(2), true, Speed::Real);
+    let mut page = Browser::open(&format!("http://{address}/"), SIZE);
+    page.wait_for("document.documentElement.dataset.ready === 'true'", 60);
+    // the stuck limit: a world setting the page's markup does not name
+    page.eval("const f = document.getElementById('settings'); f.elements.stuck_limit.value = '700'; f.requestSubmit()");
+    page.wait_for(
+        "new URLSearchParams(location.search).get('stuck_limit') === '700'",
+        30,
+    );
+    let settings = state(address)["hello"]["settings"].clone();
+    assert!(
+        settings
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|pair| pair == &serde_json::json!(["stuck_limit", "700"])),
+        "{settings}"
+    );
+}
+
+#[test]
 fn a_bad_setting_or_policy_file_is_refused_with_a_message_and_nothing_else_changes() {
     let address = serve(small(4), true, Speed::Real);
     let mut page = Browser::open(&format!("http://{address}/"), SIZE);
