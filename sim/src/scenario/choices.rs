@@ -6,6 +6,7 @@
 //! ([`rule_pucks`]).
 
 use crate::base::ranges::{self, RangeError};
+use crate::config::validate::ConfigError;
 use crate::config::{BroadPhase, Walls};
 use crate::fields::source::FieldSource;
 use crate::scenario::arena_choice::ArenaChoice;
@@ -228,11 +229,13 @@ pub struct ScenarioChoices {
 }
 
 impl ScenarioChoices {
-    /// The scenario, arena and sensor files read and checked (the counts,
-    /// noise and settings are checked when it is prepared or built); on a
+    /// The scenario, its numeric settings checked against their ranges
+    /// ([`WorldChoices::check_ranges`]) and its arena and sensor files read
+    /// and checked (the rest is checked when it is prepared or built); on a
     /// screen arena the puck count left unset is the puck rule's.
     pub fn scenario(&self) -> Result<Scenario, ScenarioError> {
         let w = &self.world;
+        w.check_ranges().map_err(ConfigError::from)?;
         let arena = w.arena_choice().arena()?;
         Ok(Scenario {
             field: w.field.clone(),
