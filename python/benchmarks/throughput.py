@@ -93,18 +93,28 @@ def zumo_rate(scale: Scale, worlds: int, threads: int, warm: int) -> tuple[float
     return steps / wall, steps / cpu
 
 
-def world_bytes(python: str, scale: Scale) -> float:
-    """Bytes of memory one world holds: the peak resident memory of a
-    process that built and stepped many worlds, less that of one with few,
-    per extra world. The peak is the process's own (`VmHWM`, which a new
-    program starts afresh; `ru_maxrss` would keep this process's, which
-    the child was forked from)."""
+# The puck count of the second memory measurement: a world's bytes less
+# those of one with this many pucks are its pucks' share.
+FEW_PUCKS = 5
+# The standard configuration's pucks, which every vector_env row steps.
+STANDARD_PUCKS = 250
+
+
+def world_bytes(python: str, scale: Scale, pucks: int | None = None) -> float:
+    """Bytes of memory one world holds (of `pucks` pucks, else the
+    standard configuration's): the peak resident memory of a process that
+    built and stepped many worlds, less that of one with few, per extra
+    world. The peak is the process's own (`VmHWM`, which a new program
+    starts afresh; `ru_maxrss` would keep this process's, which the child
+    was forked from)."""
     script = ("import re, sys, numpy as np, zumo_swarm\n"
-              "w = int(sys.argv[1]); env = zumo_swarm.vector_env(w, threads=1); env.reset(seed=1)\n"
+              "w = int(sys.argv[1]); p = {} if sys.argv[2] == 'standard' else {'pucks': int(sys.argv[2])}\n"
+              "env = zumo_swarm.vector_env(w, threads=1, **p); env.reset(seed=1)\n"
               "for _ in range(5): env.step(np.zeros((w, 8), dtype=np.int64))\n"
               "print(re.search(r'VmHWM:\\s*(\\d+) kB', open('/proc/self/status').read()).group(1))")
     few, many = scale.memory_worlds
-    kib = [int(subprocess.run([python, "-c", script, str(w)], capture_output=True, text=True, check=True).stdout)
+    kib = [int(subprocess.run([python, "-c", script, str(w), str(pucks or "standard")], capture_output=True,
+                              text=True, check=True).stdout)
            for w in (few, many)]
     return (kib[1] - kib[0]) * 1024 / (many - few)
 
@@ -228,6 +238,7 @@ def measure(args) -> dict:
         "load_average": load,
         "versions": versions,
         "bytes_per_world": world_bytes(sys.executable, scale),
+        "bytes_per_world_few_pucks": [FEW_PUCKS, world_bytes(sys.executable, scale, FEW_PUCKS)],
         "memory_worlds": list(scale.memory_worlds),
         "rows": [{k: v for k, v in row.items() if k != "run"} for row in rows],
     }
@@ -275,6 +286,11 @@ def render(results: dict) -> str:
     lines.append(
         f"A world holds about {world / 1024:,.0f} KB (peak resident memory of {many:,} worlds less that of {few:,}, "
         f"per world): {512 * world / 2**20:,.0f} MB for 512 worlds, {4096 * world / 2**20:,.0f} MB for 4,096.")
+    if "bytes_per_world_few_pucks" in results:
+        pucks, small = results["bytes_per_world_few_pucks"]
+        per_puck = (world - small) / (STANDARD_PUCKS - pucks)
+        lines[-1] += (f" With {pucks} pucks instead of {STANDARD_PUCKS} a world holds about {small / 1024:,.0f} KB: "
+                      f"about {per_puck:,.0f} bytes a puck, the rest the world's own.")
     lines.append("")
     lines.extend(verdicts(rows))
     return "\n".join(lines) + "\n"

@@ -52,6 +52,8 @@ def test_the_throughput_benchmark_runs_every_configuration_at_a_tiny_scale(repo,
     rows = results["rows"]
     assert all(len(row["runs"]) == 1 and row["runs"][0] > 0 and row["cpu_runs"][0] > 0 for row in rows)
     assert results["bytes_per_world"] > 0, "more worlds hold more memory"
+    pucks, few = results["bytes_per_world_few_pucks"]
+    assert 0 < few < results["bytes_per_world"], f"a world of {pucks} pucks holds less than one of 250"
     scale = throughput.Scale(tiny=True)
     for worlds in scale.worlds:
         for threads in {1, max(row.get("threads", 1) for row in rows)}:
