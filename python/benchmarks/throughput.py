@@ -133,10 +133,11 @@ def host_rate(host: str, args: list[str], steps: int) -> tuple[float, float]:
     return rate, steps / cpu
 
 
-def vmas_run(python: str, args: list[str]) -> dict:
-    """The JSON object vmas_steps.py prints for `args`."""
+def vmas_rate(python: str, args: list[str]) -> tuple[float, float]:
+    """vmas_steps.py's steps per second and per CPU-second for `args`."""
     cmd = [python, str(VMAS), *args]
-    return json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.splitlines()[-1])
+    result = json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.splitlines()[-1])
+    return result["steps_per_second"], result["steps_per_cpu_second"]
 
 
 def vmas_versions(python: str) -> dict:
@@ -197,8 +198,7 @@ def configurations(host: str, vmas_python: str | None, scale: Scale) -> list[dic
                 rows.append({
                     "name": vmas_name(scenario, envs, threads), "command": "vmas_steps.py " + " ".join(args),
                     "side": "vmas", "scenario": scenario, "worlds": envs, "threads": threads,
-                    "run": lambda a=args: (lambda r: (r["steps_per_second"], r["steps_per_cpu_second"]))(
-                        vmas_run(vmas_python, a)),
+                    "run": lambda a=args: vmas_rate(vmas_python, a),
                 })
     return rows
 

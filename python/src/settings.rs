@@ -17,6 +17,7 @@ use sim::scenario::arena_choice::ArenaChoice;
 use sim::scenario::choices::{ScenarioChoices, WorldChoices};
 use sim::scenario::sensor_choice::SensorChoice;
 use sim::scenario::sensor_setup::SensorSetup;
+use sim::scenario::trained_for;
 use sim::scenario::{Arena, ControllerChoice, PreparedScenario, ScenarioError};
 use sim::sensors::robot::RobotSensorConfig;
 use std::fmt;
@@ -410,6 +411,8 @@ impl EnvArgs {
                 .set(name, text)
                 .map_err(|e| ArgumentError::new(&e.name, format!("{:?}", e.value), e.problem))?;
         }
+        // What a policy exported from here records, as `host train`'s does.
+        let trained_for = trained_for::trained_for(&world.sensors, &world.arena_choice());
         // Random is the controller whose settings leave every robot an
         // outie, as the trainer has them; the environment never uses it.
         let mut scenario = ScenarioChoices {
@@ -421,11 +424,6 @@ impl EnvArgs {
         if let Some(setup) = robot_setup {
             scenario.sensors = setup;
         }
-        // The arena's name, as `host train` records it in a blob.
-        let arena_name = match &scenario.arena {
-            Arena::Square(_) => "thesis".to_string(),
-            Arena::Screen(spec) => spec.name.clone(),
-        };
         // The arena's counts where none are given.
         let (default_robots, default_pucks) = match &scenario.arena {
             Arena::Square(_) => (
@@ -465,13 +463,6 @@ impl EnvArgs {
         config
             .validate()
             .map_err(|e| SettingsError::Scenario(ScenarioError::Config(e)))?;
-        let trained_for = shared::TrainedFor::new(&self.sensors, &arena_name).map_err(|e| {
-            ArgumentError::new(
-                "sensors, arena",
-                format!("{:?}", self.sensors),
-                e.to_string(),
-            )
-        })?;
         Ok(EnvSettings {
             prepared,
             seed,
