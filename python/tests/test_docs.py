@@ -3,7 +3,9 @@ measured: docs/python-examples.md the example files verbatim,
 docs/python-results.md the learning tables rendered from their results
 files, docs/performance.md the throughput table and docs/python.md the
 comparison with VMAS rendered from the results file of the benchmark
-(python/benchmarks/throughput.py), which also runs here at a tiny scale."""
+(python/benchmarks/throughput.py), which also runs here at a tiny scale,
+and docs/performance.md the cache lines a step fetches
+(python/benchmarks/cache_lines.py)."""
 
 import argparse
 import importlib.util
@@ -31,6 +33,22 @@ def test_the_throughput_table_is_rendered_from_the_measured_results(repo):
     throughput = benchmark(repo, "throughput")
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
     assert table in (repo / "docs" / "performance.md").read_text(), "docs/performance.md does not hold the rendered table"
+
+
+def test_the_cache_line_table_is_rendered_from_the_counts_and_what_the_docs_say_of_it_holds(repo):
+    cache_lines = benchmark(repo, "cache_lines")
+    results = json.loads((repo / "docs" / "python-cache-lines.json").read_text())
+    assert cache_lines.render(results) in (repo / "docs" / "performance.md").read_text(), \
+        "docs/performance.md does not hold the rendered cache-line table"
+    rows = {row["worlds"]: row for row in results["rows"]}
+    instructions = [row["instructions"] for row in rows.values()]
+    assert max(instructions) < 1.1 * min(instructions), "the instructions stay within a tenth of each other"
+    for worlds, row in rows.items():
+        assert 200 <= row["first_level_misses"] <= 250, f"about 225 first-level misses at {worlds} worlds"
+        if worlds >= 128:
+            assert row["second_level_misses"] >= 0.8 * row["first_level_misses"], \
+                f"nearly all also miss the second level at {worlds} worlds"
+            assert 11_000 <= row["second_level_misses"] * 64 <= 13_000, f"about 12 KB a step at {worlds} worlds"
 
 
 def test_the_comparison_with_vmas_is_rendered_from_the_measured_results_of_the_pinned_version(repo):
