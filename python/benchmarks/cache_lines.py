@@ -17,7 +17,6 @@ third level or memory. Counts do not feel the machine's load.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import re
@@ -25,6 +24,8 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import results_file  # beside this script
 
 # World counts of the throughput benchmark's comparison, and two between.
 WORLDS = [64, 128, 256, 512, 1024]
@@ -126,18 +127,9 @@ def main() -> None:
     parser.add_argument("--timed", type=int, default=TIMED_STEPS)
     parser.add_argument("--out", help="results file to write (JSON)")
     args = parser.parse_args()
-    if args.render:
-        print(render(json.loads(Path(args.render).read_text())), end="")
-        return
     if min(args.worlds) < 1 or args.warm < 0 or args.timed < 1:
         parser.error("--worlds must be at least 1, --warm at least 0 and --timed at least 1")
-    results = measure(args)
-    text = json.dumps(results, indent=1) + "\n"
-    if args.out:
-        tmp = Path(args.out + ".tmp")
-        tmp.write_text(text)
-        os.replace(tmp, args.out)
-    print(render(results), end="")
+    results_file.render_or_measure(args, measure, render)
 
 
 if __name__ == "__main__":

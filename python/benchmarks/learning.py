@@ -25,6 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import results_file  # beside this script
+
 HERE = Path(__file__).resolve().parent
 
 
@@ -170,15 +172,7 @@ def main() -> None:
     p.add_argument("--no-neural", dest="neural", action="store_false")
     p.add_argument("--out", default="docs/python-learning.json")
     args = p.parse_args()
-    if args.render:
-        print(render(json.loads(Path(args.render).read_text())), end="")
-        return
-    results = run(args)
-    out = Path(args.out)
-    tmp = out.with_suffix(".tmp")
-    tmp.write_text(json.dumps(results, indent=1) + "\n")
-    os.replace(tmp, out)
-    print(render(results), end="")
+    results_file.render_or_measure(args, run, render)
 
 
 if __name__ == "__main__":

@@ -31,6 +31,8 @@ import sys
 import time
 from pathlib import Path
 
+import results_file  # beside this script
+
 HERE = Path(__file__).resolve().parent
 VMAS = HERE / "vmas_steps.py"
 # The VMAS release compared with: `measure` refuses another.
@@ -373,17 +375,10 @@ def main() -> None:
     parser.add_argument("--tiny", action="store_true", help="every step of the method at a test's scale")
     parser.add_argument("--out", help="results file to write (JSON)")
     args = parser.parse_args()
-    if args.render or args.render_vmas:
-        results = json.loads(Path(args.render or args.render_vmas).read_text())
-        print((render if args.render else render_vmas)(results), end="")
+    if args.render_vmas:
+        print(render_vmas(json.loads(Path(args.render_vmas).read_text())), end="")
         return
-    results = measure(args)
-    text = json.dumps(results, indent=1) + "\n"
-    if args.out:
-        tmp = Path(args.out + ".tmp")
-        tmp.write_text(text)
-        os.replace(tmp, args.out)
-    print(render(results), end="")
+    results_file.render_or_measure(args, measure, render)
 
 
 if __name__ == "__main__":

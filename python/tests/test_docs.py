@@ -10,12 +10,16 @@ and docs/performance.md the cache lines a step fetches
 import argparse
 import importlib.util
 import json
+import sys
 
 import pytest
 
 
 def benchmark(repo, name):
     """The module of python/benchmarks/NAME.py (not a package: loaded from its file)."""
+    here = str(repo / "python" / "benchmarks")
+    if here not in sys.path:
+        sys.path.insert(0, here)  # the benchmarks import their sibling results_file
     spec = importlib.util.spec_from_file_location(name, repo / "python" / "benchmarks" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
