@@ -282,12 +282,20 @@ pub(crate) struct PhotoSensors {
     ideal: bool,
     calibration: FieldCalibration,
     scales: FieldScales,
+    /// Each sensor's calibrated value of every reading a discharge can
+    /// give (`0..=RC_TIMEOUT_TICKS`): `scales`' arithmetic done once, so
+    /// that a reading is one load.
+    values_of_ticks: Box<[[FieldValue; READINGS]; 3]>,
 }
+
+/// The readings a discharge can give: whole ticks up to the timeout.
+const READINGS: usize = RC_TIMEOUT_TICKS as usize + 1;
 
 impl PhotoSensors {
     /// The sensors of `config` on the robots of `world`.
     pub fn new(config: &PhotoSensorConfig, world: &WorldConfig) -> PhotoSensors {
         let calibration = config.calibration();
+        let scales = calibration.scales();
         let unit_mm = world.unit_mm;
         PhotoSensors {
             points: config
@@ -298,7 +306,10 @@ impl PhotoSensors {
             latency_us: config.poll_latency_us,
             ideal: config.ideal,
             calibration,
-            scales: calibration.scales(),
+            scales,
+            values_of_ticks: Box::new(std::array::from_fn(|i| {
+                std::array::from_fn(|t| scales.0[i].value(t as u16))
+            })),
         }
     }
 
@@ -350,7 +361,8 @@ impl PhotoSensors {
         r.values = if self.ideal {
             shown.map(|v| FieldValue::from_f32(v as f32))
         } else {
-            self.scales.values(&r.ticks)
+            // Ticks are at most the timeout (`quantise_us`).
+            std::array::from_fn(|i| self.values_of_ticks[i][usize::from(r.ticks[i])])
         };
         r
     }
@@ -420,6 +432,20 @@ mod tests {
         let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100, None);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
+    }
+
+    #[test]
+    fn a_reading_s_tabulated_value_is_the_firmware_arithmetic_on_its_ticks() {
+        let mut config = PhotoSensorConfig::default();
+        for (bright_us, dark_us) in [(150.0, 1700.0), (40.0, 1990.0), (900.0, 2400.0)] {
+            config.response[1] = PhotoResponse { bright_us, dark_us };
+            let sensors = PhotoSensors::new(&config, &WorldConfig::default());
+            for t in 0..=RC_TIMEOUT_TICKS {
+                let ticks = [t; 3];
+                let tabulated = std::array::from_fn(|i| sensors.values_of_ticks[i][usize::from(t)]);
+                assert_eq!(tabulated, sensors.values(&ticks), "{t} ticks");
+            }
+        }
     }
 
     #[test]
