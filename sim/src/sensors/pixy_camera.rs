@@ -995,16 +995,19 @@ fn outline_box(
         pf[k] = c.ahead + offset.dot(lens.ahead);
         across[k] = camera.fx * (c.side + offset.dot(lens.right));
     }
+    // A point's depth, `pf cos_tilt - up sin_tilt`, rounds monotonically
+    // in `pf` (cos_tilt > 0, the tilt staying within 90 degrees): each
+    // rim's least depth is the least `pf`'s (the one row, twice).
+    let nearest = halving_16(&[pf, pf], |a, b| if a < b { a } else { b });
     let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
     for (rim, z) in [0.0, c.height].into_iter().enumerate() {
         let up = z - camera.height;
+        if nearest * camera.cos_tilt - up * camera.sin_tilt < camera.near {
+            return None;
+        }
         let mut depth = [0.0; WEDGE_POINTS];
         for k in 0..WEDGE_POINTS {
             depth[k] = pf[k] * camera.cos_tilt - up * camera.sin_tilt;
-        }
-        // the least depth (the one row, twice)
-        if halving_16(&[depth, depth], |a, b| if a < b { a } else { b }) < camera.near {
-            return None;
         }
         for k in 0..WEDGE_POINTS {
             let down = -pf[k] * camera.sin_tilt - up * camera.cos_tilt;
