@@ -146,7 +146,7 @@ impl Outline {
     }
 
     /// [`Outline::pair_depth`], but stopping as soon as the depth is known
-    /// to be at most `stop`, with a depth at most `stop` (for a pair that
+    /// to be at most `stop` (below infinity), with a depth at most `stop` (for a pair that
     /// does not touch, the first normal tried, along the centre line,
     /// often shows it).
     pub fn pair_depth_until(
@@ -195,13 +195,16 @@ fn hull_depth_until<const N: usize>(
             - delta.dot(n)
     };
     let mut best = (f64::INFINITY, Vec2::new(1.0, 0.0));
-    // Whether the search can stop.
+    // Whether the search can stop: the least value so far is at most
+    // `stop`, which it can newly be only when a candidate lowers it (for
+    // a `stop` below infinity, as every caller's is).
     let mut consider = |n: Vec2| {
         let v = value(n);
         if v < best.0 {
             best = (v, n);
+            return v <= stop;
         }
-        best.0 <= stop
+        false
     };
     for &(c, _) in circles {
         let w = delta - c;

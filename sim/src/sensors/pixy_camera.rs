@@ -369,6 +369,47 @@ pub(crate) struct PixyCamera {
     avx2: bool,
     /// The points of the last wedge-fronted robots seen.
     wedge: Option<WedgePoints>,
+    /// The search box's sizes for the last bodies' largest radius.
+    span: Option<SearchSpan>,
+}
+
+/// The sizes of [`PixyCamera::search_box`] that depend on the camera and
+/// the bodies' largest radius alone (found once, not every frame).
+#[derive(Clone, Copy, Debug)]
+struct SearchSpan {
+    max_radius: f64,
+    /// How far behind the lens the widened view cone's apex lies.
+    behind: f64,
+    /// How far from the lens a body the culls keep can lie.
+    reach: f64,
+    /// The sector's radius from the apex.
+    radius: f64,
+    /// The box's padding.
+    pad: f64,
+    /// Half the cone's width where the culls' `ahead >= -r` cuts it.
+    half_width: f64,
+}
+
+impl SearchSpan {
+    /// The sizes for `camera` and bodies up to `max_radius`.
+    fn new(camera: &PixyCamera, max_radius: f64) -> SearchSpan {
+        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
+        // for every r <= max_radius and h <= the taller body lies inside the
+        // cone from the apex ...
+        let tallest = camera.puck_height.max(camera.robot_height);
+        let behind = max_radius + camera.height + tallest + max_radius / camera.tan_half_h;
+        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
+        let reach = camera.max_range + max_radius;
+        let radius = reach + behind;
+        SearchSpan {
+            max_radius,
+            behind,
+            reach,
+            radius,
+            pad: radius * 1e-6,
+            half_width: (camera.height + tallest) * camera.tan_half_h + max_radius,
+        }
+    }
 }
 
 /// Lanes of a wedge's outline points the camera projects
@@ -464,6 +505,7 @@ impl PixyCamera {
             merged: Vec::new(),
             avx2: has_avx2(),
             wedge: None,
+            span: None,
         }
     }
 
@@ -521,7 +563,12 @@ impl PixyCamera {
     /// silhouette, nearest first (ties by body index).
     fn gather_in_view(&mut self, world: &World, robot: usize) {
         let lens = Lens::of(world, robot, self.forward);
-        let (min, max) = self.search_box(&lens, world.config().max_radius());
+        let max_radius = world.config().max_radius();
+        let span = match self.span {
+            Some(span) if span.max_radius == max_radius => span,
+            _ => *self.span.insert(SearchSpan::new(self, max_radius)),
+        };
+        let (min, max) = self.search_box(&lens, &span);
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
         let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
@@ -557,23 +604,15 @@ impl PixyCamera {
     }
 
     /// A box of the world holding the centre of every body that
-    /// [`Self::candidate`] passes, for bodies up to `max_radius`: the
+    /// [`Self::candidate`] passes, for bodies up to `span.max_radius`: the
     /// sector from the apex of the widened view cone (half the horizontal
     /// field of view each side) that reaches as far as the range does, cut
     /// off `max_radius` behind the lens, within the range's square around
     /// the lens, padded by a millionth of its radius, far more than the
     /// culls' rounding.
-    fn search_box(&self, lens: &Lens, max_radius: f64) -> (Vec2, Vec2) {
-        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
-        // for every r <= max_radius and h <= the taller body lies inside the
-        // cone from `apex` ...
-        let tallest = self.puck_height.max(self.robot_height);
-        let behind = max_radius + self.height + tallest + max_radius / self.tan_half_h;
-        let apex = lens.pos - lens.ahead * behind;
-        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
-        let reach = self.max_range + max_radius;
-        let radius = reach + behind;
-        let pad = radius * 1e-6;
+    fn search_box(&self, lens: &Lens, span: &SearchSpan) -> (Vec2, Vec2) {
+        let (max_radius, radius, pad) = (span.max_radius, span.radius, span.pad);
+        let apex = lens.pos - lens.ahead * span.behind;
         let (min, max) = (
             |a: f64, b: f64| if a < b { a } else { b },
             |a: f64, b: f64| if a > b { a } else { b },
@@ -581,7 +620,7 @@ impl PixyCamera {
         // The cone's corners where the culls' `ahead >= -r` cuts it, and
         // where its edges meet the arc.
         let back = lens.pos - lens.ahead * max_radius;
-        let half_width = (self.height + tallest) * self.tan_half_h + max_radius;
+        let half_width = span.half_width;
         let edge = |sign: f64| {
             apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius
         };
@@ -612,7 +651,7 @@ impl PixyCamera {
         if -a.y >= c {
             low.y = apex.y - radius;
         }
-        let square = Vec2::new(reach, reach);
+        let square = Vec2::new(span.reach, span.reach);
         let (near, far) = (lens.pos - square, lens.pos + square);
         let padding = Vec2::new(pad, pad);
         (
@@ -1702,7 +1741,7 @@ mod tests {
                     ahead,
                     right: Vec2::new(-ahead.y, ahead.x),
                 };
-                let (min, max) = camera.search_box(&lens, robot_r);
+                let (min, max) = camera.search_box(&lens, &SearchSpan::new(&camera, robot_r));
                 for k in 0..2000 {
                     let (radius, body) = if k % 2 == 0 {
                         (robot_r, 1)
