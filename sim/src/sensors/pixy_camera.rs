@@ -39,7 +39,9 @@
 
 use crate::base::ranges;
 use crate::base::vec2::Vec2;
+use crate::config::robot_shape::RobotShape;
 use crate::config::validate::{check, ConfigError};
+use crate::config::WorldConfig;
 use crate::physics::grid::Neighbour;
 use crate::physics::outline::Outline;
 use crate::world::World;
@@ -367,10 +369,32 @@ pub(crate) struct PixyCamera {
     merged: Vec<Blob>,
     /// Whether the processor has AVX2 ([`PixyCamera::silhouette`]).
     avx2: bool,
-    /// The points of the last wedge-fronted robots seen.
+    /// What the last world's bodies' shapes give the camera.
+    shapes: Option<BodyShapes>,
+}
+
+/// What the camera derives from a world's bodies' shapes, found once per
+/// world rather than every frame.
+#[derive(Clone, Debug)]
+struct BodyShapes {
+    /// The robots' shape and radius and the pucks' radius they are of.
+    of: (RobotShape, f64, f64),
+    /// The wedge-fronted robots' points (none for discs).
     wedge: Option<WedgePoints>,
-    /// The search box's sizes for the last bodies' largest radius.
-    span: Option<SearchSpan>,
+    /// The search box's sizes.
+    span: SearchSpan,
+}
+
+impl BodyShapes {
+    /// The shapes of `world`'s bodies as `camera` sees them.
+    fn new(camera: &PixyCamera, world: &WorldConfig) -> BodyShapes {
+        let outline = Outline::of(world.robot_shape, world.robot_radius);
+        BodyShapes {
+            of: (world.robot_shape, world.robot_radius, world.puck_radius),
+            wedge: outline.map(|o| WedgePoints::new(&o, &camera.rim_ahead, &camera.rim_right)),
+            span: SearchSpan::new(camera, world.max_radius()),
+        }
+    }
 }
 
 /// The sizes of [`PixyCamera::search_box`] that depend on the camera and
@@ -414,7 +438,9 @@ impl SearchSpan {
 
 /// Lanes of a wedge's outline points the camera projects
 /// ([`PixyCamera::outline_silhouette`]): at most `RIM_POINTS + 3` points,
-/// in a power of two for [`halving_16`].
+/// in a power of two for [`halving_16`]. Outlines of at most
+/// [`RIM_POINTS`] points (tips between `r / cos 30` and `r / cos 60` from
+/// the centre, as on `tv75`) are projected in that many lanes.
 const WEDGE_POINTS: usize = 16;
 const _: () = assert!(RIM_POINTS + 3 <= WEDGE_POINTS);
 
@@ -423,9 +449,11 @@ const _: () = assert!(RIM_POINTS + 3 <= WEDGE_POINTS);
 /// points that lie on its round back, then the tip again in the lanes left.
 #[derive(Clone, Copy, Debug)]
 struct WedgePoints {
-    outline: Outline,
     ahead: [f64; WEDGE_POINTS],
     right: [f64; WEDGE_POINTS],
+    /// Whether the points fit in the first [`RIM_POINTS`] lanes (the
+    /// others then repeat the tip, which adds nothing to a silhouette).
+    fit_rim_lanes: bool,
 }
 
 impl WedgePoints {
@@ -439,19 +467,22 @@ impl WedgePoints {
         let r = outline.radius();
         let t = outline.tangent_point();
         let mut points = WedgePoints {
-            outline: *outline,
             ahead: [outline.tip(); WEDGE_POINTS],
             right: [0.0; WEDGE_POINTS],
+            fit_rim_lanes: false,
         };
         let on_back = (0..RIM_POINTS)
             .filter(|&k| rim_ahead[k] * r < t.x)
             .map(|k| Vec2::new(rim_ahead[k], rim_right[k]) * r);
         // after the tip in lane 0
         let sides = [t, Vec2::new(t.x, -t.y)];
+        let mut lanes = 1;
         for (n, p) in (1..).zip(sides.into_iter().chain(on_back)) {
             points.ahead[n] = p.x;
             points.right[n] = p.y;
+            lanes = n + 1;
         }
+        points.fit_rim_lanes = lanes <= RIM_POINTS;
         points
     }
 }
@@ -504,8 +535,7 @@ impl PixyCamera {
             blobs: Vec::new(),
             merged: Vec::new(),
             avx2: has_avx2(),
-            wedge: None,
-            span: None,
+            shapes: None,
         }
     }
 
@@ -563,19 +593,16 @@ impl PixyCamera {
     /// silhouette, nearest first (ties by body index).
     fn gather_in_view(&mut self, world: &World, robot: usize) {
         let lens = Lens::of(world, robot, self.forward);
-        let max_radius = world.config().max_radius();
-        let span = match self.span {
-            Some(span) if span.max_radius == max_radius => span,
-            _ => *self.span.insert(SearchSpan::new(self, max_radius)),
-        };
-        let (min, max) = self.search_box(&lens, &span);
+        let config = world.config();
+        let of = (config.robot_shape, config.robot_radius, config.puck_radius);
+        if self.shapes.as_ref().is_none_or(|shapes| shapes.of != of) {
+            self.shapes = Some(BodyShapes::new(self, config));
+        }
+        let shapes = self.shapes.as_ref().expect("set just above");
+        let (min, max) = self.search_box(&lens, &shapes.span);
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
-        let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
-        if outline != self.wedge.as_ref().map(|w| w.outline) {
-            self.wedge = outline.map(|o| WedgePoints::new(&o, &self.rim_ahead, &self.rim_right));
-        }
-        let wedge = self.wedge.as_ref();
+        let wedge = shapes.wedge.as_ref();
         let robots = world.robots().len();
         world.any_body_in_box(min, max, |row| {
             for b in row {
@@ -744,7 +771,7 @@ impl PixyCamera {
 
     /// The clipped pixel box of a wedge-fronted robot, candidate `c`,
     /// facing `facing` ([`outline_box`], or [`outline_box_avx2`] on
-    /// processors with AVX2).
+    /// processors with AVX2), in [`RIM_POINTS`] lanes if its points fit.
     #[inline(always)]
     fn outline_silhouette(
         &self,
@@ -753,12 +780,23 @@ impl PixyCamera {
         facing: Vec2,
         wedge: &WedgePoints,
     ) -> Option<Rect> {
+        let robot = (c, lens, facing, wedge);
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only when the processor has AVX2.
-            return unsafe { outline_box_avx2(self, (c, lens, facing, wedge)) };
+            return unsafe {
+                if wedge.fit_rim_lanes {
+                    outline_box_avx2::<RIM_POINTS>(self, robot)
+                } else {
+                    outline_box_avx2::<WEDGE_POINTS>(self, robot)
+                }
+            };
         }
-        outline_box_any(self, (c, lens, facing, wedge))
+        if wedge.fit_rim_lanes {
+            outline_box_any::<RIM_POINTS>(self, robot)
+        } else {
+            outline_box_any::<WEDGE_POINTS>(self, robot)
+        }
     }
 
     /// Stage 2: each body's still visible part after the nearer ones'
@@ -1014,22 +1052,26 @@ projection!(#[target_feature(enable = "avx2")] #[inline(never)] unsafe ; project
 /// points at the bottom and the top, `wedge`'s). `None` if it is out
 /// of the image or reaches behind the image plane. A robot or two a
 /// frame: each point's place ahead of and beside the lens is found
-/// once for both rims, and the lanes keep to fixed-size arrays.
+/// once for both rims, and the lanes keep to fixed-size arrays: the
+/// first `N` of `wedge`'s, which hold all its points.
 /// Compiled a second time for AVX2 ([`outline_box_avx2`]: 330 instead of
-/// 675 instructions a robot).
+/// 675 instructions a robot in 16 lanes).
 #[inline(always)]
-fn outline_box(
+fn outline_box<const N: usize>(
     camera: &PixyCamera,
     c: &Candidate,
     lens: &Lens,
     facing: Vec2,
     wedge: &WedgePoints,
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let right = Vec2::new(-facing.y, facing.x);
     // Plain loops over the lanes: `array::from_fn`'s closures are not
     // inlined into the AVX2 copy.
-    let (mut pf, mut across) = ([0.0; WEDGE_POINTS], [0.0; WEDGE_POINTS]);
-    for k in 0..WEDGE_POINTS {
+    let (mut pf, mut across) = ([0.0; N], [0.0; N]);
+    for k in 0..N {
         let offset = facing * wedge.ahead[k] + right * wedge.right[k];
         pf[k] = c.ahead + offset.dot(lens.ahead);
         across[k] = camera.fx * (c.side + offset.dot(lens.right));
@@ -1037,37 +1079,40 @@ fn outline_box(
     // A point's depth, `pf cos_tilt - up sin_tilt`, rounds monotonically
     // in `pf` (cos_tilt > 0, the tilt staying within 90 degrees): each
     // rim's least depth is the least `pf`'s (the one row, twice).
-    let nearest = halving_16(&[pf, pf], |a, b| if a < b { a } else { b });
-    let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
+    let nearest = [pf, pf].reduce(|a, b| if a < b { a } else { b });
+    let (mut x, mut y) = ([[0.0; N]; 2], [[0.0; N]; 2]);
     for (rim, z) in [0.0, c.height].into_iter().enumerate() {
         let up = z - camera.height;
         if nearest * camera.cos_tilt - up * camera.sin_tilt < camera.near {
             return None;
         }
-        let mut depth = [0.0; WEDGE_POINTS];
-        for k in 0..WEDGE_POINTS {
+        let mut depth = [0.0; N];
+        for k in 0..N {
             depth[k] = pf[k] * camera.cos_tilt - up * camera.sin_tilt;
         }
-        for k in 0..WEDGE_POINTS {
+        for k in 0..N {
             let down = -pf[k] * camera.sin_tilt - up * camera.cos_tilt;
             x[rim][k] = across[k] / depth[k];
             y[rim][k] = camera.fy * down / depth[k];
         }
     }
-    let least = |v| halving_16(v, |a, b| if a < b { a } else { b });
-    let greatest = |v| halving_16(v, |a, b| if a > b { a } else { b });
+    let least = |v: &[[f64; N]; 2]| v.reduce(|a, b| if a < b { a } else { b });
+    let greatest = |v: &[[f64; N]; 2]| v.reduce(|a, b| if a > b { a } else { b });
     pixel_box(|| least(&x), || greatest(&x), || least(&y), || greatest(&y))
 }
 
 /// [`outline_box`] on any processor (`robot` as for [`outline_box_avx2`]),
 /// out of the frame's loop as the AVX2 copy is.
 #[inline(never)]
-fn outline_box_any(
+fn outline_box_any<const N: usize>(
     camera: &PixyCamera,
     robot: (&Candidate, &Lens, Vec2, &WedgePoints),
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let (c, lens, facing, wedge) = robot;
-    outline_box(camera, c, lens, facing, wedge)
+    outline_box::<N>(camera, c, lens, facing, wedge)
 }
 
 /// [`outline_box`] compiled for AVX2 (`robot`: its candidate, the lens,
@@ -1076,12 +1121,15 @@ fn outline_box_any(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn outline_box_avx2(
+unsafe fn outline_box_avx2<const N: usize>(
     camera: &PixyCamera,
     robot: (&Candidate, &Lens, Vec2, &WedgePoints),
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let (c, lens, facing, wedge) = robot;
-    outline_box(camera, c, lens, facing, wedge)
+    outline_box::<N>(camera, c, lens, facing, wedge)
 }
 
 /// The pixels of points whose image coordinates from the image's centre
@@ -1136,6 +1184,28 @@ fn halving(rims: &[[f64; RIM_POINTS]; 2], pick: impl Fn(f64, f64) -> f64) -> f64
     let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| pick(v[k], v[k + RIM_POINTS / 2]));
     let v: [f64; 2] = std::array::from_fn(|k| pick(pick(v[k], v[k + 2]), v[k + 4]));
     pick(v[1], v[0])
+}
+
+/// Two rows of lanes the camera reduces: [`halving`]'s 12 and
+/// [`halving_16`]'s 16.
+trait Lanes {
+    /// Both rows' values reduced by `pick` (the lesser or the greater of
+    /// two; none is NaN).
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64;
+}
+
+impl Lanes for [[f64; RIM_POINTS]; 2] {
+    #[inline(always)]
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64 {
+        halving(self, pick)
+    }
+}
+
+impl Lanes for [[f64; 16]; 2] {
+    #[inline(always)]
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64 {
+        halving_16(self, pick)
+    }
 }
 
 /// Both rows' values reduced by `pick` (the lesser or the greater of
@@ -1711,7 +1781,7 @@ mod tests {
                     };
                     let rect = if robot {
                         let facing = Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU));
-                        outline_box(&camera, &c, &lens, facing, &wedge)
+                        outline_box::<WEDGE_POINTS>(&camera, &c, &lens, facing, &wedge)
                     } else {
                         project(&camera, ahead, side, radius, height)
                     };
