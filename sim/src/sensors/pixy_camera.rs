@@ -580,12 +580,15 @@ impl PixyCamera {
 
     /// The frame robot `robot` sees: every block, in the order the Pixy
     /// sends them (replaces `out`'s contents). The four stages of the
-    /// module docs, in order.
+    /// module docs, in order; stage 3 only for two blobs or more (it
+    /// leaves one as it is).
     pub fn frame(&mut self, world: &World, robot: usize, out: &mut Vec<PixyBlock>) {
         self.gather_in_view(world, robot);
         self.occlude();
-        self.merge_close_blobs();
-        self.drop_enclosed_blobs();
+        if self.blobs.len() > 1 {
+            self.merge_close_blobs();
+            self.drop_enclosed_blobs();
+        }
         self.emit_blocks(out);
     }
 
