@@ -181,18 +181,15 @@ impl RobotSensors {
 
         let mut capture = std::mem::take(&mut self.capture);
         self.camera.frame(world, robot, &mut capture);
-        let classify = *self.camera.classify();
+        let classify = self.camera.classify();
+        let (puck, robot_signature) = (classify.puck_signature, classify.robot_signature);
         // What reaches the robot now: the camera sends nothing when it sees
         // nothing, and a dropped frame does not arrive. Without noise there
         // is nothing to draw (the noise draws none at zero amounts).
         let arrives = step.is_none_or(|([_, camera], _)| {
             let mut rng = camera.stream(robot as u64);
-            self.noise.perturb_frame(
-                &mut capture,
-                classify.puck_signature,
-                classify.robot_signature,
-                &mut rng,
-            );
+            self.noise
+                .perturb_frame(&mut capture, puck, robot_signature, &mut rng);
             !noise::chance(&mut rng, self.noise.frame_drop)
         });
         let link = &mut self.links[robot];
@@ -214,7 +211,8 @@ impl RobotSensors {
         out.discharge_us = photo.discharge_us;
         out.ticks = photo.ticks;
         let read = &out.frame[..out.frame.len().min(MAX_BLOCKS_PER_PERIOD)];
-        out.reading = SensorReading::from_parts(photo.values, classify.classify(read));
+        out.reading =
+            SensorReading::from_parts(photo.values, self.camera.classify().classify(read));
     }
 }
 
