@@ -118,9 +118,14 @@ impl GainGrid {
         let cols = self.columns;
         let (i, tx) = split(p.x / size.x, cols);
         let (j, ty) = split(p.y / size.y, self.rows);
-        let at = |i: usize, j: usize| self.gains[j * cols + i];
-        let top = at(i, j) + (at(i + 1, j) - at(i, j)) * tx;
-        let bottom = at(i, j + 1) + (at(i + 1, j + 1) - at(i, j + 1)) * tx;
+        // The four gains around `p`: the cell's, the next column's, and the
+        // two of the next row (`i < cols - 1` and `j < rows - 1`, so the
+        // window lies within the gains; one bounds check, not four).
+        let cell = &self.gains[j * cols + i..][..cols + 2];
+        let (top_left, top_right) = (cell[0], cell[1]);
+        let (bottom_left, bottom_right) = (cell[cols], cell[cols + 1]);
+        let top = top_left + (top_right - top_left) * tx;
+        let bottom = bottom_left + (bottom_right - bottom_left) * tx;
         top + (bottom - top) * ty
     }
 }

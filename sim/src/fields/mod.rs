@@ -276,9 +276,8 @@ impl ScalarField {
         if !((0.0..=width).contains(&u) && (0.0..=height).contains(&v)) {
             return 0.0;
         }
-        let (i0, tx) = split(u - 0.5, self.width);
-        let (j0, ty) = split(v - 0.5, self.height);
-        let (i1, j1) = ((i0 + 1).min(self.width - 1), (j0 + 1).min(self.height - 1));
+        let (i0, i1, tx) = split(u - 0.5, self.width);
+        let (j0, j1, ty) = split(v - 0.5, self.height);
         let at = |i: usize, j: usize| f64::from(self.values[j * self.width + i]);
         let top = at(i0, j0) + (at(i1, j0) - at(i0, j0)) * tx;
         let bottom = at(i0, j1) + (at(i1, j1) - at(i0, j1)) * tx;
@@ -287,18 +286,19 @@ impl ScalarField {
 }
 
 /// The pixel at or left of coordinate `t` (in pixel widths from the first
-/// centre) and the fraction towards the next, clamped to the `n` pixels.
-fn split(t: f64, n: usize) -> (usize, f64) {
+/// centre), the next one (the last pixel's is itself) and the fraction
+/// towards it, clamped to the `n` pixels.
+fn split(t: f64, n: usize) -> (usize, usize, f64) {
     if t <= 0.0 {
-        return (0, 0.0);
+        return (0, 1.min(n - 1), 0.0);
     }
     // `t` is positive and below `n` here (no NaN): its truncation is its
     // floor, exactly.
     let i = t as i64 as usize;
     if i >= n - 1 {
-        return (n - 1, 0.0);
+        return (n - 1, n - 1, 0.0);
     }
-    (i, t - i as i64 as f64)
+    (i, i + 1, t - i as i64 as f64)
 }
 
 /// `round_half_away(t)` if it lies in `0..n`, else `None`. It is at least 0

@@ -146,7 +146,7 @@ impl Outline {
     }
 
     /// [`Outline::pair_depth`], but stopping as soon as the depth is known
-    /// to be at most `stop`, with a depth at most `stop` (for a pair that
+    /// to be at most `stop` (below infinity), with a depth at most `stop` (for a pair that
     /// does not touch, the first normal tried, along the centre line,
     /// often shows it).
     pub fn pair_depth_until(
@@ -162,6 +162,7 @@ impl Outline {
             &[(Vec2::ZERO, 2.0 * r), (a, r), (-b, r), (a - b, 0.0)],
             delta,
             stop,
+            true,
         )
     }
 }
@@ -174,34 +175,51 @@ impl Outline {
 /// two terms are equal; all of those are tried, in a fixed order, and the
 /// first least kept.
 pub fn hull_depth<const N: usize>(circles: &[(Vec2, f64); N], delta: Vec2) -> (f64, Vec2) {
-    hull_depth_until(circles, delta, f64::NEG_INFINITY)
+    hull_depth_until(circles, delta, f64::NEG_INFINITY, false)
 }
 
 /// [`hull_depth`], stopping once the least value so far is at most
 /// `stop`: then the depth is at most `stop` too, and that value is
 /// returned (the candidates come in the same order, so a search that does
 /// not stop returns exactly [`hull_depth`]'s). The circles come as an
-/// array, whose loops the compiler unrolls.
+/// array (at least one), whose loops the compiler unrolls. With `centred`
+/// the first circle's centre is the origin, and its term of the search,
+/// `r + 0 . n`, is taken as `r`: exactly that for a radius other than 0
+/// and a finite `n` (every candidate's).
 fn hull_depth_until<const N: usize>(
     circles: &[(Vec2, f64); N],
     delta: Vec2,
     stop: f64,
+    centred: bool,
 ) -> (f64, Vec2) {
+    debug_assert!(!centred || circles[0].0 == Vec2::ZERO);
+    let term = |(c, r): (Vec2, f64), n: Vec2| r + c.dot(n);
+    // The greater of two terms. No term is NaN, nor -0 (a radius, at
+    // least 0, plus a dot product is -0 only for two -0s), so which of two
+    // equal terms is kept makes no difference.
+    let greater = |a: f64, b: f64| if a > b { a } else { b };
     let value = |n: Vec2| {
-        circles
+        let first = if centred {
+            circles[0].1
+        } else {
+            term(circles[0], n)
+        };
+        circles[1..]
             .iter()
-            .map(|&(c, r)| r + c.dot(n))
-            .fold(f64::NEG_INFINITY, f64::max)
+            .fold(first, |most, &circle| greater(most, term(circle, n)))
             - delta.dot(n)
     };
     let mut best = (f64::INFINITY, Vec2::new(1.0, 0.0));
-    // Whether the search can stop.
+    // Whether the search can stop: the least value so far is at most
+    // `stop`, which it can newly be only when a candidate lowers it (for
+    // a `stop` below infinity, as every caller's is).
     let mut consider = |n: Vec2| {
         let v = value(n);
         if v < best.0 {
             best = (v, n);
+            return v <= stop;
         }
-        best.0 <= stop
+        false
     };
     for &(c, _) in circles {
         let w = delta - c;
@@ -308,6 +326,29 @@ mod tests {
             if depth.abs() > 1e-6 {
                 assert!((n - m).length() < 1e-6, "{delta:?}: {n:?} {m:?}");
             }
+        }
+    }
+
+    #[test]
+    fn a_hull_centred_on_its_first_circle_is_searched_to_the_same_bits() {
+        let o = wedge();
+        let mut rng = SimRng::seed_from_u64(9);
+        for k in 0..4000 {
+            let (a, b) = (
+                Vec2::from_angle(rng.random_range(-3.2..3.2)) * o.tip(),
+                Vec2::from_angle(rng.random_range(-3.2..3.2)) * o.tip(),
+            );
+            let r = o.radius();
+            let circles = [(Vec2::ZERO, 2.0 * r), (a, r), (-b, r), (a - b, 0.0)];
+            let delta = Vec2::new(rng.random_range(-40.0..40.0), rng.random_range(-40.0..40.0));
+            let stop = if k % 2 == 0 { f64::NEG_INFINITY } else { 0.1 };
+            let (d, n) = hull_depth_until(&circles, delta, stop, true);
+            let (e, m) = hull_depth_until(&circles, delta, stop, false);
+            assert_eq!(
+                [d, n.x, n.y].map(f64::to_bits),
+                [e, m.x, m.y].map(f64::to_bits),
+                "{delta:?}"
+            );
         }
     }
 

@@ -30,7 +30,6 @@
 use crate::base::gain_grid::GainGrid;
 use crate::base::noise::Stream;
 use crate::base::ranges;
-use crate::base::rounding;
 use crate::base::vec2::Vec2;
 use crate::config::robot_shape::RobotShape;
 use crate::config::validate::{check, ConfigError};
@@ -68,21 +67,28 @@ impl PhotoResponse {
     /// The discharge time in microseconds over a field value `v` in [0, 1]
     /// with projector gamma `gamma`.
     pub fn discharge_us(&self, v: f64, gamma: f64) -> f64 {
-        self.discharge_of_light_us(light(v, gamma).unwrap_or(0.0))
+        discharge_at(self.rates(), light(v, gamma).unwrap_or(0.0))
     }
 
-    /// The discharge time under `light`, relative to full white's.
-    pub(crate) fn discharge_of_light_us(&self, light: f64) -> f64 {
+    /// The discharge rate in the dark, `1 / dark_us`, and what full white
+    /// adds to it, `1 / bright_us - 1 / dark_us`.
+    fn rates(&self) -> (f64, f64) {
         let (fast, slow) = (1.0 / self.bright_us, 1.0 / self.dark_us);
-        1.0 / (slow + light.max(0.0) * (fast - slow))
+        (slow, fast - slow)
     }
+}
+
+/// The discharge time under `light` (relative to full white's) of a sensor of [`PhotoResponse::rates`]
+/// `(slow, span)`: the inverse of its discharge rate.
+fn discharge_at((slow, span): (f64, f64), light: f64) -> f64 {
+    1.0 / (slow + light.max(0.0) * span)
 }
 
 /// The light `v.clamp(0, 1)^gamma` of full white at field value `v`, or
 /// `None` for none (`v` at most 0, as off the screen's frame: a quarter
 /// of the readings on `tv75`), skipping libm's `pow`, which gives a zero
 /// there: under a zero of either sign a sensor discharges in its dark time
-/// ([`PhotoResponse::discharge_of_light_us`]), whatever the gain on it.
+/// ([`discharge_at`]), whatever the gain on it.
 fn light(v: f64, gamma: f64) -> Option<f64> {
     if v <= 0.0 {
         None
@@ -151,12 +157,14 @@ impl Default for PhotoSensorConfig {
 }
 
 /// `floor(us / tick)` capped at the timeout: the firmware's reading of a
-/// discharge that takes `us` microseconds.
+/// discharge that takes `us` microseconds. The floor of `t` is at least a
+/// whole `n` exactly when `t` is, and from 1 up it is `t`'s truncation, so
+/// no rounding to a whole number is needed (NaN reads 0, as its floor does).
 pub(crate) fn quantise_us(us: f64) -> u16 {
-    let ticks = rounding::floor(us / f64::from(RC_TICK_US));
+    let ticks = us / f64::from(RC_TICK_US);
     if ticks >= f64::from(RC_TIMEOUT_TICKS) {
         RC_TIMEOUT_TICKS
-    } else if ticks > 0.0 {
+    } else if ticks >= 1.0 {
         ticks as u16
     } else {
         0
@@ -277,28 +285,42 @@ pub(crate) struct PhotoSensors {
     /// Left, mid, right points in the robot's frame (x forward, y right), units.
     points: [Vec2; 3],
     response: [PhotoResponse; 3],
+    /// Each sensor's [`PhotoResponse::rates`], computed once.
+    rates: [(f64, f64); 3],
     gamma: f64,
     latency_us: f64,
     ideal: bool,
     calibration: FieldCalibration,
     scales: FieldScales,
+    /// Each sensor's calibrated value of every reading a discharge can
+    /// give (`0..=RC_TIMEOUT_TICKS`): `scales`' arithmetic done once, so
+    /// that a reading is one load.
+    values_of_ticks: Box<[[FieldValue; READINGS]; 3]>,
 }
+
+/// The readings a discharge can give: whole ticks up to the timeout.
+const READINGS: usize = RC_TIMEOUT_TICKS as usize + 1;
 
 impl PhotoSensors {
     /// The sensors of `config` on the robots of `world`.
     pub fn new(config: &PhotoSensorConfig, world: &WorldConfig) -> PhotoSensors {
         let calibration = config.calibration();
+        let scales = calibration.scales();
         let unit_mm = world.unit_mm;
         PhotoSensors {
             points: config
                 .mounts_on(world)
                 .map(|m| Vec2::new(m.forward_mm / unit_mm, m.right_mm / unit_mm)),
             response: config.response,
+            rates: config.response.map(|r| r.rates()),
             gamma: config.gamma,
             latency_us: config.poll_latency_us,
             ideal: config.ideal,
             calibration,
-            scales: calibration.scales(),
+            scales,
+            values_of_ticks: Box::new(std::array::from_fn(|i| {
+                std::array::from_fn(|t| scales.0[i].value(t as u16))
+            })),
         }
     }
 
@@ -342,7 +364,7 @@ impl PhotoSensors {
                     let light =
                         light(shown[i], self.gamma).map_or(0.0, |l| l * n.grid.at(point, n.arena));
                     n.noise
-                        .jitter_discharge(self.response[i].discharge_of_light_us(light), n.rng)
+                        .jitter_discharge(discharge_at(self.rates[i], light), n.rng)
                 }
             };
             r.ticks[i] = quantise_us(r.discharge_us[i] + self.latency_us);
@@ -350,7 +372,8 @@ impl PhotoSensors {
         r.values = if self.ideal {
             shown.map(|v| FieldValue::from_f32(v as f32))
         } else {
-            self.scales.values(&r.ticks)
+            // Ticks are at most the timeout (`quantise_us`).
+            std::array::from_fn(|i| self.values_of_ticks[i][usize::from(r.ticks[i])])
         };
         r
     }
@@ -395,6 +418,14 @@ mod tests {
         assert_eq!(quantise_us(2000.0), RC_TIMEOUT_TICKS);
         assert_eq!(quantise_us(1e9), RC_TIMEOUT_TICKS);
         assert_eq!(quantise_us(-5.0), 0);
+        assert_eq!(quantise_us(f64::NAN), 0);
+        // As the floor of the ticks, rounded to a whole number, gives them.
+        for k in 0..=20_000 {
+            let us = f64::from(k) * 0.1003;
+            let floor = crate::base::rounding::floor(us / f64::from(RC_TICK_US));
+            let capped = floor.clamp(0.0, f64::from(RC_TIMEOUT_TICKS)) as u16;
+            assert_eq!(quantise_us(us), capped, "{us} us");
+        }
     }
 
     #[test]
@@ -420,6 +451,20 @@ mod tests {
         let r = sensors.read(at, Vec2::new(1.0, 0.0), &dark, &SQUARE_100, None);
         assert_eq!(sensors.values(&r.ticks), [FieldValue::ZERO; 3]);
         assert_eq!(r.ticks, cal.ranges.map(|c| c.dark));
+    }
+
+    #[test]
+    fn a_reading_s_tabulated_value_is_the_firmware_arithmetic_on_its_ticks() {
+        let mut config = PhotoSensorConfig::default();
+        for (bright_us, dark_us) in [(150.0, 1700.0), (40.0, 1990.0), (900.0, 2400.0)] {
+            config.response[1] = PhotoResponse { bright_us, dark_us };
+            let sensors = PhotoSensors::new(&config, &WorldConfig::default());
+            for t in 0..=RC_TIMEOUT_TICKS {
+                let ticks = [t; 3];
+                let tabulated = std::array::from_fn(|i| sensors.values_of_ticks[i][usize::from(t)]);
+                assert_eq!(tabulated, sensors.values(&ticks), "{t} ticks");
+            }
+        }
     }
 
     #[test]

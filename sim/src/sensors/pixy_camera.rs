@@ -39,7 +39,9 @@
 
 use crate::base::ranges;
 use crate::base::vec2::Vec2;
+use crate::config::robot_shape::RobotShape;
 use crate::config::validate::{check, ConfigError};
+use crate::config::WorldConfig;
 use crate::physics::grid::Neighbour;
 use crate::physics::outline::Outline;
 use crate::world::World;
@@ -367,13 +369,78 @@ pub(crate) struct PixyCamera {
     merged: Vec<Blob>,
     /// Whether the processor has AVX2 ([`PixyCamera::silhouette`]).
     avx2: bool,
-    /// The points of the last wedge-fronted robots seen.
+    /// What the last world's bodies' shapes give the camera.
+    shapes: Option<BodyShapes>,
+}
+
+/// What the camera derives from a world's bodies' shapes, found once per
+/// world rather than every frame.
+#[derive(Clone, Debug)]
+struct BodyShapes {
+    /// The robots' shape and radius and the pucks' radius they are of.
+    of: (RobotShape, f64, f64),
+    /// The wedge-fronted robots' points (none for discs).
     wedge: Option<WedgePoints>,
+    /// The search box's sizes.
+    span: SearchSpan,
+}
+
+impl BodyShapes {
+    /// The shapes of `world`'s bodies as `camera` sees them.
+    fn new(camera: &PixyCamera, world: &WorldConfig) -> BodyShapes {
+        let outline = Outline::of(world.robot_shape, world.robot_radius);
+        BodyShapes {
+            of: (world.robot_shape, world.robot_radius, world.puck_radius),
+            wedge: outline.map(|o| WedgePoints::new(&o, &camera.rim_ahead, &camera.rim_right)),
+            span: SearchSpan::new(camera, world.max_radius()),
+        }
+    }
+}
+
+/// The sizes of [`PixyCamera::search_box`] that depend on the camera and
+/// the bodies' largest radius alone (found once, not every frame).
+#[derive(Clone, Copy, Debug)]
+struct SearchSpan {
+    max_radius: f64,
+    /// How far behind the lens the widened view cone's apex lies.
+    behind: f64,
+    /// How far from the lens a body the culls keep can lie.
+    reach: f64,
+    /// The sector's radius from the apex.
+    radius: f64,
+    /// The box's padding.
+    pad: f64,
+    /// Half the cone's width where the culls' `ahead >= -r` cuts it.
+    half_width: f64,
+}
+
+impl SearchSpan {
+    /// The sizes for `camera` and bodies up to `max_radius`.
+    fn new(camera: &PixyCamera, max_radius: f64) -> SearchSpan {
+        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
+        // for every r <= max_radius and h <= the taller body lies inside the
+        // cone from the apex ...
+        let tallest = camera.puck_height.max(camera.robot_height);
+        let behind = max_radius + camera.height + tallest + max_radius / camera.tan_half_h;
+        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
+        let reach = camera.max_range + max_radius;
+        let radius = reach + behind;
+        SearchSpan {
+            max_radius,
+            behind,
+            reach,
+            radius,
+            pad: radius * 1e-6,
+            half_width: (camera.height + tallest) * camera.tan_half_h + max_radius,
+        }
+    }
 }
 
 /// Lanes of a wedge's outline points the camera projects
 /// ([`PixyCamera::outline_silhouette`]): at most `RIM_POINTS + 3` points,
-/// in a power of two for [`halving_16`].
+/// in a power of two for [`halving_16`]. Outlines of at most
+/// [`RIM_POINTS`] points (tips between `r / cos 30` and `r / cos 60` from
+/// the centre, as on `tv75`) are projected in that many lanes.
 const WEDGE_POINTS: usize = 16;
 const _: () = assert!(RIM_POINTS + 3 <= WEDGE_POINTS);
 
@@ -382,9 +449,11 @@ const _: () = assert!(RIM_POINTS + 3 <= WEDGE_POINTS);
 /// points that lie on its round back, then the tip again in the lanes left.
 #[derive(Clone, Copy, Debug)]
 struct WedgePoints {
-    outline: Outline,
     ahead: [f64; WEDGE_POINTS],
     right: [f64; WEDGE_POINTS],
+    /// Whether the points fit in the first [`RIM_POINTS`] lanes (the
+    /// others then repeat the tip, which adds nothing to a silhouette).
+    fit_rim_lanes: bool,
 }
 
 impl WedgePoints {
@@ -398,19 +467,22 @@ impl WedgePoints {
         let r = outline.radius();
         let t = outline.tangent_point();
         let mut points = WedgePoints {
-            outline: *outline,
             ahead: [outline.tip(); WEDGE_POINTS],
             right: [0.0; WEDGE_POINTS],
+            fit_rim_lanes: false,
         };
         let on_back = (0..RIM_POINTS)
             .filter(|&k| rim_ahead[k] * r < t.x)
             .map(|k| Vec2::new(rim_ahead[k], rim_right[k]) * r);
         // after the tip in lane 0
         let sides = [t, Vec2::new(t.x, -t.y)];
+        let mut lanes = 1;
         for (n, p) in (1..).zip(sides.into_iter().chain(on_back)) {
             points.ahead[n] = p.x;
             points.right[n] = p.y;
+            lanes = n + 1;
         }
+        points.fit_rim_lanes = lanes <= RIM_POINTS;
         points
     }
 }
@@ -463,7 +535,7 @@ impl PixyCamera {
             blobs: Vec::new(),
             merged: Vec::new(),
             avx2: has_avx2(),
-            wedge: None,
+            shapes: None,
         }
     }
 
@@ -508,12 +580,15 @@ impl PixyCamera {
 
     /// The frame robot `robot` sees: every block, in the order the Pixy
     /// sends them (replaces `out`'s contents). The four stages of the
-    /// module docs, in order.
+    /// module docs, in order; stage 3 only for two blobs or more (it
+    /// leaves one as it is).
     pub fn frame(&mut self, world: &World, robot: usize, out: &mut Vec<PixyBlock>) {
         self.gather_in_view(world, robot);
         self.occlude();
-        self.merge_close_blobs();
-        self.drop_enclosed_blobs();
+        if self.blobs.len() > 1 {
+            self.merge_close_blobs();
+            self.drop_enclosed_blobs();
+        }
         self.emit_blocks(out);
     }
 
@@ -521,14 +596,16 @@ impl PixyCamera {
     /// silhouette, nearest first (ties by body index).
     fn gather_in_view(&mut self, world: &World, robot: usize) {
         let lens = Lens::of(world, robot, self.forward);
-        let (min, max) = self.search_box(&lens, world.config().max_radius());
+        let config = world.config();
+        let of = (config.robot_shape, config.robot_radius, config.puck_radius);
+        if self.shapes.as_ref().is_none_or(|shapes| shapes.of != of) {
+            self.shapes = Some(BodyShapes::new(self, config));
+        }
+        let shapes = self.shapes.as_ref().expect("set just above");
+        let (min, max) = self.search_box(&lens, &shapes.span);
         let mut in_view = std::mem::take(&mut self.in_view);
         in_view.clear();
-        let outline = Outline::of(world.config().robot_shape, world.config().robot_radius);
-        if outline != self.wedge.as_ref().map(|w| w.outline) {
-            self.wedge = outline.map(|o| WedgePoints::new(&o, &self.rim_ahead, &self.rim_right));
-        }
-        let wedge = self.wedge.as_ref();
+        let wedge = shapes.wedge.as_ref();
         let robots = world.robots().len();
         world.any_body_in_box(min, max, |row| {
             for b in row {
@@ -557,23 +634,15 @@ impl PixyCamera {
     }
 
     /// A box of the world holding the centre of every body that
-    /// [`Self::candidate`] passes, for bodies up to `max_radius`: the
+    /// [`Self::candidate`] passes, for bodies up to `span.max_radius`: the
     /// sector from the apex of the widened view cone (half the horizontal
     /// field of view each side) that reaches as far as the range does, cut
     /// off `max_radius` behind the lens, within the range's square around
     /// the lens, padded by a millionth of its radius, far more than the
     /// culls' rounding.
-    fn search_box(&self, lens: &Lens, max_radius: f64) -> (Vec2, Vec2) {
-        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
-        // for every r <= max_radius and h <= the taller body lies inside the
-        // cone from `apex` ...
-        let tallest = self.puck_height.max(self.robot_height);
-        let behind = max_radius + self.height + tallest + max_radius / self.tan_half_h;
-        let apex = lens.pos - lens.ahead * behind;
-        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
-        let reach = self.max_range + max_radius;
-        let radius = reach + behind;
-        let pad = radius * 1e-6;
+    fn search_box(&self, lens: &Lens, span: &SearchSpan) -> (Vec2, Vec2) {
+        let (max_radius, radius, pad) = (span.max_radius, span.radius, span.pad);
+        let apex = lens.pos - lens.ahead * span.behind;
         let (min, max) = (
             |a: f64, b: f64| if a < b { a } else { b },
             |a: f64, b: f64| if a > b { a } else { b },
@@ -581,7 +650,7 @@ impl PixyCamera {
         // The cone's corners where the culls' `ahead >= -r` cuts it, and
         // where its edges meet the arc.
         let back = lens.pos - lens.ahead * max_radius;
-        let half_width = (self.height + tallest) * self.tan_half_h + max_radius;
+        let half_width = span.half_width;
         let edge = |sign: f64| {
             apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius
         };
@@ -612,7 +681,7 @@ impl PixyCamera {
         if -a.y >= c {
             low.y = apex.y - radius;
         }
-        let square = Vec2::new(reach, reach);
+        let square = Vec2::new(span.reach, span.reach);
         let (near, far) = (lens.pos - square, lens.pos + square);
         let padding = Vec2::new(pad, pad);
         (
@@ -705,7 +774,7 @@ impl PixyCamera {
 
     /// The clipped pixel box of a wedge-fronted robot, candidate `c`,
     /// facing `facing` ([`outline_box`], or [`outline_box_avx2`] on
-    /// processors with AVX2).
+    /// processors with AVX2), in [`RIM_POINTS`] lanes if its points fit.
     #[inline(always)]
     fn outline_silhouette(
         &self,
@@ -714,12 +783,23 @@ impl PixyCamera {
         facing: Vec2,
         wedge: &WedgePoints,
     ) -> Option<Rect> {
+        let robot = (c, lens, facing, wedge);
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is set only when the processor has AVX2.
-            return unsafe { outline_box_avx2(self, (c, lens, facing, wedge)) };
+            return unsafe {
+                if wedge.fit_rim_lanes {
+                    outline_box_avx2::<RIM_POINTS>(self, robot)
+                } else {
+                    outline_box_avx2::<WEDGE_POINTS>(self, robot)
+                }
+            };
         }
-        outline_box_any(self, (c, lens, facing, wedge))
+        if wedge.fit_rim_lanes {
+            outline_box_any::<RIM_POINTS>(self, robot)
+        } else {
+            outline_box_any::<WEDGE_POINTS>(self, robot)
+        }
     }
 
     /// Stage 2: each body's still visible part after the nearer ones'
@@ -975,57 +1055,67 @@ projection!(#[target_feature(enable = "avx2")] #[inline(never)] unsafe ; project
 /// points at the bottom and the top, `wedge`'s). `None` if it is out
 /// of the image or reaches behind the image plane. A robot or two a
 /// frame: each point's place ahead of and beside the lens is found
-/// once for both rims, and the lanes keep to fixed-size arrays.
+/// once for both rims, and the lanes keep to fixed-size arrays: the
+/// first `N` of `wedge`'s, which hold all its points.
 /// Compiled a second time for AVX2 ([`outline_box_avx2`]: 330 instead of
-/// 675 instructions a robot).
+/// 675 instructions a robot in 16 lanes).
 #[inline(always)]
-fn outline_box(
+fn outline_box<const N: usize>(
     camera: &PixyCamera,
     c: &Candidate,
     lens: &Lens,
     facing: Vec2,
     wedge: &WedgePoints,
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let right = Vec2::new(-facing.y, facing.x);
     // Plain loops over the lanes: `array::from_fn`'s closures are not
     // inlined into the AVX2 copy.
-    let (mut pf, mut across) = ([0.0; WEDGE_POINTS], [0.0; WEDGE_POINTS]);
-    for k in 0..WEDGE_POINTS {
+    let (mut pf, mut across) = ([0.0; N], [0.0; N]);
+    for k in 0..N {
         let offset = facing * wedge.ahead[k] + right * wedge.right[k];
         pf[k] = c.ahead + offset.dot(lens.ahead);
         across[k] = camera.fx * (c.side + offset.dot(lens.right));
     }
-    let (mut x, mut y) = ([[0.0; WEDGE_POINTS]; 2], [[0.0; WEDGE_POINTS]; 2]);
+    // A point's depth, `pf cos_tilt - up sin_tilt`, rounds monotonically
+    // in `pf` (cos_tilt > 0, the tilt staying within 90 degrees): each
+    // rim's least depth is the least `pf`'s (the one row, twice).
+    let nearest = [pf, pf].reduce(|a, b| if a < b { a } else { b });
+    let (mut x, mut y) = ([[0.0; N]; 2], [[0.0; N]; 2]);
     for (rim, z) in [0.0, c.height].into_iter().enumerate() {
         let up = z - camera.height;
-        let mut depth = [0.0; WEDGE_POINTS];
-        for k in 0..WEDGE_POINTS {
-            depth[k] = pf[k] * camera.cos_tilt - up * camera.sin_tilt;
-        }
-        // the least depth (the one row, twice)
-        if halving_16(&[depth, depth], |a, b| if a < b { a } else { b }) < camera.near {
+        if nearest * camera.cos_tilt - up * camera.sin_tilt < camera.near {
             return None;
         }
-        for k in 0..WEDGE_POINTS {
+        let mut depth = [0.0; N];
+        for k in 0..N {
+            depth[k] = pf[k] * camera.cos_tilt - up * camera.sin_tilt;
+        }
+        for k in 0..N {
             let down = -pf[k] * camera.sin_tilt - up * camera.cos_tilt;
             x[rim][k] = across[k] / depth[k];
             y[rim][k] = camera.fy * down / depth[k];
         }
     }
-    let least = |v| halving_16(v, |a, b| if a < b { a } else { b });
-    let greatest = |v| halving_16(v, |a, b| if a > b { a } else { b });
+    let least = |v: &[[f64; N]; 2]| v.reduce(|a, b| if a < b { a } else { b });
+    let greatest = |v: &[[f64; N]; 2]| v.reduce(|a, b| if a > b { a } else { b });
     pixel_box(|| least(&x), || greatest(&x), || least(&y), || greatest(&y))
 }
 
 /// [`outline_box`] on any processor (`robot` as for [`outline_box_avx2`]),
 /// out of the frame's loop as the AVX2 copy is.
 #[inline(never)]
-fn outline_box_any(
+fn outline_box_any<const N: usize>(
     camera: &PixyCamera,
     robot: (&Candidate, &Lens, Vec2, &WedgePoints),
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let (c, lens, facing, wedge) = robot;
-    outline_box(camera, c, lens, facing, wedge)
+    outline_box::<N>(camera, c, lens, facing, wedge)
 }
 
 /// [`outline_box`] compiled for AVX2 (`robot`: its candidate, the lens,
@@ -1034,12 +1124,15 @@ fn outline_box_any(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline(never)]
-unsafe fn outline_box_avx2(
+unsafe fn outline_box_avx2<const N: usize>(
     camera: &PixyCamera,
     robot: (&Candidate, &Lens, Vec2, &WedgePoints),
-) -> Option<Rect> {
+) -> Option<Rect>
+where
+    [[f64; N]; 2]: Lanes,
+{
     let (c, lens, facing, wedge) = robot;
-    outline_box(camera, c, lens, facing, wedge)
+    outline_box::<N>(camera, c, lens, facing, wedge)
 }
 
 /// The pixels of points whose image coordinates from the image's centre
@@ -1094,6 +1187,28 @@ fn halving(rims: &[[f64; RIM_POINTS]; 2], pick: impl Fn(f64, f64) -> f64) -> f64
     let v: [f64; RIM_POINTS / 2] = std::array::from_fn(|k| pick(v[k], v[k + RIM_POINTS / 2]));
     let v: [f64; 2] = std::array::from_fn(|k| pick(pick(v[k], v[k + 2]), v[k + 4]));
     pick(v[1], v[0])
+}
+
+/// Two rows of lanes the camera reduces: [`halving`]'s 12 and
+/// [`halving_16`]'s 16.
+trait Lanes {
+    /// Both rows' values reduced by `pick` (the lesser or the greater of
+    /// two; none is NaN).
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64;
+}
+
+impl Lanes for [[f64; RIM_POINTS]; 2] {
+    #[inline(always)]
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64 {
+        halving(self, pick)
+    }
+}
+
+impl Lanes for [[f64; 16]; 2] {
+    #[inline(always)]
+    fn reduce(&self, pick: impl Fn(f64, f64) -> f64) -> f64 {
+        halving_16(self, pick)
+    }
 }
 
 /// Both rows' values reduced by `pick` (the lesser or the greater of
@@ -1669,7 +1784,7 @@ mod tests {
                     };
                     let rect = if robot {
                         let facing = Vec2::from_angle(rng.random_range(0.0..std::f64::consts::TAU));
-                        outline_box(&camera, &c, &lens, facing, &wedge)
+                        outline_box::<WEDGE_POINTS>(&camera, &c, &lens, facing, &wedge)
                     } else {
                         project(&camera, ahead, side, radius, height)
                     };
@@ -1699,7 +1814,7 @@ mod tests {
                     ahead,
                     right: Vec2::new(-ahead.y, ahead.x),
                 };
-                let (min, max) = camera.search_box(&lens, robot_r);
+                let (min, max) = camera.search_box(&lens, &SearchSpan::new(&camera, robot_r));
                 for k in 0..2000 {
                     let (radius, body) = if k % 2 == 0 {
                         (robot_r, 1)

@@ -153,22 +153,21 @@ impl RobotSensors {
     /// Robot `robot`'s observation of the world, into `observations`: its
     /// field sensors' reading, and the camera frame its link delivers.
     /// With noise, `step` holds the step's [`Purpose::Discharge`] and
-    /// [`Purpose::Camera`] places, which every robot's streams share;
-    /// without, it is `None`.
+    /// [`Purpose::Camera`] places, which every robot's streams share, and
+    /// the episode's brightness gains; without, it is `None`.
     fn observe(
         &mut self,
         world: &World,
         field: &ScalarField,
         robot: usize,
-        step: Option<[Place; 2]>,
+        step: Option<([Place; 2], &GainGrid)>,
     ) {
-        let (seed, episode) = (world.state().seed, world.state().episode);
+        let episode = world.state().episode;
         let (pos, direction) = (world.bodies()[robot].pos, world.robots()[robot].direction);
         let layout = world.config().field_layout();
-        let photo = if let Some([discharge, _]) = step {
+        let photo = if let Some(([discharge, _], grid)) = step {
             let mut rng = discharge.stream(robot as u64);
             let arena = world.config().arena();
-            let grid = brightness_grid(&mut self.brightness, &self.noise, seed, episode);
             let noise = PhotoNoise {
                 noise: &self.noise,
                 grid,
@@ -182,18 +181,15 @@ impl RobotSensors {
 
         let mut capture = std::mem::take(&mut self.capture);
         self.camera.frame(world, robot, &mut capture);
-        let classify = *self.camera.classify();
+        let classify = self.camera.classify();
+        let (puck, robot_signature) = (classify.puck_signature, classify.robot_signature);
         // What reaches the robot now: the camera sends nothing when it sees
         // nothing, and a dropped frame does not arrive. Without noise there
         // is nothing to draw (the noise draws none at zero amounts).
-        let arrives = step.is_none_or(|[_, camera]| {
+        let arrives = step.is_none_or(|([_, camera], _)| {
             let mut rng = camera.stream(robot as u64);
-            self.noise.perturb_frame(
-                &mut capture,
-                classify.puck_signature,
-                classify.robot_signature,
-                &mut rng,
-            );
+            self.noise
+                .perturb_frame(&mut capture, puck, robot_signature, &mut rng);
             !noise::chance(&mut rng, self.noise.frame_drop)
         });
         let link = &mut self.links[robot];
@@ -215,7 +211,8 @@ impl RobotSensors {
         out.discharge_us = photo.discharge_us;
         out.ticks = photo.ticks;
         let read = &out.frame[..out.frame.len().min(MAX_BLOCKS_PER_PERIOD)];
-        out.reading = SensorReading::from_parts(photo.values, classify.classify(read));
+        out.reading =
+            SensorReading::from_parts(photo.values, self.camera.classify().classify(read));
     }
 }
 
@@ -241,14 +238,21 @@ impl SensorModel for RobotSensors {
         self.links.resize(robots, CameraMemory::default());
         self.observations
             .resize(robots, RobotObservation::default());
-        let (seed, step) = (world.state().seed, world.steps());
-        let places = self
-            .noisy
-            .then(|| [Purpose::Discharge, Purpose::Camera].map(|p| noise::place(seed, p, step)));
+        let (seed, episode, step) = (world.state().seed, world.state().episode, world.steps());
+        // Taken out of `self` for the robots' loop, and looked up once.
+        let mut brightness = self.brightness.take();
+        let noise = self.noisy.then(|| {
+            let places = [Purpose::Discharge, Purpose::Camera].map(|p| noise::place(seed, p, step));
+            (
+                places,
+                brightness_grid(&mut brightness, &self.noise, seed, episode),
+            )
+        });
         for (i, reading) in out.iter_mut().enumerate().take(robots) {
-            self.observe(world, field, i, places);
+            self.observe(world, field, i, noise);
             *reading = self.observations[i].reading;
         }
+        self.brightness = brightness;
     }
 
     /// The three field sensor points (the camera's view is
