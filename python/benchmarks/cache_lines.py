@@ -63,8 +63,9 @@ def counts(python: str, worlds: int, steps: int, cache: tuple[int, int, int]) ->
     cmd = ["valgrind", "--tool=cachegrind", "--cache-sim=yes", f"--LL={size},{ways},{line}",
            "--cachegrind-out-file=/dev/null", python, "-c", STEP_SCRIPT, str(worlds), str(steps)]
     # One BLAS thread: numpy's idle BLAS threads spin under valgrind, which
-    # runs one thread at a time, and would count as the step's.
-    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    # runs one thread at a time, and would count as the step's. A fixed
+    # string hash: the two runs' interpreters then do the same work.
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "PYTHONHASHSEED": "0"}
     done = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if done.returncode != 0:
         sys.exit(f"cache_lines: {' '.join(cmd[:5])} ... failed:\n{done.stderr[-2000:]}")
@@ -126,7 +127,10 @@ def main() -> None:
     parser.add_argument("--warm", type=int, default=WARM_STEPS)
     parser.add_argument("--timed", type=int, default=TIMED_STEPS)
     parser.add_argument("--out", help="results file to write (JSON)")
+    parser.add_argument("--tiny", action="store_true", help="two and four worlds, a few steps: the method at a test's scale")
     args = parser.parse_args()
+    if args.tiny:
+        args.worlds, args.warm, args.timed = [2, 4], 2, 3
     if min(args.worlds) < 1 or args.warm < 0 or args.timed < 1:
         parser.error("--worlds must be at least 1, --warm at least 0 and --timed at least 1")
     results_file.render_or_measure(args, measure, render)

@@ -10,6 +10,7 @@ and docs/performance.md the cache lines a step fetches
 import argparse
 import importlib.util
 import json
+import subprocess
 import sys
 
 import pytest
@@ -53,6 +54,19 @@ def test_the_cache_line_table_is_rendered_from_the_counts_and_what_the_docs_say_
             assert row["second_level_misses"] >= 0.8 * row["first_level_misses"], \
                 f"nearly all also miss the second level at {worlds} worlds"
             assert 11_000 <= row["second_level_misses"] * 64 <= 13_000, f"about 12 KB a step at {worlds} worlds"
+
+
+def test_the_cache_line_benchmark_counts_every_world_count_at_a_tiny_scale(repo, tmp_path):
+    out = tmp_path / "cache-lines.json"
+    done = subprocess.run([sys.executable, str(repo / "python" / "benchmarks" / "cache_lines.py"), "--tiny",
+                           "--out", str(out)], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    results = json.loads(out.read_text())
+    assert [row["worlds"] for row in results["rows"]] == [2, 4]
+    for row in results["rows"]:
+        assert row["instructions"] > 1000, f"a world step is thousands of instructions: {row}"
+        assert row["first_level_misses"] > 0, row
+    assert done.stdout == benchmark(repo, "cache_lines").render(results)
 
 
 def test_the_comparison_with_vmas_is_rendered_from_the_measured_results_of_the_pinned_version(repo):
