@@ -337,13 +337,9 @@ pub(crate) struct PixyCamera {
     /// cos and sin of half the horizontal field of view, for the search box.
     cos_half_h: f64,
     sin_half_h: f64,
-    /// `sqrt(1 + (tan_half_h cos_tilt)^2)`: how much a point at most a
-    /// unit from a body's centre can bring `|side| - tan_half_h depth` below
-    /// the centre's ([`PixyCamera::beside_view`]).
-    side_spread: f64,
-    /// The most a point's height adds to its depth (`-up sin_tilt`, for
-    /// points between the floor and the tallest body).
-    depth_lift: f64,
+    /// The side cull's bound, `|side| - slope ahead > per_radius radius +
+    /// offset` ([`PixyCamera::beside_view`]), found once.
+    beside: BesideBound,
     puck_height: f64,
     robot_height: f64,
     max_range: f64,
@@ -436,6 +432,45 @@ impl SearchSpan {
     }
 }
 
+/// [`PixyCamera::beside_view`]'s bound, `|side| - slope ahead >
+/// per_radius radius + offset`: with `spread = sqrt(1 + (tan_half_h
+/// cos_tilt)^2)`, how much a point at most a unit from a body's centre can
+/// bring `|side| - tan_half_h depth` below the centre's, and `lift`, the
+/// most a point's height adds to its depth (`-up sin_tilt`, for points
+/// between the floor and the tallest body), it is `|side| - tan_half_h
+/// (ahead cos_tilt + lift) - radius spread > pad`. The pad, a billionth of
+/// the farthest a body in view can be (`max_range + radius`), keeps the
+/// decision far from rounding: the projection, and this bound's terms,
+/// round within a few units in the last place of the range.
+#[derive(Clone, Copy, Debug)]
+struct BesideBound {
+    /// `tan_half_h cos_tilt`.
+    slope: f64,
+    /// `spread` and the pad's part per unit of radius.
+    per_radius: f64,
+    /// `tan_half_h lift` and the pad's part for the range.
+    offset: f64,
+}
+
+impl BesideBound {
+    /// The bound of a camera of `config` in a world of `unit_mm`
+    /// millimetres per unit.
+    fn new(config: &PixyCameraConfig, unit_mm: f64) -> BesideBound {
+        const PAD: f64 = 1e-9;
+        let tilt = config.tilt_deg.to_radians();
+        let tan_half_h = (config.fov_h_deg / 2.0).to_radians().tan();
+        let (height, sin) = (config.height_mm / unit_mm, tilt.sin());
+        let tallest = config.puck_height_mm.max(config.robot_height_mm) / unit_mm;
+        let lift = (height * sin).max((height - tallest) * sin);
+        let slope = tan_half_h * tilt.cos();
+        BesideBound {
+            slope,
+            per_radius: (1.0 + slope * slope).sqrt() + PAD,
+            offset: tan_half_h * lift + config.max_range_mm / unit_mm * PAD,
+        }
+    }
+}
+
 /// Lanes of a wedge's outline points the camera projects
 /// ([`PixyCamera::outline_silhouette`]): at most `RIM_POINTS + 3` points,
 /// in a power of two for [`halving_16`]. Outlines of at most
@@ -508,12 +543,7 @@ impl PixyCamera {
             fx: f64::from(IMAGE_WIDTH) / 2.0 / half_h.tan(),
             fy: f64::from(IMAGE_HEIGHT) / 2.0 / half_v.tan(),
             tan_half_h: half_h.tan(),
-            side_spread: (1.0 + (half_h.tan() * tilt.cos()).powi(2)).sqrt(),
-            depth_lift: {
-                let (height, sin) = (config.height_mm / unit_mm, tilt.sin());
-                let tallest = config.puck_height_mm.max(config.robot_height_mm) / unit_mm;
-                (height * sin).max((height - tallest) * sin)
-            },
+            beside: BesideBound::new(config, unit_mm),
             cos_half_h: half_h.cos(),
             sin_half_h: half_h.sin(),
             puck_height: config.puck_height_mm / unit_mm,
@@ -710,19 +740,20 @@ impl PixyCamera {
         if ahead + b.radius < 0.0 {
             return None;
         }
+        let side = rel.dot(lens.right);
+        // The cheapest cull that leaves out most bodies first.
+        if self.beside_view(ahead, side, b.radius) {
+            return None;
+        }
         let (height, signature) = if index < robots {
             (self.robot_height, self.classify.robot_signature)
         } else {
             (self.puck_height, self.classify.puck_signature)
         };
-        let side = rel.dot(lens.right);
         if side.abs() > (ahead + b.radius + self.height + height) * self.tan_half_h + b.radius {
             return None;
         }
         let reach = self.max_range + b.radius;
-        if self.beside_view(ahead, side, b.radius, reach) {
-            return None;
-        }
         let distance_squared = ahead * ahead + side * side;
         (distance_squared <= reach * reach).then_some(Candidate {
             index,
@@ -742,20 +773,14 @@ impl PixyCamera {
     /// point at `(ahead + a, side + s)` and height `up` from the lens is
     /// beyond the right side when `side + s - tan_half_h depth > 0`, its
     /// depth `(ahead + a) cos_tilt - up sin_tilt`; `s - tan_half_h cos_tilt
-    /// a` is at least `-radius side_spread` and `-up sin_tilt` at most
-    /// `depth_lift`, so the centre's bound below holds for every point (the
-    /// left side likewise). `pad`, a billionth of the range (which every
-    /// body in view is within), keeps the decision far from rounding:
-    /// the projection rounds every point within a few units in the last
-    /// place. Only points in front of the image plane are projected: the
-    /// others make the silhouette `None` anyway.
+    /// a` is at least `-radius spread` and `-up sin_tilt` at most `lift`
+    /// ([`BesideBound`]), so the centre's bound below holds for every point
+    /// (the left side likewise). Only points in front of the image plane
+    /// are projected: the others make the silhouette `None` anyway.
     #[inline(always)]
-    fn beside_view(&self, ahead: f64, side: f64, radius: f64, reach: f64) -> bool {
-        let pad = reach * 1e-9;
-        side.abs()
-            - radius * self.side_spread
-            - self.tan_half_h * (ahead * self.cos_tilt + self.depth_lift)
-            > pad
+    fn beside_view(&self, ahead: f64, side: f64, radius: f64) -> bool {
+        let bound = &self.beside;
+        side.abs() - bound.slope * ahead > radius * bound.per_radius + bound.offset
     }
 
     /// The clipped pixel box of a cylinder of `radius` and `height` whose
@@ -1763,13 +1788,13 @@ mod tests {
                     let reach = camera.max_range + radius;
                     let ahead = rng.random_range(-radius..reach);
                     // Near where the bound crosses zero, on either side.
-                    let edge = radius * camera.side_spread
-                        + camera.tan_half_h * (ahead * camera.cos_tilt + camera.depth_lift);
+                    let bound = &camera.beside;
+                    let edge = radius * bound.per_radius + bound.offset + bound.slope * ahead;
                     let near = if k % 3 == 0 { 1e-6 } else { 0.05 };
                     let side = edge
                         * rng.random_range(1.0 - near..1.0 + near)
                         * if k % 4 < 2 { 1.0 } else { -1.0 };
-                    if !camera.beside_view(ahead, side, radius, reach) {
+                    if !camera.beside_view(ahead, side, radius) {
                         continue;
                     }
                     beside += 1;
