@@ -334,9 +334,6 @@ pub(crate) struct PixyCamera {
     fy: f64,
     /// tan(half the horizontal field of view), for culling.
     tan_half_h: f64,
-    /// cos and sin of half the horizontal field of view, for the search box.
-    cos_half_h: f64,
-    sin_half_h: f64,
     /// The side cull's bound, `|side| - slope ahead > per_radius radius +
     /// offset` ([`PixyCamera::beside_view`]), found once.
     beside: BesideBound,
@@ -397,8 +394,11 @@ impl BodyShapes {
 /// the bodies' largest radius alone (found once, not every frame).
 #[derive(Clone, Copy, Debug)]
 struct SearchSpan {
-    max_radius: f64,
-    /// How far behind the lens the widened view cone's apex lies.
+    /// How far behind the lens the culls' `ahead >= -r` cuts the cone off
+    /// (ahead of it if negative).
+    back: f64,
+    /// How far behind the lens the view cone's apex lies (ahead of it if
+    /// negative).
     behind: f64,
     /// How far from the lens a body the culls keep can lie.
     reach: f64,
@@ -406,28 +406,38 @@ struct SearchSpan {
     radius: f64,
     /// The box's padding.
     pad: f64,
-    /// Half the cone's width where the culls' `ahead >= -r` cuts it.
+    /// Half the cone's width where it is cut off.
     half_width: f64,
+    /// cos and sin of the cone's half angle.
+    cos_half: f64,
+    sin_half: f64,
 }
 
 impl SearchSpan {
     /// The sizes for `camera` and bodies up to `max_radius`.
     fn new(camera: &PixyCamera, max_radius: f64) -> SearchSpan {
-        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
-        // for every r <= max_radius and h <= the taller body lies inside the
-        // cone from the apex ...
-        let tallest = camera.puck_height.max(camera.robot_height);
-        let behind = max_radius + camera.height + tallest + max_radius / camera.tan_half_h;
-        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
+        // The side cull keeps |side| <= slope ahead + per_radius r + offset,
+        // which for every r <= max_radius lies inside the cone from the
+        // apex, of half angle atan(slope) ...
+        let bound = &camera.beside;
+        let widest = max_radius * bound.per_radius + bound.offset;
+        let behind = widest / bound.slope;
+        // ... cut off where ahead >= -r stops it, or at the apex ...
+        let back = max_radius.min(behind);
+        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of
+        // the lens, so within `reach + |behind|` of the apex.
         let reach = camera.max_range + max_radius;
-        let radius = reach + behind;
+        let radius = reach + behind.abs();
+        let hypotenuse = (1.0 + bound.slope * bound.slope).sqrt();
         SearchSpan {
-            max_radius,
+            back,
             behind,
             reach,
             radius,
             pad: radius * 1e-6,
-            half_width: (camera.height + tallest) * camera.tan_half_h + max_radius,
+            half_width: (widest - bound.slope * back).max(0.0),
+            cos_half: 1.0 / hypotenuse,
+            sin_half: bound.slope / hypotenuse,
         }
     }
 }
@@ -544,8 +554,6 @@ impl PixyCamera {
             fy: f64::from(IMAGE_HEIGHT) / 2.0 / half_v.tan(),
             tan_half_h: half_h.tan(),
             beside: BesideBound::new(config, unit_mm),
-            cos_half_h: half_h.cos(),
-            sin_half_h: half_h.sin(),
             puck_height: config.puck_height_mm / unit_mm,
             robot_height: config.robot_height_mm / unit_mm,
             max_range: config.max_range_mm / unit_mm,
@@ -664,25 +672,25 @@ impl PixyCamera {
     }
 
     /// A box of the world holding the centre of every body that
-    /// [`Self::candidate`] passes, for bodies up to `span.max_radius`: the
-    /// sector from the apex of the widened view cone (half the horizontal
-    /// field of view each side) that reaches as far as the range does, cut
-    /// off `max_radius` behind the lens, within the range's square around
-    /// the lens, padded by a millionth of its radius, far more than the
-    /// culls' rounding.
+    /// [`Self::candidate`] passes, for bodies up to the radius `span` is
+    /// for: the sector from the apex of the cone the side cull
+    /// ([`Self::beside_view`]) keeps centres in, that reaches as far as the
+    /// range does, cut off where `ahead >= -r` stops it, within the range's
+    /// square around the lens, padded by a millionth of its radius, far
+    /// more than the culls' rounding.
     fn search_box(&self, lens: &Lens, span: &SearchSpan) -> (Vec2, Vec2) {
-        let (max_radius, radius, pad) = (span.max_radius, span.radius, span.pad);
+        let (radius, pad) = (span.radius, span.pad);
         let apex = lens.pos - lens.ahead * span.behind;
         let (min, max) = (
             |a: f64, b: f64| if a < b { a } else { b },
             |a: f64, b: f64| if a > b { a } else { b },
         );
-        // The cone's corners where the culls' `ahead >= -r` cuts it, and
-        // where its edges meet the arc.
-        let back = lens.pos - lens.ahead * max_radius;
+        // The cone's corners where it is cut off, and where its edges meet
+        // the arc.
+        let back = lens.pos - lens.ahead * span.back;
         let half_width = span.half_width;
         let edge = |sign: f64| {
-            apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius
+            apex + (lens.ahead * span.cos_half + lens.right * (sign * span.sin_half)) * radius
         };
         let corners = [
             back + lens.right * half_width,
@@ -697,8 +705,8 @@ impl PixyCamera {
             high = Vec2::new(max(high.x, p.x), max(high.y, p.y));
         }
         // The arc between the edges reaches as far as `radius` along each
-        // axis within half the field of view of the heading.
-        let (a, c) = (lens.ahead, self.cos_half_h);
+        // axis within the cone's half angle of the heading.
+        let (a, c) = (lens.ahead, span.cos_half);
         if a.x >= c {
             high.x = apex.x + radius;
         }
@@ -1852,17 +1860,22 @@ mod tests {
                         camera.puck_height
                     };
                     let reach = camera.max_range + radius;
-                    // On the range's circle, on the widened cone's edges, or anywhere near.
-                    let (f, s) = match k % 3 {
+                    // On the range's circle, on the side cull's or the wider
+                    // side test's edges, or anywhere near.
+                    let (f, s) = match k % 4 {
                         0 => {
                             let angle = rng.random_range(-1.6..1.6) * (k % 7) as f64 / 6.0;
                             (reach * angle.cos(), reach * angle.sin())
                         }
-                        1 => {
+                        1 | 2 => {
                             let f = rng.random_range(-radius..reach);
-                            let side =
-                                (f + radius + camera.height + height) * camera.tan_half_h + radius;
-                            (f, if k % 4 == 1 { side } else { -side })
+                            let bound = &camera.beside;
+                            let side = if k % 4 == 1 {
+                                bound.slope * f + radius * bound.per_radius + bound.offset
+                            } else {
+                                (f + radius + camera.height + height) * camera.tan_half_h + radius
+                            };
+                            (f, if k % 8 < 4 { side } else { -side })
                         }
                         _ => (
                             rng.random_range(-reach..reach),
