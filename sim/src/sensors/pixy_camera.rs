@@ -48,6 +48,7 @@ use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::{CameraConfig, PixyBlock};
+use std::cmp::Reverse;
 
 /// Where the camera sits, what it sees, and how it forms blocks. Lengths
 /// are in millimetres.
@@ -263,7 +264,7 @@ struct InView {
 }
 
 /// A blob after occlusion: bounding box and pixel count.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Blob {
     signature: u16,
     rect: Rect,
@@ -948,13 +949,7 @@ impl PixyCamera {
     /// at most `max_blocks_per_signature` of each.
     fn emit_blocks(&mut self, out: &mut Vec<PixyBlock>) {
         out.clear();
-        self.blobs.sort_by(|a, b| {
-            a.signature
-                .cmp(&b.signature)
-                .then(b.area.cmp(&a.area))
-                .then(a.rect.left.cmp(&b.rect.left))
-                .then(a.rect.top.cmp(&b.rect.top))
-        });
+        sort_send_order(&mut self.blobs);
         let per_signature = self.per_signature;
         let mut kept = 0;
         out.extend(
@@ -1009,6 +1004,24 @@ impl Candidate {
             signature: self.signature,
             rect,
         }
+    }
+}
+
+/// Sorts blobs in the order the Pixy sends their blocks: by signature,
+/// largest first, then leftmost, then topmost; blobs alike in all four
+/// keep their order. A stable insertion sort (the standard library's
+/// stable sort gives the same order, called out of line), for a frame
+/// holds a few blobs.
+fn sort_send_order(blobs: &mut [Blob]) {
+    let key = |b: &Blob| (b.signature, Reverse(b.area), b.rect.left, b.rect.top);
+    for i in 1..blobs.len() {
+        let blob = blobs[i];
+        let mut k = i;
+        while k > 0 && key(&blob) < key(&blobs[k - 1]) {
+            blobs[k] = blobs[k - 1];
+            k -= 1;
+        }
+        blobs[k] = blob;
     }
 }
 
@@ -1491,6 +1504,39 @@ mod tests {
         let (left, disc_left) = (w.x - w.width / 2, disc.x - disc.width / 2);
         assert!(left >= disc_left && left <= disc_left + 1, "{w:?} {disc:?}");
         assert!(w.width > disc.width + 10, "{w:?} {disc:?}");
+    }
+
+    #[test]
+    fn blobs_sort_in_send_order_as_the_stable_sort_orders_them() {
+        let mut rng = SimRng::seed_from_u64(23);
+        for _ in 0..2000 {
+            // Few distinct values, so that many blobs tie in every key.
+            let mut blobs: Vec<Blob> = (0..rng.random_range(0..9))
+                .map(|_| {
+                    let (left, top) = (rng.random_range(0..3), rng.random_range(0..3));
+                    Blob {
+                        signature: rng.random_range(1..3),
+                        rect: Rect {
+                            left,
+                            top,
+                            right: left + rng.random_range(0..3),
+                            bottom: top + rng.random_range(0..3),
+                        },
+                        area: rng.random_range(1..4),
+                    }
+                })
+                .collect();
+            let mut expected = blobs.clone();
+            expected.sort_by(|a, b| {
+                a.signature
+                    .cmp(&b.signature)
+                    .then(b.area.cmp(&a.area))
+                    .then(a.rect.left.cmp(&b.rect.left))
+                    .then(a.rect.top.cmp(&b.rect.top))
+            });
+            sort_send_order(&mut blobs);
+            assert_eq!(blobs, expected);
+        }
     }
 
     #[test]
