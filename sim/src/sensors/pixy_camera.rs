@@ -48,6 +48,7 @@ use crate::world::World;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
 use shared::{CameraConfig, PixyBlock};
+use std::cmp::Reverse;
 
 /// Where the camera sits, what it sees, and how it forms blocks. Lengths
 /// are in millimetres.
@@ -263,7 +264,7 @@ struct InView {
 }
 
 /// A blob after occlusion: bounding box and pixel count.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Blob {
     signature: u16,
     rect: Rect,
@@ -334,16 +335,9 @@ pub(crate) struct PixyCamera {
     fy: f64,
     /// tan(half the horizontal field of view), for culling.
     tan_half_h: f64,
-    /// cos and sin of half the horizontal field of view, for the search box.
-    cos_half_h: f64,
-    sin_half_h: f64,
-    /// `sqrt(1 + (tan_half_h cos_tilt)^2)`: how much a point at most a
-    /// unit from a body's centre can bring `|side| - tan_half_h depth` below
-    /// the centre's ([`PixyCamera::beside_view`]).
-    side_spread: f64,
-    /// The most a point's height adds to its depth (`-up sin_tilt`, for
-    /// points between the floor and the tallest body).
-    depth_lift: f64,
+    /// The side cull's bound, `|side| - slope ahead > per_radius radius +
+    /// offset` ([`PixyCamera::beside_view`]), found once.
+    beside: BesideBound,
     puck_height: f64,
     robot_height: f64,
     max_range: f64,
@@ -401,8 +395,11 @@ impl BodyShapes {
 /// the bodies' largest radius alone (found once, not every frame).
 #[derive(Clone, Copy, Debug)]
 struct SearchSpan {
-    max_radius: f64,
-    /// How far behind the lens the widened view cone's apex lies.
+    /// How far behind the lens the culls' `ahead >= -r` cuts the cone off
+    /// (ahead of it if negative).
+    back: f64,
+    /// How far behind the lens the view cone's apex lies (ahead of it if
+    /// negative).
     behind: f64,
     /// How far from the lens a body the culls keep can lie.
     reach: f64,
@@ -410,28 +407,77 @@ struct SearchSpan {
     radius: f64,
     /// The box's padding.
     pad: f64,
-    /// Half the cone's width where the culls' `ahead >= -r` cuts it.
+    /// Half the cone's width where it is cut off.
     half_width: f64,
+    /// cos and sin of the cone's half angle.
+    cos_half: f64,
+    sin_half: f64,
 }
 
 impl SearchSpan {
     /// The sizes for `camera` and bodies up to `max_radius`.
     fn new(camera: &PixyCamera, max_radius: f64) -> SearchSpan {
-        // The culls keep |side| <= (ahead + r + height + h) * tan + r, which
-        // for every r <= max_radius and h <= the taller body lies inside the
-        // cone from the apex ...
-        let tallest = camera.puck_height.max(camera.robot_height);
-        let behind = max_radius + camera.height + tallest + max_radius / camera.tan_half_h;
-        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of the lens.
+        // The side cull keeps |side| <= slope ahead + per_radius r + offset,
+        // which for every r <= max_radius lies inside the cone from the
+        // apex, of half angle atan(slope) ...
+        let bound = &camera.beside;
+        let widest = max_radius * bound.per_radius + bound.offset;
+        let behind = widest / bound.slope;
+        // ... cut off where ahead >= -r stops it, or at the apex ...
+        let back = max_radius.min(behind);
+        // ... and ahead^2 + side^2 <= (max_range + r)^2 within `reach` of
+        // the lens, so within `reach + |behind|` of the apex.
         let reach = camera.max_range + max_radius;
-        let radius = reach + behind;
+        let radius = reach + behind.abs();
+        let hypotenuse = (1.0 + bound.slope * bound.slope).sqrt();
         SearchSpan {
-            max_radius,
+            back,
             behind,
             reach,
             radius,
             pad: radius * 1e-6,
-            half_width: (camera.height + tallest) * camera.tan_half_h + max_radius,
+            half_width: (widest - bound.slope * back).max(0.0),
+            cos_half: 1.0 / hypotenuse,
+            sin_half: bound.slope / hypotenuse,
+        }
+    }
+}
+
+/// [`PixyCamera::beside_view`]'s bound, `|side| - slope ahead >
+/// per_radius radius + offset`: with `spread = sqrt(1 + (tan_half_h
+/// cos_tilt)^2)`, how much a point at most a unit from a body's centre can
+/// bring `|side| - tan_half_h depth` below the centre's, and `lift`, the
+/// most a point's height adds to its depth (`-up sin_tilt`, for points
+/// between the floor and the tallest body), it is `|side| - tan_half_h
+/// (ahead cos_tilt + lift) - radius spread > pad`. The pad, a billionth of
+/// the farthest a body in view can be (`max_range + radius`), keeps the
+/// decision far from rounding: the projection, and this bound's terms,
+/// round within a few units in the last place of the range.
+#[derive(Clone, Copy, Debug)]
+struct BesideBound {
+    /// `tan_half_h cos_tilt`.
+    slope: f64,
+    /// `spread` and the pad's part per unit of radius.
+    per_radius: f64,
+    /// `tan_half_h lift` and the pad's part for the range.
+    offset: f64,
+}
+
+impl BesideBound {
+    /// The bound of a camera of `config` in a world of `unit_mm`
+    /// millimetres per unit.
+    fn new(config: &PixyCameraConfig, unit_mm: f64) -> BesideBound {
+        const PAD: f64 = 1e-9;
+        let tilt = config.tilt_deg.to_radians();
+        let tan_half_h = (config.fov_h_deg / 2.0).to_radians().tan();
+        let (height, sin) = (config.height_mm / unit_mm, tilt.sin());
+        let tallest = config.puck_height_mm.max(config.robot_height_mm) / unit_mm;
+        let lift = (height * sin).max((height - tallest) * sin);
+        let slope = tan_half_h * tilt.cos();
+        BesideBound {
+            slope,
+            per_radius: (1.0 + slope * slope).sqrt() + PAD,
+            offset: tan_half_h * lift + config.max_range_mm / unit_mm * PAD,
         }
     }
 }
@@ -508,14 +554,7 @@ impl PixyCamera {
             fx: f64::from(IMAGE_WIDTH) / 2.0 / half_h.tan(),
             fy: f64::from(IMAGE_HEIGHT) / 2.0 / half_v.tan(),
             tan_half_h: half_h.tan(),
-            side_spread: (1.0 + (half_h.tan() * tilt.cos()).powi(2)).sqrt(),
-            depth_lift: {
-                let (height, sin) = (config.height_mm / unit_mm, tilt.sin());
-                let tallest = config.puck_height_mm.max(config.robot_height_mm) / unit_mm;
-                (height * sin).max((height - tallest) * sin)
-            },
-            cos_half_h: half_h.cos(),
-            sin_half_h: half_h.sin(),
+            beside: BesideBound::new(config, unit_mm),
             puck_height: config.puck_height_mm / unit_mm,
             robot_height: config.robot_height_mm / unit_mm,
             max_range: config.max_range_mm / unit_mm,
@@ -634,25 +673,25 @@ impl PixyCamera {
     }
 
     /// A box of the world holding the centre of every body that
-    /// [`Self::candidate`] passes, for bodies up to `span.max_radius`: the
-    /// sector from the apex of the widened view cone (half the horizontal
-    /// field of view each side) that reaches as far as the range does, cut
-    /// off `max_radius` behind the lens, within the range's square around
-    /// the lens, padded by a millionth of its radius, far more than the
-    /// culls' rounding.
+    /// [`Self::candidate`] passes, for bodies up to the radius `span` is
+    /// for: the sector from the apex of the cone the side cull
+    /// ([`Self::beside_view`]) keeps centres in, that reaches as far as the
+    /// range does, cut off where `ahead >= -r` stops it, within the range's
+    /// square around the lens, padded by a millionth of its radius, far
+    /// more than the culls' rounding.
     fn search_box(&self, lens: &Lens, span: &SearchSpan) -> (Vec2, Vec2) {
-        let (max_radius, radius, pad) = (span.max_radius, span.radius, span.pad);
+        let (radius, pad) = (span.radius, span.pad);
         let apex = lens.pos - lens.ahead * span.behind;
         let (min, max) = (
             |a: f64, b: f64| if a < b { a } else { b },
             |a: f64, b: f64| if a > b { a } else { b },
         );
-        // The cone's corners where the culls' `ahead >= -r` cuts it, and
-        // where its edges meet the arc.
-        let back = lens.pos - lens.ahead * max_radius;
+        // The cone's corners where it is cut off, and where its edges meet
+        // the arc.
+        let back = lens.pos - lens.ahead * span.back;
         let half_width = span.half_width;
         let edge = |sign: f64| {
-            apex + (lens.ahead * self.cos_half_h + lens.right * (sign * self.sin_half_h)) * radius
+            apex + (lens.ahead * span.cos_half + lens.right * (sign * span.sin_half)) * radius
         };
         let corners = [
             back + lens.right * half_width,
@@ -667,8 +706,8 @@ impl PixyCamera {
             high = Vec2::new(max(high.x, p.x), max(high.y, p.y));
         }
         // The arc between the edges reaches as far as `radius` along each
-        // axis within half the field of view of the heading.
-        let (a, c) = (lens.ahead, self.cos_half_h);
+        // axis within the cone's half angle of the heading.
+        let (a, c) = (lens.ahead, span.cos_half);
         if a.x >= c {
             high.x = apex.x + radius;
         }
@@ -692,8 +731,8 @@ impl PixyCamera {
 
     /// Body `b` if it is another body than robot `robot` (of `robots`,
     /// whose bodies come first) and the cheap culls before projecting keep
-    /// it: not behind the lens, not far outside the horizontal field of
-    /// view, not beside it ([`Self::beside_view`]), in range.
+    /// it: not behind the lens, not beside the view ([`Self::beside_view`]),
+    /// not far outside the horizontal field of view, in range.
     fn candidate(
         &self,
         robots: usize,
@@ -710,19 +749,21 @@ impl PixyCamera {
         if ahead + b.radius < 0.0 {
             return None;
         }
+        let side = rel.dot(lens.right);
+        // The side cull before the side test: it leaves out more bodies,
+        // in fewer instructions.
+        if self.beside_view(ahead, side, b.radius) {
+            return None;
+        }
         let (height, signature) = if index < robots {
             (self.robot_height, self.classify.robot_signature)
         } else {
             (self.puck_height, self.classify.puck_signature)
         };
-        let side = rel.dot(lens.right);
         if side.abs() > (ahead + b.radius + self.height + height) * self.tan_half_h + b.radius {
             return None;
         }
         let reach = self.max_range + b.radius;
-        if self.beside_view(ahead, side, b.radius, reach) {
-            return None;
-        }
         let distance_squared = ahead * ahead + side * side;
         (distance_squared <= reach * reach).then_some(Candidate {
             index,
@@ -738,24 +779,19 @@ impl PixyCamera {
     /// Whether every point within `radius` of a centre `ahead` of and
     /// `side` right of the lens, between the floor and the tallest body,
     /// projects beyond one side of the image, so that its silhouette is
-    /// `None` (a third of the bodies the other culls keep on `tv75`). A
+    /// `None` (two thirds of the bodies in front of the lens its search box
+    /// visits on `tv75`). A
     /// point at `(ahead + a, side + s)` and height `up` from the lens is
     /// beyond the right side when `side + s - tan_half_h depth > 0`, its
     /// depth `(ahead + a) cos_tilt - up sin_tilt`; `s - tan_half_h cos_tilt
-    /// a` is at least `-radius side_spread` and `-up sin_tilt` at most
-    /// `depth_lift`, so the centre's bound below holds for every point (the
-    /// left side likewise). `pad`, a billionth of the range (which every
-    /// body in view is within), keeps the decision far from rounding:
-    /// the projection rounds every point within a few units in the last
-    /// place. Only points in front of the image plane are projected: the
-    /// others make the silhouette `None` anyway.
+    /// a` is at least `-radius spread` and `-up sin_tilt` at most `lift`
+    /// ([`BesideBound`]), so the centre's bound below holds for every point
+    /// (the left side likewise). Only points in front of the image plane
+    /// are projected: the others make the silhouette `None` anyway.
     #[inline(always)]
-    fn beside_view(&self, ahead: f64, side: f64, radius: f64, reach: f64) -> bool {
-        let pad = reach * 1e-9;
-        side.abs()
-            - radius * self.side_spread
-            - self.tan_half_h * (ahead * self.cos_tilt + self.depth_lift)
-            > pad
+    fn beside_view(&self, ahead: f64, side: f64, radius: f64) -> bool {
+        let bound = &self.beside;
+        side.abs() - bound.slope * ahead > radius * bound.per_radius + bound.offset
     }
 
     /// The clipped pixel box of a cylinder of `radius` and `height` whose
@@ -915,13 +951,7 @@ impl PixyCamera {
     /// at most `max_blocks_per_signature` of each.
     fn emit_blocks(&mut self, out: &mut Vec<PixyBlock>) {
         out.clear();
-        self.blobs.sort_by(|a, b| {
-            a.signature
-                .cmp(&b.signature)
-                .then(b.area.cmp(&a.area))
-                .then(a.rect.left.cmp(&b.rect.left))
-                .then(a.rect.top.cmp(&b.rect.top))
-        });
+        sort_send_order(&mut self.blobs);
         let per_signature = self.per_signature;
         let mut kept = 0;
         out.extend(
@@ -976,6 +1006,24 @@ impl Candidate {
             signature: self.signature,
             rect,
         }
+    }
+}
+
+/// Sorts blobs in the order the Pixy sends their blocks: by signature,
+/// largest first, then leftmost, then topmost; blobs alike in all four
+/// keep their order. A stable insertion sort (the standard library's
+/// stable sort gives the same order, called out of line), for a frame
+/// holds a few blobs.
+fn sort_send_order(blobs: &mut [Blob]) {
+    let key = |b: &Blob| (b.signature, Reverse(b.area), b.rect.left, b.rect.top);
+    for i in 1..blobs.len() {
+        let blob = blobs[i];
+        let mut k = i;
+        while k > 0 && key(&blob) < key(&blobs[k - 1]) {
+            blobs[k] = blobs[k - 1];
+            k -= 1;
+        }
+        blobs[k] = blob;
     }
 }
 
@@ -1461,6 +1509,39 @@ mod tests {
     }
 
     #[test]
+    fn blobs_sort_in_send_order_as_the_stable_sort_orders_them() {
+        let mut rng = SimRng::seed_from_u64(23);
+        for _ in 0..2000 {
+            // Few distinct values, so that many blobs tie in every key.
+            let mut blobs: Vec<Blob> = (0..rng.random_range(0..9))
+                .map(|_| {
+                    let (left, top) = (rng.random_range(0..3), rng.random_range(0..3));
+                    Blob {
+                        signature: rng.random_range(1..3),
+                        rect: Rect {
+                            left,
+                            top,
+                            right: left + rng.random_range(0..3),
+                            bottom: top + rng.random_range(0..3),
+                        },
+                        area: rng.random_range(1..4),
+                    }
+                })
+                .collect();
+            let mut expected = blobs.clone();
+            expected.sort_by(|a, b| {
+                a.signature
+                    .cmp(&b.signature)
+                    .then(b.area.cmp(&a.area))
+                    .then(a.rect.left.cmp(&b.rect.left))
+                    .then(a.rect.top.cmp(&b.rect.top))
+            });
+            sort_send_order(&mut blobs);
+            assert_eq!(blobs, expected);
+        }
+    }
+
+    #[test]
     fn touching_pucks_merge_into_one_block() {
         let blocks = frame_of(&[], &[(5.0, -1.0), (5.0, 1.0)]);
         assert_eq!(blocks.len(), 1, "{blocks:?}");
@@ -1763,13 +1844,13 @@ mod tests {
                     let reach = camera.max_range + radius;
                     let ahead = rng.random_range(-radius..reach);
                     // Near where the bound crosses zero, on either side.
-                    let edge = radius * camera.side_spread
-                        + camera.tan_half_h * (ahead * camera.cos_tilt + camera.depth_lift);
+                    let bound = &camera.beside;
+                    let edge = radius * bound.per_radius + bound.offset + bound.slope * ahead;
                     let near = if k % 3 == 0 { 1e-6 } else { 0.05 };
                     let side = edge
                         * rng.random_range(1.0 - near..1.0 + near)
                         * if k % 4 < 2 { 1.0 } else { -1.0 };
-                    if !camera.beside_view(ahead, side, radius, reach) {
+                    if !camera.beside_view(ahead, side, radius) {
                         continue;
                     }
                     beside += 1;
@@ -1827,17 +1908,22 @@ mod tests {
                         camera.puck_height
                     };
                     let reach = camera.max_range + radius;
-                    // On the range's circle, on the widened cone's edges, or anywhere near.
-                    let (f, s) = match k % 3 {
+                    // On the range's circle, on the side cull's or the wider
+                    // side test's edges, or anywhere near.
+                    let (f, s) = match k % 4 {
                         0 => {
                             let angle = rng.random_range(-1.6..1.6) * (k % 7) as f64 / 6.0;
                             (reach * angle.cos(), reach * angle.sin())
                         }
-                        1 => {
+                        1 | 2 => {
                             let f = rng.random_range(-radius..reach);
-                            let side =
-                                (f + radius + camera.height + height) * camera.tan_half_h + radius;
-                            (f, if k % 4 == 1 { side } else { -side })
+                            let bound = &camera.beside;
+                            let side = if k % 4 == 1 {
+                                bound.slope * f + radius * bound.per_radius + bound.offset
+                            } else {
+                                (f + radius + camera.height + height) * camera.tan_half_h + radius
+                            };
+                            (f, if k % 8 < 4 { side } else { -side })
                         }
                         _ => (
                             rng.random_range(-reach..reach),
