@@ -35,6 +35,18 @@ pub(crate) fn round_half_away(t: f64) -> i64 {
         .saturating_sub(i64::from(frac <= -0.5))
 }
 
+/// `round_half_away(t).clamp(0, limit)`, rounded after clamping:
+/// rounding is monotone and keeps 0 and `limit`, so the order makes no
+/// difference, and from 0 up it is a truncation and a comparison (the
+/// fraction is exact). NaN gives 0, as there. (A camera block's jittered
+/// place: fewer instructions than rounding, then clamping.)
+#[inline]
+pub(crate) fn round_half_away_within(t: f64, limit: u16) -> u16 {
+    let t = t.clamp(0.0, f64::from(limit));
+    let whole = t as u16;
+    whole + u16::from(t - f64::from(whole) >= 0.5)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,6 +95,25 @@ mod tests {
     fn rounding_matches_the_standard_round() {
         for t in values() {
             assert_eq!(round_half_away(t), t.round() as i64, "{t:e}");
+        }
+    }
+
+    #[test]
+    fn rounding_within_a_limit_is_rounding_then_clamping() {
+        let mut values = values();
+        for k in -400..=2_000 {
+            let v = f64::from(k) / 4.0;
+            values.extend([v, v.next_down(), v.next_up(), v + 0.123]);
+        }
+        for limit in [0, 1, 207, 208, 315, 316, u16::MAX] {
+            for &v in &values {
+                let clamped = round_half_away(v).clamp(0, i64::from(limit)) as u16;
+                assert_eq!(
+                    round_half_away_within(v, limit),
+                    clamped,
+                    "{v} within {limit}"
+                );
+            }
         }
     }
 }

@@ -9,6 +9,7 @@
 use crate::base::gain_grid::GainGrid;
 use crate::base::noise::{self, Purpose, Stream};
 use crate::base::ranges;
+use crate::base::rounding::round_half_away_within;
 use crate::config::validate::ConfigError;
 use serde::{Deserialize, Serialize};
 use shared::camera::{IMAGE_HEIGHT, IMAGE_WIDTH};
@@ -141,7 +142,7 @@ impl RobotNoise {
         if self.block_jitter_px > 0.0 {
             let jitter = |v: u16, limit: u16, rng: &mut Stream| {
                 let moved = f64::from(v) + self.block_jitter_px * noise::normal(rng);
-                round_within(moved, limit)
+                round_half_away_within(moved, limit)
             };
             for b in frame.iter_mut() {
                 b.x = jitter(b.x, IMAGE_WIDTH - 1, rng);
@@ -170,17 +171,6 @@ impl RobotNoise {
     }
 }
 
-/// `round_half_away(v).clamp(0, limit)`
-/// ([`crate::base::rounding::round_half_away`]), rounded after clamping:
-/// rounding is monotone and keeps 0 and `limit`, so the order makes no
-/// difference, and from 0 up it is a truncation and a comparison (the
-/// fraction is exact). NaN gives 0, as there.
-fn round_within(v: f64, limit: u16) -> u16 {
-    let t = v.clamp(0.0, f64::from(limit));
-    let whole = t as u16;
-    whole + u16::from(t - f64::from(whole) >= 0.5)
-}
-
 fn rng_unit(rng: &mut Stream) -> f64 {
     noise::symmetric(rng, 0.5) + 0.5
 }
@@ -188,22 +178,6 @@ fn rng_unit(rng: &mut Stream) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::base::rounding::round_half_away;
-
-    #[test]
-    fn a_block_s_jittered_place_rounds_as_rounding_then_clamping_does() {
-        let mut values = vec![f64::NAN, -0.0, 0.0, 0.5, -0.5, 1e300, -1e300];
-        for k in -400..=2_000 {
-            let v = f64::from(k) / 4.0;
-            values.extend([v, v.next_down(), v.next_up(), v + 0.123]);
-        }
-        for limit in [IMAGE_WIDTH - 1, IMAGE_HEIGHT - 1, IMAGE_WIDTH, IMAGE_HEIGHT] {
-            for &v in &values {
-                let clamped = round_half_away(v).clamp(0, i64::from(limit)) as u16;
-                assert_eq!(round_within(v, limit), clamped, "{v} within {limit}");
-            }
-        }
-    }
 
     #[test]
     fn no_noise_changes_nothing() {
