@@ -6,7 +6,10 @@
 //! and its tables, `state-*.policy`, written by `host experiment
 //! experiments/campaigns/general-state.toml`) and the general-policy
 //! campaign's (`docs/generated-shapes/evaluate-policy*.jsonl`, written by
-//! `host experiment experiments/campaigns/general-policy.toml`).
+//! `host experiment experiments/campaigns/general-policy.toml`) and the
+//! general-hold campaign's search log
+//! (`docs/generated-shapes/general-hold.search.json`, written by `host
+//! experiment experiments/campaigns/general-hold.toml`).
 
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -19,6 +22,10 @@ const END: &str = "<!-- generated-shapes end -->";
 /// The lines around the general-policy campaign's tables.
 const POLICY_BEGIN: &str = "<!-- general-policy begin: generated from docs/generated-shapes/evaluate-policy*.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
 const POLICY_END: &str = "<!-- general-policy end -->";
+
+/// The lines around the general-hold campaign's tables.
+const HOLD_BEGIN: &str = "<!-- general-hold begin: generated from docs/generated-shapes/general-hold.search.json by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
+const HOLD_END: &str = "<!-- general-hold end -->";
 
 /// The lines around the annulus-first lineage's table.
 const ANNULUS_FIRST_BEGIN: &str = "<!-- annulus-first begin: generated from docs/generated-shapes/evaluate-after-annulus.jsonl by host/tests/generated_shapes_doc.rs (the test prints it); do not edit -->";
@@ -161,6 +168,82 @@ fn per_shape((fields, sums): &Sums, names: &[(&str, &str)]) -> String {
     out
 }
 
+/// The general-hold search's generations: each challenger's balance
+/// against the start's, and the worlds (shape and noise level) where it
+/// formed less than the hold share of the start's count, the report's
+/// shapes by name with the share they kept.
+fn hold_table(dir: &Path) -> String {
+    let text = std::fs::read_to_string(dir.join("general-hold.search.json")).unwrap();
+    let log: Value = serde_json::from_str(&text).unwrap();
+    let search = &log["search"];
+    let hold = search["hold"].as_f64().unwrap();
+    let shapes: Vec<String> = std::iter::once(&log["world"]["field"])
+        .chain(search["also_field"].as_array().unwrap())
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    let noises: Vec<String> = std::iter::once("default".to_string())
+        .chain(
+            search["also_noise"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|n| format!("{}x", n.as_f64().unwrap())),
+        )
+        .collect();
+    let worlds: Vec<(String, String)> = shapes
+        .iter()
+        .flat_map(|s| noises.iter().map(move |n| (s.clone(), n.clone())))
+        .collect();
+    let counts = |score: &Value| -> Vec<u64> {
+        score["fields"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .collect()
+    };
+    let start = counts(&log["start_validation"]);
+    assert_eq!(
+        start.len(),
+        worlds.len(),
+        "a count per shape and noise level"
+    );
+    let start_balance = log["start_validation"]["balance"].as_f64().unwrap();
+    let mut out = format!(
+        "| generation | challenger's balance (start {start_balance:.2}) | replaced the result | worlds below {hold} of the start | report shapes below it (share kept) |\n\
+         | ---: | ---: | --- | ---: | --- |\n"
+    );
+    for g in log["generations"].as_array().unwrap() {
+        let challenger = &g["challenger_validation"];
+        let below: Vec<(&(String, String), f64)> = counts(challenger)
+            .iter()
+            .zip(&start)
+            .zip(&worlds)
+            .filter(|((&mine, &theirs), _)| (mine as f64) < hold * theirs as f64)
+            .map(|((&mine, &theirs), world)| (world, mine as f64 / theirs as f64))
+            .collect();
+        let report: Vec<String> = below
+            .iter()
+            .filter(|((shape, _), _)| split(shape) == "report")
+            .map(|((shape, noise), share)| format!("`{shape}` {noise} {share:.2}"))
+            .collect();
+        out += &format!(
+            "| {} | {:.2} | {} | {} of {} | {} |\n",
+            g["generation"].as_u64().unwrap() + 1,
+            challenger["balance"].as_f64().unwrap(),
+            if g["replaced"].as_bool().unwrap() {
+                "yes"
+            } else {
+                "no"
+            },
+            below.len(),
+            worlds.len(),
+            report.join(", ")
+        );
+    }
+    out
+}
+
 /// The annulus-first lineage's table: its two tables per shape.
 fn annulus_first_table(dir: &Path) -> String {
     let names = [
@@ -279,6 +362,11 @@ fn the_general_policy_tables_are_what_its_evaluations_give() {
         POLICY_END,
         &tables(&data(), "evaluate-policy"),
     );
+}
+
+#[test]
+fn the_general_hold_table_is_what_its_search_log_gives() {
+    assert_between(HOLD_BEGIN, HOLD_END, &hold_table(&data()));
 }
 
 #[test]

@@ -8,8 +8,10 @@
 //! distribution moves towards the `elites` best; the best candidate other
 //! than the result is scored on the validation worlds, and becomes the
 //! result only if it forms more there than the result did (or as many, at
-//! a higher mean Eval). So the result never forms fewer than the start
-//! table on the validation worlds. Scores: [`Score`].
+//! a higher mean Eval) and, with a `hold` share, forms at least that share
+//! of the start table's count there on every field and noise level. So the
+//! result never forms fewer than the start table on the validation worlds.
+//! Scores: [`Score`].
 
 use super::cem::{random_table, Categorical};
 use super::config::{default_world, SearchConfig, Start, DEFAULT_DISTIL_STEPS};
@@ -373,14 +375,16 @@ pub fn run_from(
     let fields = scorer.fields() as u64;
     let validation_cost = settings.validation_steps * validation.len() as u64 * fields;
     let fitness_cost = settings.fitness_steps * settings.fitness_seeds as u64 * fields;
-    let start_validation = scorer.score(
-        std::slice::from_ref(&start),
-        &validation,
-        settings.validation_steps,
-    )?[0];
+    let start_validation = scorer
+        .score(
+            std::slice::from_ref(&start),
+            &validation,
+            settings.validation_steps,
+        )?
+        .remove(0);
     let mut steps = validation_cost;
     let mut distribution = Categorical::around(&start, actions, settings.keep);
-    let (mut result, mut result_validation) = (start, start_validation);
+    let (mut result, mut result_validation) = (start, start_validation.clone());
     let mut generations: Vec<Generation> = Vec::new();
     for g in 0..settings.generations {
         let mut rng = SimRng::seed_from_u64(mix(mix(config.world.seed ^ SAMPLE_STREAM) ^ g));
@@ -414,20 +418,23 @@ pub fn run_from(
         distribution.update(&elites, settings.rate, settings.floor);
         let challenger = ranked.iter().copied().find(|&i| i != 0).unwrap_or(1);
         let challenger_validation = match earlier {
-            Some(earlier) => earlier.challenger_validation,
+            Some(earlier) => earlier.challenger_validation.clone(),
             None => {
                 steps += validation_cost;
-                scorer.score(
-                    std::slice::from_ref(&candidates[challenger]),
-                    &validation,
-                    settings.validation_steps,
-                )?[0]
+                scorer
+                    .score(
+                        std::slice::from_ref(&candidates[challenger]),
+                        &validation,
+                        settings.validation_steps,
+                    )?
+                    .remove(0)
             }
         };
-        let replaced = challenger_validation.beats(&result_validation);
+        let replaced = challenger_validation.beats(&result_validation)
+            && challenger_validation.holds(&start_validation, settings.hold);
         if replaced {
             result = candidates[challenger].clone();
-            result_validation = challenger_validation;
+            result_validation = challenger_validation.clone();
         }
         let generation = Generation {
             generation: g,
@@ -435,7 +442,7 @@ pub fn run_from(
             fitness_seeds: seeds,
             challenger,
             challenger_validation,
-            result_validation,
+            result_validation: result_validation.clone(),
             replaced,
             entropy: distribution.mean_entropy(),
             steps: earlier.map_or(steps, |e| e.steps),
@@ -490,6 +497,7 @@ mod tests {
             threads,
             also_field: Vec::new(),
             also_noise: Vec::new(),
+            hold: 0.0,
         }
     }
 
@@ -510,21 +518,64 @@ mod tests {
 
     /// [`small`], also scored on `also_field`.
     fn small_over(threads: usize, start: Start, also_field: Vec<FieldSource>) -> SearchLog {
-        let flags = small_flags();
+        small_with(SearchConfig {
+            also_field,
+            ..small_settings(threads, start)
+        })
+    }
+
+    /// The small search's world searched with `search`.
+    fn small_with(search: SearchConfig) -> SearchLog {
         let request = SearchRequest {
             config: None,
-            flags,
-            search: SearchConfig {
-                also_field,
-                ..small_settings(threads, start)
-            },
+            flags: small_flags(),
+            search,
         };
         let configs = worlds(&request).unwrap();
         let config = configs[0].clone();
         assert_eq!(config.world.pucks, Some(12), "the annulus' count on the TV");
-        let scorer = Scorer::new(&configs, threads).unwrap();
+        let scorer = Scorer::new(&configs, request.search.threads).unwrap();
         let (table, distilled) = start_table(&config, &request.search.start).unwrap();
         run(&config, &request.search, &scorer, table, distilled).unwrap()
+    }
+
+    #[test]
+    fn with_a_hold_share_the_result_keeps_that_share_of_the_start_on_every_field() {
+        let search = |hold: f64| {
+            small_with(SearchConfig {
+                also_noise: vec![2.0],
+                generations: 4,
+                hold,
+                ..small_settings(2, Start::Orbital)
+            })
+        };
+        let free = search(0.0);
+        assert_eq!(free.start_validation.fields.len(), 2, "both noise levels");
+        let held = search(1.0);
+        for g in &held.generations {
+            let holds = g.challenger_validation.holds(&held.start_validation, 1.0);
+            assert_eq!(
+                g.replaced,
+                holds && g.challenger_validation.beats(&g_before(&held, g))
+            );
+        }
+        assert!(held.result_validation.holds(&held.start_validation, 1.0));
+        // the bar decides: a challenger the free search took fails it here
+        assert!(
+            free.generations
+                .iter()
+                .any(|g| g.replaced && !g.challenger_validation.holds(&free.start_validation, 1.0)),
+            "the free search gave up a field somewhere: the test must see the bar act"
+        );
+        assert_ne!(free.generations, held.generations);
+    }
+
+    /// The result's validation score before generation `g`.
+    fn g_before(log: &SearchLog, g: &Generation) -> Score {
+        match g.generation {
+            0 => log.start_validation.clone(),
+            n => log.generations[n as usize - 1].result_validation.clone(),
+        }
     }
 
     #[test]
@@ -642,11 +693,11 @@ mod tests {
         for start in [Start::Orbital, Start::Random] {
             let log = small(2, start);
             assert!(log.result_validation.formations >= log.start_validation.formations);
-            let mut best = log.start_validation;
+            let mut best = log.start_validation.clone();
             for g in &log.generations {
                 assert_eq!(g.replaced, g.challenger_validation.beats(&best));
                 if g.replaced {
-                    best = g.challenger_validation;
+                    best = g.challenger_validation.clone();
                 }
                 assert_eq!(g.result_validation, best, "the best validated so far");
             }

@@ -128,6 +128,13 @@ pub struct SearchConfig {
     #[arg(long = "also-noise", value_name = "MULTIPLE")]
     #[serde(default)]
     pub also_noise: Vec<f64>,
+    /// A challenger becomes the result only if it also forms at least this
+    /// share of the start table's count on the validation worlds of every
+    /// field and noise level (0: no such bar): a general table that gains
+    /// on some shapes without giving up others.
+    #[arg(long, value_name = "SHARE", default_value_t = 0.0)]
+    #[serde(default)]
+    pub hold: f64,
 }
 
 impl SearchConfig {
@@ -162,6 +169,7 @@ impl SearchConfig {
             ("--keep", self.keep),
             ("--rate", self.rate),
             ("--floor", self.floor),
+            ("--hold", self.hold),
         ] {
             ranges::SEARCH_PROBABILITY.check_as(flag, value)?;
         }

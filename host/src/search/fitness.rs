@@ -44,7 +44,7 @@ pub fn validation_seeds(seed: u64, count: usize) -> Vec<u64> {
 
 /// A table's score on a set of worlds: a higher balance is better (more
 /// formations, with one field), and of equal balance a higher mean Eval.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Score {
     /// Formations, summed over the worlds of every field.
     pub formations: u64,
@@ -52,6 +52,10 @@ pub struct Score {
     pub eval: f64,
     /// The sum over the fields of ln(1 + the field's formations).
     pub balance: f64,
+    /// Formations on each field (each field and noise level of the
+    /// search, in its order), summed over the worlds.
+    #[serde(default)]
+    pub fields: Vec<u64>,
 }
 
 impl Score {
@@ -67,12 +71,24 @@ impl Score {
             .unwrap_or(std::cmp::Ordering::Equal)
     }
 
+    /// Whether this score forms at least `share` of `bar`'s count on
+    /// every field (always, with a share of 0).
+    pub fn holds(&self, bar: &Score, share: f64) -> bool {
+        self.fields.len() == bar.fields.len()
+            && self
+                .fields
+                .iter()
+                .zip(&bar.fields)
+                .all(|(&mine, &theirs)| mine as f64 >= share * theirs as f64)
+    }
+
     /// The score of per-field scores (formations and mean Eval of each).
     fn of_fields(fields: &[(u64, f64)]) -> Score {
         Score {
             formations: fields.iter().map(|f| f.0).sum(),
             eval: fields.iter().map(|f| f.1).sum::<f64>() / fields.len().max(1) as f64,
             balance: fields.iter().map(|f| (f.0 as f64).ln_1p()).sum(),
+            fields: fields.iter().map(|f| f.0).collect(),
         }
     }
 }
@@ -199,6 +215,24 @@ mod tests {
         let strong_plus = Score::of_fields(&[(1010, 0.5), (10, 0.5)]);
         assert!(weak_doubled.beats(&strong_plus));
         assert_eq!(weak_doubled.formations, 1020);
+    }
+
+    #[test]
+    fn a_score_holds_a_share_of_another_only_on_every_field() {
+        let bar = Score::of_fields(&[(100, 0.5), (10, 0.5)]);
+        let gains_one_loses_one = Score::of_fields(&[(300, 0.5), (8, 0.5)]);
+        assert!(gains_one_loses_one.beats(&bar));
+        assert!(!gains_one_loses_one.holds(&bar, 1.0));
+        assert!(gains_one_loses_one.holds(&bar, 0.8));
+        assert!(
+            gains_one_loses_one.holds(&bar, 0.0),
+            "a share of 0 holds anything"
+        );
+        let other_fields = Score::of_fields(&[(300, 0.5)]);
+        assert!(
+            !other_fields.holds(&bar, 0.0),
+            "scores of other worlds never hold"
+        );
     }
 
     #[test]

@@ -163,6 +163,7 @@ pub fn search_settings(scale: f64) -> SearchConfig {
         threads: 0,
         also_field: Vec::new(),
         also_noise: vec![2.0],
+        hold: 0.0,
     }
 }
 
@@ -228,7 +229,7 @@ fn choose_start(
         distil_orbital(config, distilled)?,
         distil_orbital(&role, distilled)?,
     ];
-    let scores = scorer.score(&tables, &seeds, settings.fitness_steps)?;
+    let mut scores = scorer.score(&tables, &seeds, settings.fitness_steps)?;
     let best = (1..tables.len()).fold(0, |best, i| {
         if scores[i].beats(&scores[best]) {
             i
@@ -236,11 +237,12 @@ fn choose_start(
             best
         }
     });
+    let (oc_role, oc, general) = (scores.remove(2), scores.remove(1), scores.remove(0));
     Ok(StartChoice {
         chosen: STARTS[best].to_string(),
-        general: scores[0],
-        oc: scores[1],
-        oc_role: scores[2],
+        general,
+        oc,
+        oc_role,
         seeds,
         hasher: tables[best].hasher().name().to_string(),
         table: tables[best].packed().to_vec(),

@@ -657,13 +657,13 @@ pub const SEARCH_WORLDS: Range = Range::closed(
     "2 and 4 by default; the thesis' experiments run 10 trials",
 );
 
-/// The policy search's probabilities.
+/// The policy search's probabilities and shares.
 pub const SEARCH_PROBABILITY: Range = Range::closed(
-    &["--keep", "--rate", "--floor"],
+    &["--keep", "--rate", "--floor", "--hold"],
     0.0,
     1.0,
     "",
-    "0.9, 0.5 and 0.01 by default; --floor at most 1 / actions",
+    "0.9, 0.5, 0.01 and 0 by default; --floor at most 1 / actions",
 );
 
 /// Rewards an n-step update sums.
