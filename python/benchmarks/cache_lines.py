@@ -1,6 +1,6 @@
 """Cache lines a world's step fetches when many worlds step in one batch:
-why steps per CPU-second fall as the batch grows (docs/performance.md,
-"Python environments"). Each world count's batch (the standard
+why steps per CPU-second fall as the batch grows
+(docs/python-performance.md). Each world count's batch (the standard
 configuration, one thread, random actions) runs under valgrind's
 cachegrind, whose cache model has the processor's first-level data cache
 and, as its last level, a cache of this machine's second-level size (read

@@ -7,7 +7,7 @@ here (VMAS_VERSION), its `transport` scenario with its defaults and our
 standard configuration's bodies (`pucks`, python/benchmarks/vmas_steps.py).
 Writes the raw runs as JSON, the load average and VMAS's and PyTorch's
 versions with them; `--render` turns such a file into the markdown table
-of docs/performance.md, `--render-vmas` into docs/python.md's comparison.
+of docs/python-performance.md, `--render-vmas` into docs/python.md's comparison.
 `--tiny` runs every step of the method at a scale a test can afford.
 
     cargo build --release -p host && scripts/test-python   # the release host, the wheel in target/python-venv

@@ -1,10 +1,10 @@
 """The Python pages show the examples that run and the figures that were
 measured: docs/python-examples.md the example files verbatim,
 docs/python-results.md the learning tables rendered from their results
-files, docs/performance.md the throughput table and docs/python.md the
-comparison with VMAS rendered from the results file of the benchmark
+files, docs/python-performance.md the throughput table and docs/python.md
+the comparison with VMAS rendered from the results file of the benchmark
 (python/benchmarks/throughput.py), which also runs here at a tiny scale,
-and docs/performance.md the cache lines a step fetches
+and docs/python-performance.md the cache lines a step fetches
 (python/benchmarks/cache_lines.py)."""
 
 import argparse
@@ -37,14 +37,14 @@ def test_the_examples_in_the_docs_are_the_example_files(repo):
 def test_the_throughput_table_is_rendered_from_the_measured_results(repo):
     throughput = benchmark(repo, "throughput")
     table = throughput.render(json.loads((repo / "docs" / "python-throughput.json").read_text()))
-    assert table in (repo / "docs" / "performance.md").read_text(), "docs/performance.md does not hold the rendered table"
+    assert table in (repo / "docs" / "python-performance.md").read_text(), "docs/python-performance.md does not hold the rendered table"
 
 
 def test_the_cache_line_table_is_rendered_from_the_counts_and_what_the_docs_say_of_it_holds(repo):
     cache_lines = benchmark(repo, "cache_lines")
     results = json.loads((repo / "docs" / "python-cache-lines.json").read_text())
-    assert cache_lines.render(results) in (repo / "docs" / "performance.md").read_text(), \
-        "docs/performance.md does not hold the rendered cache-line table"
+    assert cache_lines.render(results) in (repo / "docs" / "python-performance.md").read_text(), \
+        "docs/python-performance.md does not hold the rendered cache-line table"
     rows = {row["worlds"]: row for row in results["rows"]}
     instructions = [row["instructions"] for row in rows.values()]
     assert max(instructions) < 1.1 * min(instructions), "the instructions stay within a tenth of each other"
@@ -78,7 +78,7 @@ def test_the_comparison_with_vmas_is_rendered_from_the_measured_results_of_the_p
     table = throughput.render_vmas(results)
     assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered comparison"
     install = f"pip install vmas=={throughput.VMAS_VERSION}"
-    assert install in (repo / "docs" / "performance.md").read_text() and install in throughput.__doc__
+    assert install in (repo / "docs" / "python-performance.md").read_text() and install in throughput.__doc__
 
 
 def test_the_throughput_benchmark_runs_every_configuration_at_a_tiny_scale(repo, host):
