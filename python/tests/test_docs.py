@@ -10,6 +10,7 @@ and docs/python-performance.md the cache lines a step fetches
 import argparse
 import importlib.util
 import json
+import statistics
 import subprocess
 import sys
 
@@ -77,6 +78,14 @@ def test_the_comparison_with_vmas_is_rendered_from_the_measured_results_of_the_p
     assert {("ours", 1), ("vmas", 1)} <= sides and len({t for _, t in sides if t}) == 2, "both sides at one thread and on every core"
     table = throughput.render_vmas(results)
     assert table in (repo / "docs" / "python.md").read_text(), "docs/python.md does not hold the rendered comparison"
+    # what docs/python.md says the targets would take
+    per_cpu = {row["name"]: statistics.median(row["cpu_runs"]) for row in results["rows"]}
+    native = per_cpu["host run, random actions (one thread)"]
+    transport = {row["worlds"]: statistics.median(row["cpu_runs"]) for row in results["rows"]
+                 if row["side"] == "vmas" and row["threads"] == 1 and "transport" in row["name"]}
+    ours_64 = per_cpu["vector_env, 64 worlds, 1 thread, random actions"]
+    assert 3 * transport[512] > native, "3x VMAS at 512 worlds is beyond one native world in the cache"
+    assert 1.1 < 10 * transport[64] / ours_64 < 1.2, "10x at 64 worlds is about a seventh more than ours"
     install = f"pip install vmas=={throughput.VMAS_VERSION}"
     assert install in (repo / "docs" / "python-performance.md").read_text() and install in throughput.__doc__
 
