@@ -72,14 +72,17 @@ impl Score {
     }
 
     /// Whether this score forms at least `share` of `bar`'s count on
-    /// every field (always, with a share of 0).
+    /// every field: always with a share of 0 (as a search before the bar
+    /// did, whose logs keep no counts per field), never for a score of
+    /// other fields.
     pub fn holds(&self, bar: &Score, share: f64) -> bool {
-        self.fields.len() == bar.fields.len()
-            && self
-                .fields
-                .iter()
-                .zip(&bar.fields)
-                .all(|(&mine, &theirs)| mine as f64 >= share * theirs as f64)
+        share <= 0.0
+            || self.fields.len() == bar.fields.len()
+                && self
+                    .fields
+                    .iter()
+                    .zip(&bar.fields)
+                    .all(|(&mine, &theirs)| mine as f64 >= share * theirs as f64)
     }
 
     /// The score of per-field scores (formations and mean Eval of each).
@@ -230,7 +233,7 @@ mod tests {
         );
         let other_fields = Score::of_fields(&[(300, 0.5)]);
         assert!(
-            !other_fields.holds(&bar, 0.0),
+            !other_fields.holds(&bar, 0.5),
             "scores of other worlds never hold"
         );
     }
