@@ -47,10 +47,14 @@ def test_the_cache_line_table_is_rendered_from_the_counts_and_what_the_docs_say_
     assert cache_lines.render(results) in (repo / "docs" / "python-performance.md").read_text(), \
         "docs/python-performance.md does not hold the rendered cache-line table"
     rows = {row["worlds"]: row for row in results["rows"]}
-    instructions = [row["instructions"] for row in rows.values()]
+    instructions = [row["instructions"] for worlds, row in rows.items() if worlds >= 64]
     assert max(instructions) < 1.1 * min(instructions), "the instructions stay within a tenth of each other"
     for worlds, row in rows.items():
-        assert 200 <= row["first_level_misses"] <= 250, f"about 225 first-level misses at {worlds} worlds"
+        if worlds >= 64:
+            assert 200 <= row["first_level_misses"] <= 250, f"about 225 first-level misses at {worlds} worlds"
+        else:
+            assert row["second_level_misses"] < 0.1 * row["first_level_misses"], \
+                f"the lines stay in the second level at {worlds} worlds"
         if worlds >= 128:
             assert row["second_level_misses"] >= 0.8 * row["first_level_misses"], \
                 f"nearly all also miss the second level at {worlds} worlds"
