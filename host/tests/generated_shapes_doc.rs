@@ -176,7 +176,7 @@ fn hold_table(dir: &Path) -> String {
     let text = std::fs::read_to_string(dir.join("general-hold.search.json")).unwrap();
     let log: Value = serde_json::from_str(&text).unwrap();
     let search = &log["search"];
-    let hold = search["hold"].as_f64().unwrap();
+    let hold = search["hold_share"].as_f64().unwrap();
     let shapes: Vec<String> = std::iter::once(&log["world"]["field"])
         .chain(search["also_field"].as_array().unwrap())
         .map(|f| f.as_str().unwrap().to_string())

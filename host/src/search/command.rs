@@ -8,7 +8,7 @@
 //! distribution moves towards the `elites` best; the best candidate other
 //! than the result is scored on the validation worlds, and becomes the
 //! result only if it forms more there than the result did (or as many, at
-//! a higher mean Eval) and, with a `hold` share, forms at least that share
+//! a higher mean Eval) and, with a `hold_share`, forms at least that share
 //! of the start table's count there on every field and noise level. So the
 //! result never forms fewer than the start table on the validation worlds.
 //! Scores: [`Score`].
@@ -431,7 +431,7 @@ pub fn run_from(
             }
         };
         let replaced = challenger_validation.beats(&result_validation)
-            && challenger_validation.holds(&start_validation, settings.hold);
+            && challenger_validation.holds(&start_validation, settings.hold_share);
         if replaced {
             result = candidates[challenger].clone();
             result_validation = challenger_validation.clone();
@@ -497,7 +497,7 @@ mod tests {
             threads,
             also_field: Vec::new(),
             also_noise: Vec::new(),
-            hold: 0.0,
+            hold_share: 0.0,
         }
     }
 
@@ -545,7 +545,7 @@ mod tests {
             small_with(SearchConfig {
                 also_noise: vec![2.0],
                 generations: 4,
-                hold,
+                hold_share: hold,
                 ..small_settings(2, Start::Orbital)
             })
         };

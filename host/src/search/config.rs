@@ -134,7 +134,7 @@ pub struct SearchConfig {
     /// on some shapes without giving up others.
     #[arg(long, value_name = "SHARE", default_value_t = 0.0)]
     #[serde(default)]
-    pub hold: f64,
+    pub hold_share: f64,
 }
 
 impl SearchConfig {
@@ -169,7 +169,7 @@ impl SearchConfig {
             ("--keep", self.keep),
             ("--rate", self.rate),
             ("--floor", self.floor),
-            ("--hold", self.hold),
+            ("--hold-share", self.hold_share),
         ] {
             ranges::SEARCH_PROBABILITY.check_as(flag, value)?;
         }

@@ -163,7 +163,7 @@ pub fn search_settings(scale: f64) -> SearchConfig {
         threads: 0,
         also_field: Vec::new(),
         also_noise: vec![2.0],
-        hold: 0.0,
+        hold_share: 0.0,
     }
 }
 

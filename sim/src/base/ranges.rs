@@ -659,7 +659,7 @@ pub const SEARCH_WORLDS: Range = Range::closed(
 
 /// The policy search's probabilities and shares.
 pub const SEARCH_PROBABILITY: Range = Range::closed(
-    &["--keep", "--rate", "--floor", "--hold"],
+    &["--keep", "--rate", "--floor", "--hold-share"],
     0.0,
     1.0,
     "",
