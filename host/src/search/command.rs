@@ -95,6 +95,20 @@ pub struct SearchLog {
     pub result: Vec<u8>,
 }
 
+impl SearchLog {
+    /// Generations whose challenger scored more than the result on the
+    /// validation worlds and was refused for the hold share.
+    pub fn refused(&self) -> usize {
+        let mut before = &self.start_validation;
+        let mut refused = 0;
+        for g in &self.generations {
+            refused += usize::from(!g.replaced && g.challenger_validation.beats(before));
+            before = &g.result_validation;
+        }
+        refused
+    }
+}
+
 /// What a search did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SearchReport {
@@ -133,6 +147,15 @@ impl std::fmt::Display for SearchReport {
             l.validation_seeds.len(),
             l.search.validation_steps
         )?;
+        if l.search.hold_share > 0.0 {
+            writeln!(
+                f,
+                "hold share           {}: {} of {} challengers that scored more refused",
+                l.search.hold_share,
+                l.refused(),
+                l.generations.len()
+            )?;
+        }
         writeln!(
             f,
             "speed                {:.0} steps/s per core ({} core{}, {:.1} s)",
@@ -568,6 +591,13 @@ mod tests {
             "the free search gave up a field somewhere: the test must see the bar act"
         );
         assert_ne!(free.generations, held.generations);
+        // the first decision the two differ on is one the bar refused
+        assert_eq!(
+            free.refused(),
+            0,
+            "without a bar nothing that scores more is refused"
+        );
+        assert!(held.refused() >= 1);
     }
 
     /// The result's validation score before generation `g`.
